@@ -1,0 +1,76 @@
+//! Error type of the finite-element kernels.
+
+use thiserror::Error;
+
+/// Everything that can go wrong while building or evaluating finite elements.
+#[non_exhaustive]
+#[derive(Debug, Error)]
+pub enum FemError {
+    /// A material constant is out of its admissible range.
+    #[error("invalid material constant {field} = {value}: expected {expected}")]
+    InvalidMaterial {
+        /// Name of the constant.
+        field: &'static str,
+        /// Offending value.
+        value: f64,
+        /// Admissible range, in words.
+        expected: &'static str,
+    },
+    /// An element or load parameter (thickness, modulus, scale factor, ...) is out of range.
+    #[error("invalid parameter {name} = {value}: expected {expected}")]
+    InvalidParameter {
+        /// Name of the parameter.
+        name: &'static str,
+        /// Offending value.
+        value: f64,
+        /// Admissible range, in words.
+        expected: &'static str,
+    },
+    /// The deformation gradient has `J = det F <= 0` or non-finite entries.
+    #[error("inverted element: det F = {det_f}")]
+    InvertedElement {
+        /// Determinant of the deformation gradient.
+        det_f: f64,
+    },
+    /// The reference geometry has a non-positive (or non-finite) Jacobian determinant.
+    #[error("degenerate reference element: det J = {det_j}")]
+    DegenerateElement {
+        /// Jacobian determinant of the isoparametric map at the offending point.
+        det_j: f64,
+    },
+    /// Only the spatial dimensions 2 and 3 are supported.
+    #[error("unsupported spatial dimension {dim}: expected 2 or 3")]
+    UnsupportedDimension {
+        /// Requested dimension.
+        dim: usize,
+    },
+    /// A slice argument has the wrong number of entries.
+    #[error("{what}: expected {expected} entries, found {found}")]
+    LengthMismatch {
+        /// What the slice holds.
+        what: &'static str,
+        /// Required length.
+        expected: usize,
+        /// Actual length.
+        found: usize,
+    },
+    /// An error raised while processing one element of a mesh.
+    #[error("element {index}: {source}")]
+    Element {
+        /// Element index in the mesh.
+        index: usize,
+        /// Underlying error.
+        source: Box<FemError>,
+    },
+    /// The mesh is inconsistent.
+    #[error("invalid mesh: {0}")]
+    InvalidMesh(String),
+    /// A rigid body has unphysical inertia or an inadmissible axis.
+    #[error("invalid rigid body {body}: {reason}")]
+    InvalidRigidBody {
+        /// Name of the body.
+        body: String,
+        /// What is wrong.
+        reason: String,
+    },
+}

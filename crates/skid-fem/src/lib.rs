@@ -1,0 +1,28 @@
+//! Finite-element kernels of skid, an implicit solver for frictional contact.
+//!
+//! * [`material`]: hyperelastic laws in Kirchhoff-stress form with their spatial tangents
+//!   ([`PolynomialN1`]: Mooney-Rivlin deviatoric part plus the Abaqus volumetric term).
+//! * [`cell`]: the multilinear reference quad/hex (corner order, shape functions, Gauss rule,
+//!   hourglass base vectors, reference geometry).
+//! * [`solid`]: the one-point solid element with hourglass stiffness ([`OnePointSolid`]), one
+//!   code path for 2D plane strain (D = 2) and 3D (D = 3).
+//! * [`pressure`]: follower pressure on element faces.
+//! * [`mesh`]: solid meshes with node sets and surfaces ([`SolidMesh`]).
+//! * [`rigid`]: rigid bodies (reference node with point mass and rotary inertia).
+//!
+//! All kernels work in SI units and report failures as [`FemError`].
+
+pub mod cell;
+pub mod error;
+pub mod material;
+pub mod mesh;
+pub mod pressure;
+pub mod rigid;
+pub mod solid;
+
+pub use error::FemError;
+pub use material::{Hyperelastic, PolynomialN1, SpatialTangent};
+pub use mesh::SolidMesh;
+pub use pressure::pressure_face_forces;
+pub use rigid::RigidBody;
+pub use solid::{ElementResponse, OnePointSolid};

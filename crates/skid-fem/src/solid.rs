@@ -1,0 +1,635 @@
+//! One-point (reduced-integration) solid element with Flanagan-Belytschko hourglass stiffness:
+//! the CPE4R role in 2D plane strain (D = 2) and the C3D8R role in 3D (D = 3), one code path.
+
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6xX, SVector, Vector3};
+
+use crate::cell::{ReferenceGeometry, corner_count, embed, hourglass_base_vectors};
+use crate::error::FemError;
+use crate::material::{Hyperelastic, VOIGT_PAIRS};
+
+/// A reduced-integration solid element: reference volume, mean gradients and hourglass data.
+#[derive(Clone, Debug)]
+pub struct OnePointSolid<const D: usize> {
+    /// Reference volume `V0` (area times thickness in 2D).
+    volume: f64,
+    /// Mean gradients `b_I = (1/V0) int dN_I/dX dV`.
+    mean_gradients: Vec<SVector<f64, D>>,
+    /// Hourglass shape vectors `gamma_alpha` as the rows of a (modes x nodes) matrix.
+    hourglass_vectors: DMatrix<f64>,
+    /// Hourglass stiffness `k_i` per displacement direction.
+    hourglass_stiffness: SVector<f64, D>,
+}
+
+/// Response of one element at a given displacement.
+#[derive(Clone, Debug)]
+pub struct ElementResponse {
+    /// Internal nodal forces, length `D * 2^D`, node-major (index `a * D + i`).
+    pub force: DVector<f64>,
+    /// Tangent `d force / d u` (symmetric), same ordering, if requested.
+    pub stiffness: Option<DMatrix<f64>>,
+    /// Material strain energy `V0 W(F)`.
+    pub strain_energy: f64,
+    /// Hourglass stabilisation energy.
+    pub hourglass_energy: f64,
+    /// Cauchy stress `sigma = tau / J` (3D; in plane strain `sigma33` included).
+    pub cauchy_stress: Matrix3<f64>,
+    /// Volume ratio `J = det F`.
+    pub volume_ratio: f64,
+}
+
+impl<const D: usize> OnePointSolid<D> {
+    /// Builds the element from its reference geometry.
+    ///
+    /// `x_ref`: the 2^D reference nodal coordinates in the cell corner order. `thickness`:
+    /// out-of-plane thickness in 2D (plane strain; volume = area * thickness); ignored in 3D
+    /// (pass 1.0). `shear_modulus`: mu0 of the material. `hourglass_scale`: dimensionless factor
+    /// (1.0 = default, 0.0 = no stabilisation) on the stabilisation stiffness.
+    ///
+    /// Hourglass vectors: `gamma_alpha = (1/n) [h_alpha - sum_j (h_alpha . X_j) b_j]` with
+    /// `n = 2^D`, `X_j` the reference nodal coordinates in direction j and `b_j` the mean
+    /// gradient components; thus `gamma . X_j = 0` and `gamma . 1 = 0` (affine fields, rigid
+    /// motions included, produce no hourglass strain) and `gamma . u_i` is the amplitude `q` of
+    /// the mode `u_i = q h(xi)`.
+    ///
+    /// Hourglass stiffness per direction: `k_i = s (2/3) mu0 V0 n sum_I b_iI^2`. On a brick with
+    /// half-width `a` along i, the mode `u_i = q xi eta` has `eps_ii = q eta / a`, whose
+    /// deviatoric bending energy `1/2 * 2 mu0 int eps_ii^2 dV = mu0 q^2 V0 / (3 a^2)` equals
+    /// `1/2 k_i q^2` with `k_i = (2/3) mu0 V0 / a^2`, and `n sum_I b_iI^2 = 1/a^2` there. The same
+    /// `k_i` is used for all modes alpha of direction i. Only `mu0` enters, so the
+    /// stabilisation does not stiffen with the bulk modulus.
+    ///
+    /// # Errors
+    /// [`FemError::UnsupportedDimension`] unless D is 2 or 3, [`FemError::LengthMismatch`],
+    /// [`FemError::DegenerateElement`] for a reference Jacobian `det J <= 0`,
+    /// [`FemError::InvalidParameter`] for a non-positive thickness (2D), a negative or
+    /// non-finite shear modulus or hourglass scale.
+    pub fn new(
+        x_ref: &[SVector<f64, D>],
+        thickness: f64,
+        shear_modulus: f64,
+        hourglass_scale: f64,
+    ) -> Result<Self, FemError> {
+        let geometry = ReferenceGeometry::new(x_ref)?;
+        let thickness = if D == 2 {
+            check_parameter("thickness", thickness, thickness > 0.0, "finite and > 0")?
+        } else {
+            1.0
+        };
+        check_parameter(
+            "shear_modulus",
+            shear_modulus,
+            shear_modulus >= 0.0,
+            "finite and >= 0",
+        )?;
+        check_parameter(
+            "hourglass_scale",
+            hourglass_scale,
+            hourglass_scale >= 0.0,
+            "finite and >= 0",
+        )?;
+        let volume = geometry.measure * thickness;
+        let b = geometry.mean_gradients;
+        let n = corner_count(D);
+        let coordinates: Vec<DVector<f64>> = (0..D)
+            .map(|j| DVector::from_iterator(n, x_ref.iter().map(|x| x[j])))
+            .collect();
+        let gradients: Vec<DVector<f64>> = (0..D)
+            .map(|j| DVector::from_iterator(n, b.iter().map(|g| g[j])))
+            .collect();
+        let bases = hourglass_base_vectors::<D>()?;
+        let mut hourglass_vectors = DMatrix::zeros(bases.len(), n);
+        for (alpha, h) in bases.iter().enumerate() {
+            let mut gamma = h.clone();
+            for (x_j, b_j) in coordinates.iter().zip(&gradients) {
+                gamma.axpy(-h.dot(x_j), b_j, 1.0);
+            }
+            hourglass_vectors.set_row(alpha, &(gamma / n as f64).transpose());
+        }
+        let hourglass_stiffness = SVector::from_fn(|i, _| {
+            hourglass_scale
+                * (2.0 / 3.0)
+                * shear_modulus
+                * volume
+                * n as f64
+                * gradients[i].norm_squared()
+        });
+        Ok(Self {
+            volume,
+            mean_gradients: b,
+            hourglass_vectors,
+            hourglass_stiffness,
+        })
+    }
+
+    /// Number of nodes `2^D`.
+    pub fn node_count(&self) -> usize {
+        self.mean_gradients.len()
+    }
+
+    /// Reference volume `V0` (area times thickness in 2D).
+    pub fn volume(&self) -> f64 {
+        self.volume
+    }
+
+    /// F = I + sum_I u_I (x) b_I, embedded in 3D (plane strain: F33 = 1,
+    /// F13 = F23 = F31 = F32 = 0).
+    ///
+    /// `u` must hold one displacement per node; [`Self::evaluate`] checks this.
+    pub fn deformation_gradient(&self, u: &[SVector<f64, D>]) -> Matrix3<f64> {
+        self.mean_gradients
+            .iter()
+            .zip(u)
+            .fold(Matrix3::identity(), |f, (b, u)| {
+                f + embed(u) * embed(b).transpose()
+            })
+    }
+
+    /// Internal force, optional tangent, energies and stress at displacement u (node-major
+    /// ordering: index a*D + i).
+    ///
+    /// With `g_a = F^{-T} b_a` (the spatial gradient of `N_a`) and the Kirchhoff stress `tau`:
+    /// material force `f_a = V0 tau g_a`; tangent
+    /// `K_ab,ik = V0 [sum_jl g_aj c^tau_ijkl g_bl + (g_a . tau g_b) delta_ik]` (material +
+    /// geometric), with only in-plane `i, k` in 2D. Hourglass: `q_{i alpha} = gamma_alpha . u_i`,
+    /// `E_hg = 1/2 sum_i k_i sum_alpha q_{i alpha}^2`,
+    /// `f_{iI} = k_i sum_alpha q_{i alpha} gamma_{alpha I}`, constant stiffness
+    /// `k_i sum_alpha gamma_{alpha I} gamma_{alpha J}`.
+    ///
+    /// # Errors
+    /// [`FemError::LengthMismatch`] if `u` does not hold one vector per node,
+    /// [`FemError::InvertedElement`] if `J <= 0` or `F` is not finite.
+    pub fn evaluate(
+        &self,
+        material: &dyn Hyperelastic,
+        u: &[SVector<f64, D>],
+        with_tangent: bool,
+    ) -> Result<ElementResponse, FemError> {
+        let n = self.node_count();
+        if u.len() != n {
+            return Err(FemError::LengthMismatch {
+                what: "nodal displacements",
+                expected: n,
+                found: u.len(),
+            });
+        }
+        let f = self.deformation_gradient(u);
+        let det_f = f.determinant();
+        let inverted = FemError::InvertedElement { det_f };
+        if !(det_f > 0.0 && f.iter().all(|v| v.is_finite())) {
+            return Err(inverted);
+        }
+        let f_inv_t = f.try_inverse().ok_or(inverted)?.transpose();
+        let (tau, tangent) = if with_tangent {
+            let (tau, c) = material.stress_and_tangent(&f);
+            (tau, Some(c))
+        } else {
+            (material.kirchhoff_stress(&f), None)
+        };
+        let g: Vec<Vector3<f64>> = self
+            .mean_gradients
+            .iter()
+            .map(|b| f_inv_t * embed(b))
+            .collect();
+
+        let dofs = D * n;
+        let mut force = DVector::zeros(dofs);
+        for (a, g_a) in g.iter().enumerate() {
+            let f_a = tau * g_a * self.volume;
+            for i in 0..D {
+                force[a * D + i] = f_a[i];
+            }
+        }
+
+        let u_by_direction = DMatrix::from_fn(n, D, |a, i| u[a][i]);
+        let q = &self.hourglass_vectors * u_by_direction;
+        let mut hourglass_energy = 0.0;
+        for i in 0..D {
+            let k_i = self.hourglass_stiffness[i];
+            hourglass_energy += 0.5 * k_i * q.column(i).norm_squared();
+            let f_i = self.hourglass_vectors.tr_mul(&q.column(i)) * k_i;
+            for a in 0..n {
+                force[a * D + i] += f_i[a];
+            }
+        }
+
+        let stiffness = tangent.map(|c| {
+            let b = strain_displacement::<D>(&g);
+            let mut k = (b.transpose() * c.0 * &b) * self.volume;
+            let hourglass = self.hourglass_vectors.tr_mul(&self.hourglass_vectors);
+            for (a, g_a) in g.iter().enumerate() {
+                for (bn, g_b) in g.iter().enumerate() {
+                    let geometric = self.volume * g_a.dot(&(tau * g_b));
+                    for i in 0..D {
+                        k[(a * D + i, bn * D + i)] +=
+                            geometric + self.hourglass_stiffness[i] * hourglass[(a, bn)];
+                    }
+                }
+            }
+            k
+        });
+
+        Ok(ElementResponse {
+            force,
+            stiffness,
+            strain_energy: self.volume * material.strain_energy(&f),
+            hourglass_energy,
+            cauchy_stress: tau / det_f,
+            volume_ratio: det_f,
+        })
+    }
+
+    /// Lumped (row-sum) mass per node: rho V0 / 2^D.
+    pub fn lumped_node_mass(&self, density: f64) -> f64 {
+        density * self.volume / self.node_count() as f64
+    }
+}
+
+/// `value` if it is finite and `admissible`, else [`FemError::InvalidParameter`].
+fn check_parameter(
+    name: &'static str,
+    value: f64,
+    admissible: bool,
+    expected: &'static str,
+) -> Result<f64, FemError> {
+    if admissible && value.is_finite() {
+        Ok(value)
+    } else {
+        Err(FemError::InvalidParameter {
+            name,
+            value,
+            expected,
+        })
+    }
+}
+
+/// Strain-displacement matrix: column `a*D + i` is the engineering Voigt vector of
+/// `sym(e_i (x) g_a)`, so that `sum_jl g_aj c_ijkl g_bl = (B^T c B)_(ai)(bk)` for a Voigt
+/// tangent `c` with tensor components.
+fn strain_displacement<const D: usize>(g: &[Vector3<f64>]) -> Matrix6xX<f64> {
+    let mut b = Matrix6xX::zeros(D * g.len());
+    for (a, g_a) in g.iter().enumerate() {
+        for i in 0..D {
+            for (row, &(p, q)) in VOIGT_PAIRS.iter().enumerate() {
+                let delta = |m: usize| if m == i { 1.0 } else { 0.0 };
+                b[(row, a * D + i)] = if p == q {
+                    delta(p) * g_a[p]
+                } else {
+                    delta(p) * g_a[q] + delta(q) * g_a[p]
+                };
+            }
+        }
+    }
+    b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::{corners, restrict};
+    use crate::material::PolynomialN1;
+    use crate::mesh::SolidMesh;
+    use nalgebra::{Rotation3, SymmetricEigen, Vector2, Vector3 as V3};
+
+    fn material() -> Result<PolynomialN1, FemError> {
+        PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6)
+    }
+
+    /// Deterministic pseudo-random number in [-0.5, 0.5].
+    fn jitter(k: usize) -> f64 {
+        let s = (k as f64 * 12.9898 + 78.233).sin() * 43758.5453;
+        s - s.floor() - 0.5
+    }
+
+    /// A distorted element around the box with half-widths 1.0, 0.6, 0.8.
+    fn distorted<const D: usize>() -> Vec<SVector<f64, D>> {
+        let half = [1.0, 0.6, 0.8];
+        corners::<D>()
+            .iter()
+            .enumerate()
+            .map(|(a, c)| SVector::from_fn(|k, _| half[k] * c[k] + 0.3 * jitter(a * D + k)))
+            .collect()
+    }
+
+    /// Box element with half-widths `half`.
+    fn brick<const D: usize>(half: [f64; 3]) -> Vec<SVector<f64, D>> {
+        corners::<D>()
+            .iter()
+            .map(|c| SVector::from_fn(|k, _| half[k] * c[k]))
+            .collect()
+    }
+
+    /// Homogeneous finite deformation gradient (in-plane block used in 2D).
+    fn homogeneous_f<const D: usize>() -> Matrix3<f64> {
+        let f = Matrix3::new(1.12, 0.15, -0.05, -0.08, 0.9, 0.1, 0.04, -0.06, 1.05);
+        Matrix3::from_fn(|i, j| {
+            if i < D && j < D {
+                f[(i, j)]
+            } else if i == j {
+                1.0
+            } else {
+                0.0
+            }
+        })
+    }
+
+    fn affine<const D: usize>(f: &Matrix3<f64>, x: &[SVector<f64, D>]) -> Vec<SVector<f64, D>> {
+        x.iter()
+            .map(|x| restrict(&((f - Matrix3::identity()) * embed(x))))
+            .collect()
+    }
+
+    /// A general finite deformation: affine part plus a non-affine (hourglass-exciting) part.
+    fn general_u<const D: usize>(x: &[SVector<f64, D>]) -> Vec<SVector<f64, D>> {
+        affine(&homogeneous_f::<D>(), x)
+            .iter()
+            .enumerate()
+            .map(|(a, u)| u + SVector::from_fn(|k, _| 0.08 * jitter(100 + a * D + k)))
+            .collect()
+    }
+
+    fn perturb<const D: usize>(u: &[SVector<f64, D>], dof: usize, h: f64) -> Vec<SVector<f64, D>> {
+        let mut u = u.to_vec();
+        u[dof / D][dof % D] += h;
+        u
+    }
+
+    fn check_tangent_and_energy<const D: usize>() -> Result<(), FemError> {
+        let m = material()?;
+        let x = distorted::<D>();
+        let element = OnePointSolid::new(&x, 0.7, m.initial_shear_modulus(), 1.0)?;
+        let u = general_u(&x);
+        let r = element.evaluate(&m, &u, true)?;
+        assert!(r.hourglass_energy > 0.0 && (r.volume_ratio - 1.0).abs() > 1e-2);
+        let k = r
+            .stiffness
+            .ok_or(FemError::InvalidMesh("no stiffness".into()))?;
+        assert!((&k - k.transpose()).amax() < 1e-10 * k.amax());
+        let without = element.evaluate(&m, &u, false)?;
+        assert!((&without.force - &r.force).amax() == 0.0 && without.stiffness.is_none());
+        let h = 1e-6;
+        for dof in 0..D * element.node_count() {
+            let plus = element.evaluate(&m, &perturb(&u, dof, h), false)?;
+            let minus = element.evaluate(&m, &perturb(&u, dof, -h), false)?;
+            let fd_column = (&plus.force - &minus.force) / (2.0 * h);
+            let err = (fd_column - k.column(dof)).amax() / k.amax();
+            assert!(err < 1e-6, "D = {D}, dof {dof}: tangent error {err}");
+            let energy = |r: &ElementResponse| r.strain_energy + r.hourglass_energy;
+            let fd_force = (energy(&plus) - energy(&minus)) / (2.0 * h);
+            let err = (fd_force - r.force[dof]).abs() / r.force.amax();
+            assert!(err < 1e-6, "D = {D}, dof {dof}: force error {err}");
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn tangent_and_force_match_finite_differences() -> Result<(), FemError> {
+        check_tangent_and_energy::<2>()?;
+        check_tangent_and_energy::<3>()
+    }
+
+    /// Patch of distorted elements: affine displacement on the boundary, Newton on the interior
+    /// nodes must reproduce the affine field and the homogeneous stress exactly.
+    fn check_patch<const D: usize>(divisions: [usize; D]) -> Result<(), FemError> {
+        let m = material()?;
+        let mut mesh =
+            SolidMesh::<D>::structured_block(SVector::zeros(), SVector::repeat(3.0), divisions)?;
+        let boundary: std::collections::BTreeSet<usize> =
+            mesh.node_sets.values().flatten().copied().collect();
+        for (id, x) in mesh.nodes.iter_mut().enumerate() {
+            *x += SVector::from_fn(|k, _| 0.3 * jitter(7 * id + k));
+        }
+        mesh.validate()?;
+        let elements = mesh
+            .elements
+            .iter()
+            .map(|e| {
+                let x: Vec<_> = e.iter().map(|&id| mesh.nodes[id]).collect();
+                OnePointSolid::new(&x, 1.0, m.initial_shear_modulus(), 1.0)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let f = homogeneous_f::<D>();
+        let exact = affine(&f, &mesh.nodes);
+        let free: Vec<usize> = (0..mesh.nodes.len() * D)
+            .filter(|dof| !boundary.contains(&(dof / D)))
+            .collect();
+        assert!(!free.is_empty());
+        let mut u = exact.clone();
+        for &dof in &free {
+            u[dof / D][dof % D] += 0.05 * jitter(dof + 999);
+        }
+        let tolerance = 1e-12 * m.initial_shear_modulus();
+        let mut converged = false;
+        for _ in 0..30 {
+            let (mut force, mut stiffness) = (
+                DVector::zeros(u.len() * D),
+                DMatrix::zeros(u.len() * D, u.len() * D),
+            );
+            for (element, nodes) in elements.iter().zip(&mesh.elements) {
+                let u_e: Vec<_> = nodes.iter().map(|&id| u[id]).collect();
+                let r = element.evaluate(&m, &u_e, true)?;
+                let k = r
+                    .stiffness
+                    .ok_or(FemError::InvalidMesh("no stiffness".into()))?;
+                for (a, &na) in nodes.iter().enumerate() {
+                    for i in 0..D {
+                        force[na * D + i] += r.force[a * D + i];
+                        for (b, &nb) in nodes.iter().enumerate() {
+                            for j in 0..D {
+                                stiffness[(na * D + i, nb * D + j)] += k[(a * D + i, b * D + j)];
+                            }
+                        }
+                    }
+                }
+            }
+            let residual = DVector::from_iterator(free.len(), free.iter().map(|&d| force[d]));
+            if residual.amax() < tolerance {
+                converged = true;
+                break;
+            }
+            let k_ff =
+                DMatrix::from_fn(free.len(), free.len(), |r, c| stiffness[(free[r], free[c])]);
+            let du = k_ff
+                .lu()
+                .solve(&(-residual))
+                .ok_or(FemError::InvalidMesh("singular".into()))?;
+            for (&dof, step) in free.iter().zip(du.iter()) {
+                u[dof / D][dof % D] += step;
+            }
+        }
+        assert!(converged, "D = {D}: Newton did not converge");
+        for (ui, ei) in u.iter().zip(&exact) {
+            assert!((ui - ei).norm() < 1e-9, "D = {D}: {ui} vs {ei}");
+        }
+        let sigma = m.kirchhoff_stress(&f) / f.determinant();
+        for (element, nodes) in elements.iter().zip(&mesh.elements) {
+            let u_e: Vec<_> = nodes.iter().map(|&id| u[id]).collect();
+            let r = element.evaluate(&m, &u_e, false)?;
+            assert!((r.cauchy_stress - sigma).norm() < 1e-8 * sigma.norm());
+            assert!(r.hourglass_energy < 1e-12 * r.strain_energy);
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn patch_of_distorted_elements_reproduces_homogeneous_deformation() -> Result<(), FemError> {
+        check_patch::<2>([3, 3])?;
+        check_patch::<3>([3, 3, 2])
+    }
+
+    fn check_rigid_rotation<const D: usize>(rotation: Matrix3<f64>) -> Result<(), FemError> {
+        let m = material()?;
+        let x = distorted::<D>();
+        let element = OnePointSolid::new(&x, 1.0, m.initial_shear_modulus(), 1.0)?;
+        let u = affine(&rotation, &x);
+        let r = element.evaluate(&m, &u, false)?;
+        let mu = m.initial_shear_modulus();
+        assert!((r.volume_ratio - 1.0).abs() < 1e-14);
+        assert!(r.cauchy_stress.norm() < 1e-8 * mu, "{}", r.cauchy_stress);
+        assert!(r.force.amax() < 1e-8 * mu * element.volume());
+        assert!(r.hourglass_energy < 1e-20 * mu * element.volume());
+        assert!(r.strain_energy.abs() < 1e-12 * mu * element.volume());
+        Ok(())
+    }
+
+    #[test]
+    fn large_rigid_rotation_is_stress_and_force_free() -> Result<(), FemError> {
+        let angle = 60f64.to_radians();
+        check_rigid_rotation::<2>(*Rotation3::from_axis_angle(&V3::z_axis(), angle).matrix())?;
+        let axis = nalgebra::Unit::new_normalize(V3::new(1.0, -2.0, 0.5));
+        check_rigid_rotation::<3>(*Rotation3::from_axis_angle(&axis, angle).matrix())
+    }
+
+    fn zero_eigenvalues<const D: usize>(scale: f64) -> Result<usize, FemError> {
+        let m = material()?;
+        let x = distorted::<D>();
+        let element = OnePointSolid::new(&x, 1.0, m.initial_shear_modulus(), scale)?;
+        let u = vec![SVector::zeros(); element.node_count()];
+        let k = element
+            .evaluate(&m, &u, true)?
+            .stiffness
+            .ok_or(FemError::InvalidMesh("no stiffness".into()))?;
+        let eigenvalues = SymmetricEigen::new(k).eigenvalues;
+        let largest = eigenvalues.amax();
+        assert!(eigenvalues.min() > -1e-10 * largest);
+        Ok(eigenvalues
+            .iter()
+            .filter(|l| l.abs() < 1e-10 * largest)
+            .count())
+    }
+
+    #[test]
+    fn stabilised_element_has_only_rigid_zero_modes() -> Result<(), FemError> {
+        assert_eq!(zero_eigenvalues::<2>(1.0)?, 3);
+        assert_eq!(zero_eigenvalues::<3>(1.0)?, 6);
+        // Without stabilisation: 2 hourglass modes in 2D, 12 in 3D.
+        assert_eq!(zero_eigenvalues::<2>(0.0)?, 3 + 2);
+        assert_eq!(zero_eigenvalues::<3>(0.0)?, 6 + 12);
+        Ok(())
+    }
+
+    fn check_hourglass_mode_energy<const D: usize>() -> Result<(), FemError> {
+        let m = material()?;
+        let mu = m.initial_shear_modulus();
+        let half = [1.5, 0.5, 0.8];
+        let element = OnePointSolid::new(&brick::<D>(half), 1.0, mu, 1.0)?;
+        let q = 1e-3;
+        for h in hourglass_base_vectors::<D>()? {
+            for (i, a_i) in half.iter().enumerate().take(D) {
+                let u: Vec<SVector<f64, D>> = h
+                    .iter()
+                    .map(|&v| SVector::from_fn(|k, _| if k == i { q * v } else { 0.0 }))
+                    .collect();
+                let r = element.evaluate(&m, &u, false)?;
+                // The mode has no mean strain, so the one-point material part does not see it...
+                assert!(r.strain_energy.abs() < 1e-20 * mu * element.volume());
+                // ...and the stabilisation energy is mu0 q^2 V0 / (3 a_i^2).
+                let expected = mu * q * q * element.volume() / (3.0 * a_i * a_i);
+                assert!((r.hourglass_energy - expected).abs() < 1e-12 * expected);
+            }
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn hourglass_modes_carry_the_bending_energy_of_a_brick() -> Result<(), FemError> {
+        check_hourglass_mode_energy::<2>()?;
+        check_hourglass_mode_energy::<3>()
+    }
+
+    #[test]
+    fn volume_includes_thickness_and_lumped_mass_sums_to_total() -> Result<(), FemError> {
+        let rect = OnePointSolid::<2>::new(&brick([1.0, 1.5, 0.0]), 0.5, 1.0, 1.0)?;
+        assert!((rect.volume() - 2.0 * 3.0 * 0.5).abs() < 1e-14);
+        let hex = OnePointSolid::<3>::new(&brick([1.0, 1.5, 0.25]), 7.0, 1.0, 1.0)?;
+        assert!((hex.volume() - 2.0 * 3.0 * 0.5).abs() < 1e-14);
+        let rho = 7800.0;
+        let quad = OnePointSolid::<2>::new(&distorted(), 0.3, 1.0, 1.0)?;
+        let total = quad.lumped_node_mass(rho) * quad.node_count() as f64;
+        assert!((total - rho * quad.volume()).abs() < 1e-12 * total);
+        assert_eq!(quad.node_count(), 4);
+        let hex = OnePointSolid::<3>::new(&distorted(), 1.0, 1.0, 1.0)?;
+        let total = hex.lumped_node_mass(rho) * hex.node_count() as f64;
+        assert!((total - rho * hex.volume()).abs() < 1e-12 * total);
+        Ok(())
+    }
+
+    #[test]
+    fn inverted_and_degenerate_elements_are_errors() -> Result<(), FemError> {
+        let m = material()?;
+        let quad = OnePointSolid::<2>::new(&distorted(), 1.0, 1.0, 1.0)?;
+        let flip = Matrix3::from_diagonal(&V3::new(-0.5, 1.0, 1.0));
+        let u = affine(&flip, &distorted::<2>());
+        assert!(
+            matches!(quad.evaluate(&m, &u, true), Err(FemError::InvertedElement { det_f }) if det_f < 0.0)
+        );
+        let hex = OnePointSolid::<3>::new(&distorted(), 1.0, 1.0, 1.0)?;
+        let flip = Matrix3::from_diagonal(&V3::new(1.0, 1.0, -0.5));
+        let u = affine(&flip, &distorted::<3>());
+        assert!(matches!(
+            hex.evaluate(&m, &u, false),
+            Err(FemError::InvertedElement { .. })
+        ));
+        let mut nan = vec![V3::zeros(); 8];
+        nan[3].x = f64::NAN;
+        assert!(matches!(
+            hex.evaluate(&m, &nan, false),
+            Err(FemError::InvertedElement { .. })
+        ));
+        assert!(matches!(
+            hex.evaluate(&m, &nan[..7], false),
+            Err(FemError::LengthMismatch { .. })
+        ));
+
+        let mut clockwise = distorted::<2>();
+        clockwise.swap(1, 3);
+        assert!(matches!(
+            OnePointSolid::new(&clockwise, 1.0, 1.0, 1.0),
+            Err(FemError::DegenerateElement { det_j }) if det_j < 0.0
+        ));
+        let mut upside_down = distorted::<3>();
+        upside_down.rotate_left(4);
+        assert!(matches!(
+            OnePointSolid::new(&upside_down, 1.0, 1.0, 1.0),
+            Err(FemError::DegenerateElement { .. })
+        ));
+        assert!(matches!(
+            OnePointSolid::new(&[Vector2::new(1.0, 1.0); 4], 1.0, 1.0, 1.0),
+            Err(FemError::DegenerateElement { .. })
+        ));
+        assert!(matches!(
+            OnePointSolid::<2>::new(&distorted(), 0.0, 1.0, 1.0),
+            Err(FemError::InvalidParameter {
+                name: "thickness",
+                ..
+            })
+        ));
+        assert!(matches!(
+            OnePointSolid::<3>::new(&distorted(), 1.0, 1.0, -1.0),
+            Err(FemError::InvalidParameter {
+                name: "hourglass_scale",
+                ..
+            })
+        ));
+        Ok(())
+    }
+}
