@@ -1,0 +1,106 @@
+//! Input checks for the friction problem, done before any data reaches clarabel (which asserts).
+
+use nalgebra::DMatrix;
+
+use super::{CoulombSettings, FrictionProblem};
+use crate::error::ContactError;
+
+/// Largest accepted asymmetry `max |W_ij - W_ji|`, relative to `max |W_ij|`.
+const SYMMETRY_TOLERANCE: f64 = 1e-6;
+
+fn invalid(message: String) -> Result<(), ContactError> {
+    Err(ContactError::InvalidProblem(message))
+}
+
+/// Check sizes, finiteness, `dim ∈ {2, 3}`, `mu_i >= 0`, `W` square, symmetric (to
+/// [`SYMMETRY_TOLERANCE`]) with a positive diagonal. Returns the number of contacts.
+pub(crate) fn check_problem(problem: &FrictionProblem) -> Result<usize, ContactError> {
+    let dim = problem.dim;
+    if dim != 2 && dim != 3 {
+        invalid(format!("contact dimension must be 2 or 3, got {dim}"))?;
+    }
+    let n_contacts = problem.mu.len();
+    let m = dim * n_contacts;
+    if problem.q.len() != m {
+        invalid(format!(
+            "q has length {} but {n_contacts} contacts of dimension {dim} need {m}",
+            problem.q.len()
+        ))?;
+    }
+    if problem.w.nrows() != m || problem.w.ncols() != m {
+        invalid(format!(
+            "W is {}x{} but must be {m}x{m}",
+            problem.w.nrows(),
+            problem.w.ncols()
+        ))?;
+    }
+    if let Some((i, mu)) = problem
+        .mu
+        .iter()
+        .enumerate()
+        .find(|(_, mu)| !(mu.is_finite() && **mu >= 0.0))
+    {
+        invalid(format!(
+            "friction coefficient of contact {i} must be finite and >= 0, got {mu}"
+        ))?;
+    }
+    if !problem.q.iter().all(|v| v.is_finite()) {
+        invalid("q has non-finite entries".into())?;
+    }
+    check_delassus(problem.w)?;
+    Ok(n_contacts)
+}
+
+fn check_delassus(w: &DMatrix<f64>) -> Result<(), ContactError> {
+    if !w.iter().all(|v| v.is_finite()) {
+        invalid("W has non-finite entries".into())?;
+    }
+    if let Some(i) = (0..w.nrows()).find(|&i| w[(i, i)] <= 0.0) {
+        invalid(format!(
+            "W must have a positive diagonal, W[{i},{i}] = {}",
+            w[(i, i)]
+        ))?;
+    }
+    let magnitude = w.amax();
+    let asymmetry = (w - w.transpose()).amax();
+    if asymmetry > SYMMETRY_TOLERANCE * magnitude {
+        invalid(format!(
+            "W is not symmetric: max |W - W^T| = {asymmetry:e} against max |W| = {magnitude:e}"
+        ))?;
+    }
+    Ok(())
+}
+
+/// Check the settings: positive finite tolerances and at least one iteration of each loop.
+pub(crate) fn check_settings(settings: &CoulombSettings) -> Result<(), ContactError> {
+    if !(settings.tolerance.is_finite() && settings.tolerance > 0.0) {
+        invalid(format!(
+            "tolerance must be finite and positive, got {}",
+            settings.tolerance
+        ))?;
+    }
+    if !(settings.conic_tolerance.is_finite() && settings.conic_tolerance > 0.0) {
+        invalid(format!(
+            "conic tolerance must be finite and positive, got {}",
+            settings.conic_tolerance
+        ))?;
+    }
+    if settings.max_fixed_point_iterations == 0 || settings.conic_max_iterations == 0 {
+        invalid("iteration limits must be at least 1".into())?;
+    }
+    Ok(())
+}
+
+/// Check a warm-start shift: one finite, non-negative entry per contact.
+pub(crate) fn check_shift(shift: &[f64], n_contacts: usize) -> Result<(), ContactError> {
+    if shift.len() != n_contacts {
+        invalid(format!(
+            "initial shift has length {} but there are {n_contacts} contacts",
+            shift.len()
+        ))?;
+    }
+    if !shift.iter().all(|s| s.is_finite() && *s >= 0.0) {
+        invalid("initial shift entries must be finite and >= 0".into())?;
+    }
+    Ok(())
+}

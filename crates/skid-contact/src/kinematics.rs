@@ -1,0 +1,304 @@
+//! Gap and slip kinematics of a slave node against a surface carried by a rigid body rotating
+//! about a fixed axis.
+//!
+//! With body reference point `c`, unit world axis `e` and angle `theta`, `Q(theta)` is the rotation
+//! by `theta` about `e` and the body frame is `y = Q^T (x - c)`. Since `dQ/dtheta = [e]x Q` and
+//! `Q^T e = e`, `dy = Q^T dx - (e x y) dtheta`. For any surface function `f(y)` this gives
+//! `df/dx = Q (df/dy)` and `df/dtheta = -(df/dy) . (e x y)`.
+
+use nalgebra::{Rotation3, Unit, Vector2, Vector3};
+
+use crate::surface::RigidSurface;
+
+/// Placement of a rigid body rotating about a fixed axis.
+#[derive(Clone, Copy, Debug)]
+pub struct RotatingFrame {
+    /// Reference point `c` of the body on the rotation axis (world frame).
+    pub center: Vector3<f64>,
+    /// Unit rotation axis `e` (world frame); it is normalised again on use.
+    pub axis: Vector3<f64>,
+    /// Rotation angle `theta` (radians, counter-clockwise about `axis`); the body frame coincides
+    /// with the world orientation at `theta = 0`.
+    pub angle: f64,
+}
+
+/// Gap, convected coordinates and their exact first derivatives for one slave node.
+#[derive(Clone, Debug)]
+pub struct ContactKinematics {
+    /// Signed gap `g` (`> 0` open).
+    pub gap: f64,
+    /// Convected surface coordinates `xi` of the closest point (body frame).
+    pub coords: Vector2<f64>,
+    /// World-frame outward unit normal of the surface at the closest point, `Q dg/dy` normalised.
+    pub normal: Vector3<f64>,
+    /// Derivatives of `[g, xi_0, xi_1]` with respect to the slave node's world position `x`:
+    /// `Q df/dy`.
+    pub d_dx: [Vector3<f64>; 3],
+    /// Derivatives of `[g, xi_0, xi_1]` with respect to the body's rotation angle `theta`:
+    /// `-(df/dy) . (e x y)`.
+    pub d_dangle: [f64; 3],
+}
+
+/// Evaluate gap, convected coordinates and their exact first derivatives for a node at world
+/// position `x` (2D problems pass `z = 0` and a `z` axis).
+///
+/// Returns `None` if the frame is degenerate (zero or non-finite axis, non-finite centre or angle)
+/// or the surface projection is undefined at `y = Q^T (x - c)`.
+pub fn evaluate(
+    surface: &dyn RigidSurface,
+    frame: &RotatingFrame,
+    x: &Vector3<f64>,
+) -> Option<ContactKinematics> {
+    if !(frame.angle.is_finite() && frame.center.iter().all(|c| c.is_finite())) {
+        return None;
+    }
+    let axis = Unit::try_new(frame.axis, 0.0).filter(|a| a.iter().all(|c| c.is_finite()))?;
+    let rotation = Rotation3::from_axis_angle(&axis, frame.angle);
+    let y = rotation.inverse_transform_vector(&(x - frame.center));
+    let projection = surface.project(&y)?;
+    let body_velocity = axis.cross(&y);
+    let gradients = [
+        projection.gap_gradient,
+        projection.coords_gradient[0],
+        projection.coords_gradient[1],
+    ];
+    let normal_world = rotation * projection.gap_gradient;
+    let normal_norm = normal_world.norm();
+    let normal = if normal_norm > 0.0 {
+        normal_world / normal_norm
+    } else {
+        normal_world
+    };
+    Some(ContactKinematics {
+        gap: projection.gap,
+        coords: projection.coords,
+        normal,
+        d_dx: gradients.map(|g| rotation * g),
+        d_dangle: gradients.map(|g| -g.dot(&body_velocity)),
+    })
+}
+
+/// Slip increment `current - previous` between two convected-coordinate states, each periodic
+/// component unwrapped with its surface period `p` into `(-p/2, p/2]`.
+pub fn slip_increment(
+    surface: &dyn RigidSurface,
+    previous: &Vector2<f64>,
+    current: &Vector2<f64>,
+) -> Vector2<f64> {
+    let periods = surface.coords_period();
+    let mut increment = current - previous;
+    for (component, period) in increment.iter_mut().zip(periods) {
+        if let Some(p) = period.filter(|p| p.is_finite() && *p > 0.0) {
+            *component -= p * (*component / p).round();
+            if *component <= -0.5 * p {
+                *component += p;
+            } else if *component > 0.5 * p {
+                *component -= p;
+            }
+        }
+    }
+    increment
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::ContactError;
+    use crate::surface::AnalyticCylinder;
+    use approx::assert_relative_eq;
+    use std::f64::consts::PI;
+
+    fn eval(
+        surface: &dyn RigidSurface,
+        frame: &RotatingFrame,
+        x: &Vector3<f64>,
+    ) -> Result<ContactKinematics, ContactError> {
+        evaluate(surface, frame, x).ok_or(ContactError::InvalidSurface("undefined".into()))
+    }
+
+    /// Differences of `[g, xi_0, xi_1]` between two states, with `xi` unwrapped.
+    fn difference(
+        surface: &dyn RigidSurface,
+        plus: &ContactKinematics,
+        minus: &ContactKinematics,
+    ) -> [f64; 3] {
+        let slip = slip_increment(surface, &minus.coords, &plus.coords);
+        [plus.gap - minus.gap, slip[0], slip[1]]
+    }
+
+    fn check_derivatives(
+        surface: &dyn RigidSurface,
+        frame: &RotatingFrame,
+        x: &Vector3<f64>,
+    ) -> Result<(), ContactError> {
+        let k = eval(surface, frame, x)?;
+        let h = 1e-6;
+        for j in 0..3 {
+            let mut xp = *x;
+            let mut xm = *x;
+            xp[j] += h;
+            xm[j] -= h;
+            let d = difference(
+                surface,
+                &eval(surface, frame, &xp)?,
+                &eval(surface, frame, &xm)?,
+            );
+            for (difference, derivative) in d.iter().zip(&k.d_dx) {
+                assert_relative_eq!(difference / (2.0 * h), derivative[j], epsilon = 1e-7);
+            }
+        }
+        let plus = RotatingFrame {
+            angle: frame.angle + h,
+            ..*frame
+        };
+        let minus = RotatingFrame {
+            angle: frame.angle - h,
+            ..*frame
+        };
+        let d = difference(
+            surface,
+            &eval(surface, &plus, x)?,
+            &eval(surface, &minus, x)?,
+        );
+        for (difference, derivative) in d.iter().zip(k.d_dangle) {
+            assert_relative_eq!(difference / (2.0 * h), derivative, epsilon = 1e-7);
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences_3d() -> Result<(), ContactError> {
+        let axis = Vector3::new(0.2, -0.4, 0.9).normalize();
+        let drum = AnalyticCylinder::new(0.2, axis)?;
+        let points = [
+            Vector3::new(0.3, 0.1, 0.5),
+            Vector3::new(-0.21, 0.05, -0.1),
+            Vector3::new(0.0, -0.19, 0.3),
+            Vector3::new(1.1, 0.7, 0.4),
+        ];
+        for angle in [0.0, 0.7, -2.5, 3.1, 11.0] {
+            let frame = RotatingFrame {
+                center: Vector3::new(0.9, 0.5, 0.3),
+                axis,
+                angle,
+            };
+            for x in &points {
+                check_derivatives(&drum, &frame, x)?;
+            }
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn derivatives_across_branch_cut() -> Result<(), ContactError> {
+        let drum = AnalyticCylinder::new(0.2, Vector3::z())?;
+        let frame = RotatingFrame {
+            center: Vector3::zeros(),
+            axis: Vector3::z(),
+            angle: 0.0,
+        };
+        // body-frame angle pi: atan2 jumps from +pi to -pi within the finite-difference stencil
+        let x = Vector3::new(-0.2005, 1e-8, 0.0);
+        let k = eval(&drum, &frame, &x)?;
+        assert!(k.coords[0] > 0.0);
+        let xm = Vector3::new(-0.2005, -1e-7, 0.0);
+        assert!(eval(&drum, &frame, &xm)?.coords[0] < 0.0);
+        check_derivatives(&drum, &frame, &x)?;
+        // a body rotated by pi/2 brings the cut to world angle 3 pi / 2 (below the centre)
+        let rotated = RotatingFrame {
+            angle: PI / 2.0,
+            ..frame
+        };
+        check_derivatives(&drum, &rotated, &Vector3::new(1e-9, -0.21, 0.0))?;
+        Ok(())
+    }
+
+    #[test]
+    fn circle_rotation_derivatives_are_exact() -> Result<(), ContactError> {
+        let radius = 0.2;
+        let drum = AnalyticCylinder::new(radius, Vector3::z())?;
+        for angle in [0.0, 1.0, -4.0] {
+            let frame = RotatingFrame {
+                center: Vector3::new(0.1, -0.3, 0.0),
+                axis: Vector3::z(),
+                angle,
+            };
+            let x = Vector3::new(0.17, -0.05, 0.0);
+            let k = eval(&drum, &frame, &x)?;
+            assert_relative_eq!(k.d_dangle[0], 0.0, epsilon = 1e-15);
+            assert_relative_eq!(k.d_dangle[1], -radius, epsilon = 1e-14);
+            assert_relative_eq!(k.d_dangle[2], 0.0, epsilon = 1e-15);
+            // 2D point in the z = 0 plane with a z axis has axial coordinate 0
+            assert_eq!(k.coords[1], 0.0);
+            // the world normal is radial from the centre, independent of the angle
+            let radial = (x - frame.center).normalize();
+            assert_relative_eq!(k.normal, radial, epsilon = 1e-14);
+            assert_relative_eq!(k.gap, (x - frame.center).norm() - radius, epsilon = 1e-15);
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn rotating_the_body_moves_material_points_under_a_fixed_node() -> Result<(), ContactError> {
+        let radius = 0.2;
+        let drum = AnalyticCylinder::new(radius, Vector3::z())?;
+        let x = Vector3::new(0.0, 0.2, 0.0);
+        let at = |angle: f64| -> Result<ContactKinematics, ContactError> {
+            let frame = RotatingFrame {
+                center: Vector3::zeros(),
+                axis: Vector3::z(),
+                angle,
+            };
+            eval(&drum, &frame, &x)
+        };
+        // a full turn in 0.1 rad steps: the unwrapped slip sums to -2 pi R
+        let mut total = 0.0;
+        let mut previous = at(0.0)?.coords;
+        for step in 1..=63 {
+            let current = at(step as f64 * 0.1)?.coords;
+            total += slip_increment(&drum, &previous, &current)[0];
+            previous = current;
+        }
+        assert_relative_eq!(total, -6.3 * radius, epsilon = 1e-12);
+        Ok(())
+    }
+
+    #[test]
+    fn unwrapping_across_branch_cut() -> Result<(), ContactError> {
+        let drum = AnalyticCylinder::new(0.2, Vector3::z())?;
+        let period = 0.4 * PI;
+        let before = Vector2::new(0.2 * (PI - 0.01), 0.3);
+        let after = Vector2::new(0.2 * (-PI + 0.02), 0.1);
+        let slip = slip_increment(&drum, &before, &after);
+        assert_relative_eq!(slip[0], 0.2 * 0.03, epsilon = 1e-14);
+        assert_relative_eq!(slip[1], -0.2, epsilon = 1e-15);
+        let back = slip_increment(&drum, &after, &before);
+        assert_relative_eq!(back[0], -0.2 * 0.03, epsilon = 1e-14);
+        // exactly half a period maps to +p/2 (the interval is (-p/2, p/2])
+        let half = slip_increment(&drum, &Vector2::zeros(), &Vector2::new(-0.5 * period, 0.0));
+        assert_relative_eq!(half[0], 0.5 * period, epsilon = 1e-15);
+        Ok(())
+    }
+
+    #[test]
+    fn degenerate_frame_or_axis_point_gives_none() -> Result<(), ContactError> {
+        let drum = AnalyticCylinder::new(0.2, Vector3::z())?;
+        let frame = RotatingFrame {
+            center: Vector3::new(1.0, 2.0, 0.0),
+            axis: Vector3::z(),
+            angle: 0.3,
+        };
+        assert!(evaluate(&drum, &frame, &Vector3::new(1.0, 2.0, 0.5)).is_none());
+        let no_axis = RotatingFrame {
+            axis: Vector3::zeros(),
+            ..frame
+        };
+        assert!(evaluate(&drum, &no_axis, &Vector3::new(0.0, 0.0, 0.0)).is_none());
+        let nan_angle = RotatingFrame {
+            angle: f64::NAN,
+            ..frame
+        };
+        assert!(evaluate(&drum, &nan_angle, &Vector3::new(0.0, 0.0, 0.0)).is_none());
+        Ok(())
+    }
+}

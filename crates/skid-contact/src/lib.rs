@@ -1,0 +1,27 @@
+//! Frictional contact for `skid`: rigid surfaces, gap and slip kinematics against a rotating rigid
+//! body, and the exact Coulomb friction problem.
+//!
+//! * [`surface`]: rigid surfaces described in the body frame of their rigid body, with closest-point
+//!   projections giving the signed gap and convected (arc-length, axial) coordinates.
+//! * [`plane`]: the analytical rigid plane (a line in 2D).
+//! * [`kinematics`]: gap, convected coordinates and their exact first derivatives for a slave node
+//!   against a surface carried by a body rotating about a fixed axis; slip increments unwrapped
+//!   across periodic coordinates.
+//! * [`coulomb`]: the exact (De Saxcé bipotential) Coulomb law in Delassus form,
+//!   `K*_mu ∋ u + mu ||u_T|| e_N ⊥ r ∈ K_mu` with `u = W r + q`, solved as a fixed point on the normal
+//!   shift over convex second-order-cone programs (clarabel). Unlike the plain convex relaxation,
+//!   sliding contacts do not dilate (`u_N = 0`).
+
+pub mod coulomb;
+pub mod error;
+pub mod kinematics;
+pub mod plane;
+pub mod surface;
+
+pub use coulomb::{
+    CoulombSettings, CoulombSolution, FrictionProblem, natural_map_error, solve_coulomb,
+};
+pub use error::ContactError;
+pub use kinematics::{ContactKinematics, RotatingFrame, evaluate, slip_increment};
+pub use plane::RigidPlane;
+pub use surface::{AnalyticCylinder, Projection, RigidSurface};

@@ -1,0 +1,85 @@
+//! Analytical rigid plane (a line in 2D).
+
+use nalgebra::{Vector2, Vector3};
+
+use crate::error::ContactError;
+use crate::surface::{Projection, RigidSurface};
+
+/// The plane through the body-frame origin with outward unit normal `n`.
+///
+/// `g = n . y`, `dg/dy = n`; convected coordinates `xi_0 = t1 . y`, `xi_1 = t2 . y` with the
+/// in-plane unit vectors `t1` (given) and `t2 = n x t1`.
+#[derive(Clone, Debug)]
+pub struct RigidPlane {
+    normal: Vector3<f64>,
+    t1: Vector3<f64>,
+    t2: Vector3<f64>,
+}
+
+impl RigidPlane {
+    /// Plane with outward `normal` and first in-plane direction `tangent` (both are normalised;
+    /// `tangent` must not be parallel to `normal`, its normal component is removed).
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidSurface`] for zero, non-finite or parallel vectors.
+    pub fn new(normal: Vector3<f64>, tangent: Vector3<f64>) -> Result<Self, ContactError> {
+        let bad = || {
+            ContactError::InvalidSurface(format!(
+                "plane needs a finite non-zero normal and a tangent not parallel to it, got \
+                 {normal:?} and {tangent:?}"
+            ))
+        };
+        let n = normal.try_normalize(1e-300).ok_or_else(bad)?;
+        let t1 = (tangent - n * n.dot(&tangent))
+            .try_normalize(1e-12 * tangent.norm())
+            .ok_or_else(bad)?;
+        if !(n.iter().chain(t1.iter()).all(|c| c.is_finite())) {
+            return Err(bad());
+        }
+        Ok(Self {
+            normal: n,
+            t1,
+            t2: n.cross(&t1),
+        })
+    }
+}
+
+impl RigidSurface for RigidPlane {
+    fn project(&self, y: &Vector3<f64>) -> Option<Projection> {
+        y.iter().all(|c| c.is_finite()).then(|| Projection {
+            gap: self.normal.dot(y),
+            gap_gradient: self.normal,
+            coords: Vector2::new(self.t1.dot(y), self.t2.dot(y)),
+            coords_gradient: [self.t1, self.t2],
+        })
+    }
+
+    fn coords_period(&self) -> [Option<f64>; 2] {
+        [None, None]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gap_and_coordinates_are_distances_along_the_frame() {
+        let plane = RigidPlane::new(Vector3::new(0.0, 2.0, 0.0), Vector3::new(1.0, 0.5, 0.0))
+            .expect("plane");
+        let p = plane
+            .project(&Vector3::new(0.3, -0.01, 0.2))
+            .expect("projection");
+        assert!((p.gap + 0.01).abs() < 1e-15);
+        assert!((p.coords[0] - 0.3).abs() < 1e-15);
+        assert!((p.coords[1] + 0.2).abs() < 1e-15, "t2 = y x x = -z");
+        assert_eq!(plane.coords_period(), [None, None]);
+    }
+
+    #[test]
+    fn degenerate_frames_are_rejected() {
+        assert!(RigidPlane::new(Vector3::zeros(), Vector3::x()).is_err());
+        assert!(RigidPlane::new(Vector3::y(), Vector3::y() * 3.0).is_err());
+        assert!(RigidPlane::new(Vector3::new(f64::NAN, 1.0, 0.0), Vector3::x()).is_err());
+    }
+}

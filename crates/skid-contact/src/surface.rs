@@ -1,0 +1,205 @@
+//! Rigid surfaces, described in the body frame of the rigid body that carries them (they are
+//! static in that frame), with closest-point projections.
+
+use nalgebra::{Vector2, Vector3};
+
+use crate::error::ContactError;
+
+/// Closest-point projection of a point `y` (body frame) onto a surface.
+#[derive(Clone, Debug)]
+pub struct Projection {
+    /// Signed normal distance `g(y)`: `> 0` open, `< 0` penetration.
+    pub gap: f64,
+    /// `dg/dy`; the outward unit normal at the closest point for a distance function.
+    pub gap_gradient: Vector3<f64>,
+    /// Convected surface coordinates `xi = [arc length along the circumference, axial position]`.
+    pub coords: Vector2<f64>,
+    /// `d xi_k / dy` for `k = 0, 1`.
+    pub coords_gradient: [Vector3<f64>; 2],
+}
+
+/// A rigid surface, static in the body frame of its rigid body.
+pub trait RigidSurface: Send + Sync + std::fmt::Debug {
+    /// Closest-point projection of the body-frame point `y`; `None` only where the projection is
+    /// undefined (e.g. on the axis of a cylinder) or `y` is not finite.
+    fn project(&self, y: &Vector3<f64>) -> Option<Projection>;
+    /// Period of each convected coordinate (`Some(2 pi R)` for the arc length of a closed
+    /// circumference, `None` for a non-periodic coordinate), used to unwrap increments.
+    fn coords_period(&self) -> [Option<f64>; 2];
+}
+
+/// Analytical circle (2D) / cylinder (3D) of radius `R` about the body-frame unit axis `e` through
+/// the body-frame origin.
+///
+/// With `y_perp = y - (e.y) e`, `rho = |y_perp|`, `n = y_perp / rho` and `t = e x n`:
+/// `g = rho - R`, `dg/dy = n`; `xi_0 = R atan2(y.b2, y.b1)` (arc length, counter-clockwise about
+/// `e`), `d xi_0/dy = (R/rho) t`; `xi_1 = e.y`, `d xi_1/dy = e`.
+#[derive(Clone, Debug)]
+pub struct AnalyticCylinder {
+    radius: f64,
+    axis: Vector3<f64>,
+    b1: Vector3<f64>,
+    b2: Vector3<f64>,
+}
+
+impl AnalyticCylinder {
+    /// Cylinder of `radius > 0` about `axis` (normalised here; must be finite and non-zero).
+    ///
+    /// The reference direction `b1` (where the arc length is zero) is the normalised projection,
+    /// perpendicular to the axis, of the Cartesian basis vector least aligned with the axis (the
+    /// first one on ties), and `b2 = e x b1`; for `e = e_z` that gives `b1 = e_x`, `b2 = e_y`.
+    pub fn new(radius: f64, axis: Vector3<f64>) -> Result<Self, ContactError> {
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(ContactError::InvalidSurface(format!(
+                "cylinder radius must be finite and positive, got {radius}"
+            )));
+        }
+        let norm = axis.norm();
+        if !(norm.is_finite() && norm > 0.0) {
+            return Err(ContactError::InvalidSurface(format!(
+                "cylinder axis must be finite and non-zero, got {axis:?}"
+            )));
+        }
+        let axis = axis / norm;
+        let least_aligned = (0..3)
+            .min_by(|&i, &j| axis[i].abs().total_cmp(&axis[j].abs()))
+            .unwrap_or(0);
+        let mut reference = Vector3::zeros();
+        reference[least_aligned] = 1.0;
+        let b1 = (reference - axis * axis.dot(&reference)).normalize();
+        let b2 = axis.cross(&b1);
+        Ok(Self {
+            radius,
+            axis,
+            b1,
+            b2,
+        })
+    }
+
+    /// Radius `R`.
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// Unit axis `e` (body frame).
+    pub fn axis(&self) -> Vector3<f64> {
+        self.axis
+    }
+
+    /// Reference direction `b1` (body frame), where the arc-length coordinate is zero.
+    pub fn reference_direction(&self) -> Vector3<f64> {
+        self.b1
+    }
+}
+
+impl RigidSurface for AnalyticCylinder {
+    fn project(&self, y: &Vector3<f64>) -> Option<Projection> {
+        if !y.iter().all(|c| c.is_finite()) {
+            return None;
+        }
+        let axial = self.axis.dot(y);
+        let radial = y - self.axis * axial;
+        let rho = radial.norm();
+        // below this, the direction of y_perp is round-off
+        if rho <= 64.0 * f64::EPSILON * (self.radius + y.norm()) {
+            return None;
+        }
+        let normal = radial / rho;
+        let tangent = self.axis.cross(&normal);
+        let angle = self.b2.dot(y).atan2(self.b1.dot(y));
+        Some(Projection {
+            gap: rho - self.radius,
+            gap_gradient: normal,
+            coords: Vector2::new(self.radius * angle, axial),
+            coords_gradient: [tangent * (self.radius / rho), self.axis],
+        })
+    }
+
+    fn coords_period(&self) -> [Option<f64>; 2] {
+        [Some(std::f64::consts::TAU * self.radius), None]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn rejects_invalid_data() {
+        assert!(matches!(
+            AnalyticCylinder::new(0.0, Vector3::z()),
+            Err(ContactError::InvalidSurface(_))
+        ));
+        assert!(AnalyticCylinder::new(f64::NAN, Vector3::z()).is_err());
+        assert!(AnalyticCylinder::new(0.2, Vector3::zeros()).is_err());
+        assert!(AnalyticCylinder::new(0.2, Vector3::new(f64::INFINITY, 0.0, 1.0)).is_err());
+    }
+
+    #[test]
+    fn z_axis_uses_conventional_polar_angle() -> Result<(), ContactError> {
+        let drum = AnalyticCylinder::new(0.2, Vector3::new(0.0, 0.0, 3.0))?;
+        assert_relative_eq!(drum.axis(), Vector3::z());
+        assert_relative_eq!(drum.reference_direction(), Vector3::x());
+        let y = Vector3::new(0.0, 0.25, 0.07);
+        let p = drum
+            .project(&y)
+            .ok_or(ContactError::InvalidSurface("none".into()))?;
+        assert_relative_eq!(p.gap, 0.05, epsilon = 1e-15);
+        assert_relative_eq!(p.gap_gradient, Vector3::y(), epsilon = 1e-15);
+        assert_relative_eq!(
+            p.coords[0],
+            0.2 * std::f64::consts::FRAC_PI_2,
+            epsilon = 1e-15
+        );
+        assert_relative_eq!(p.coords[1], 0.07, epsilon = 1e-15);
+        // counter-clockwise tangent at +y is -x, scaled by R / rho
+        assert_relative_eq!(p.coords_gradient[0], -Vector3::x() * 0.8, epsilon = 1e-15);
+        assert_eq!(drum.coords_period()[0], Some(0.4 * std::f64::consts::PI));
+        assert_eq!(drum.coords_period()[1], None);
+        Ok(())
+    }
+
+    #[test]
+    fn undefined_on_axis() -> Result<(), ContactError> {
+        let drum = AnalyticCylinder::new(0.2, Vector3::new(1.0, 1.0, 0.0))?;
+        assert!(drum.project(&Vector3::new(0.3, 0.3, 0.0)).is_none());
+        assert!(drum.project(&Vector3::new(f64::NAN, 0.0, 0.0)).is_none());
+        Ok(())
+    }
+
+    #[test]
+    fn gradients_match_finite_differences_for_oblique_axis() -> Result<(), ContactError> {
+        let drum = AnalyticCylinder::new(0.2, Vector3::new(0.3, -0.5, 0.8))?;
+        let y = Vector3::new(0.11, 0.17, -0.05);
+        let p = drum
+            .project(&y)
+            .ok_or(ContactError::InvalidSurface("none".into()))?;
+        let h = 1e-6;
+        for k in 0..3 {
+            let mut yp = y;
+            let mut ym = y;
+            yp[k] += h;
+            ym[k] -= h;
+            let pp = drum
+                .project(&yp)
+                .ok_or(ContactError::InvalidSurface("none".into()))?;
+            let pm = drum
+                .project(&ym)
+                .ok_or(ContactError::InvalidSurface("none".into()))?;
+            assert_relative_eq!(
+                (pp.gap - pm.gap) / (2.0 * h),
+                p.gap_gradient[k],
+                epsilon = 1e-8
+            );
+            for c in 0..2 {
+                assert_relative_eq!(
+                    (pp.coords[c] - pm.coords[c]) / (2.0 * h),
+                    p.coords_gradient[c][k],
+                    epsilon = 1e-8
+                );
+            }
+        }
+        Ok(())
+    }
+}
