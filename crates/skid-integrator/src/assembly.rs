@@ -1,0 +1,217 @@
+//! Assembly of internal forces, the effective tangent and external loads on the fixed pattern.
+//!
+//! Element vectors and matrices are scattered through the [`DofMap`](crate::dof::DofMap):
+//! components of tied nodes land in their body's equation, fixed components are dropped. The
+//! effective tangent has the form `K_eff = c_K K_T + diag(c_M m)` (HHT: `c_K = 1 + alpha`,
+//! `c_M = 1/(beta h^2)`); equations held fixed in a step get an identity row and column.
+
+use nalgebra::{DVector, SVector};
+use rayon::prelude::*;
+use skid_fem::error::FemError;
+use skid_fem::pressure::pressure_face_forces;
+use skid_fem::solid::ElementResponse;
+
+use crate::error::{IncrementFailure, ModelError};
+use crate::model::Model;
+use crate::sparse::{Factorization, PatternBuilder, SparsePattern};
+
+/// Below this many elements the element loop runs sequentially (threads cost more than they
+/// save on tiny meshes).
+const PARALLEL_ELEMENT_THRESHOLD: usize = 256;
+
+/// Where one element's matrix entries go.
+#[derive(Debug)]
+struct ElementScatter {
+    /// Global equation of each local component (node-major), `None` if fixed.
+    eqs: Vec<Option<usize>>,
+    /// (local row, local column, value slot) for every stored lower-triangle contribution.
+    entries: Vec<(usize, usize, usize)>,
+}
+
+/// Internal forces and energies of the solid at one configuration.
+#[derive(Clone, Debug)]
+pub struct InternalState {
+    /// Internal force per equation, N (N m for rotations).
+    pub force: DVector<f64>,
+    /// Elastic strain energy, J.
+    pub strain_energy: f64,
+    /// Hourglass stabilisation energy, J.
+    pub hourglass_energy: f64,
+}
+
+/// Owns the pattern, the scatter maps and the value array of the effective tangent.
+#[derive(Debug)]
+pub struct Assembler {
+    pattern: SparsePattern,
+    scatter: Vec<ElementScatter>,
+    diagonal: Vec<usize>,
+    slot_position: Vec<(usize, usize)>,
+    values: Vec<f64>,
+}
+
+impl Assembler {
+    /// Builds the pattern from the model's connectivity and analyses it once.
+    ///
+    /// # Errors
+    /// [`ModelError::Invalid`] if the pattern cannot be analysed.
+    pub fn new<const D: usize>(model: &Model<D>) -> Result<Self, ModelError> {
+        let mut builder = PatternBuilder::default();
+        let mut slot_position = Vec::new();
+        let mut push = |builder: &mut PatternBuilder, i: usize, j: usize| {
+            slot_position.push((i.max(j), i.min(j)));
+            builder.push(i, j)
+        };
+        let mut scatter = Vec::with_capacity(model.elements().len());
+        for conn in &model.part().mesh.elements {
+            let eqs: Vec<Option<usize>> =
+                conn.iter().flat_map(|&n| *model.dofs().node(n)).collect();
+            let mut entries = Vec::new();
+            for (p, ep) in eqs.iter().enumerate() {
+                for (q, eq) in eqs.iter().enumerate() {
+                    if let (Some(i), Some(j)) = (ep, eq)
+                        && i >= j
+                    {
+                        entries.push((p, q, push(&mut builder, *i, *j)));
+                    }
+                }
+            }
+            scatter.push(ElementScatter { eqs, entries });
+        }
+        let n = model.dofs().len();
+        let diagonal = (0..n).map(|i| push(&mut builder, i, i)).collect();
+        let pattern = SparsePattern::new(n, builder).map_err(ModelError::Invalid)?;
+        let values = vec![0.0; pattern.slots()];
+        Ok(Self {
+            pattern,
+            scatter,
+            diagonal,
+            slot_position,
+            values,
+        })
+    }
+
+    /// Internal forces at displacement `x`; if `tangent_factor` is `Some(c_K)`, also resets the
+    /// effective tangent to `c_K K_T(x)`.
+    ///
+    /// # Errors
+    /// [`IncrementFailure::InvertedElement`] if an element has J <= 0.
+    pub fn internal<const D: usize>(
+        &mut self,
+        model: &Model<D>,
+        x: &DVector<f64>,
+        tangent_factor: Option<f64>,
+    ) -> Result<InternalState, IncrementFailure> {
+        let part = model.part();
+        let evaluate = |e: usize| -> Result<ElementResponse, IncrementFailure> {
+            let u: Vec<SVector<f64, D>> = part.mesh.elements[e]
+                .iter()
+                .map(|&n| model.dofs().node_displacement(x, n))
+                .collect();
+            model.elements()[e]
+                .evaluate(part.material.as_ref(), &u, tangent_factor.is_some())
+                .map_err(|err| match err {
+                    FemError::InvertedElement { det_f } => {
+                        IncrementFailure::InvertedElement { element: e, det_f }
+                    }
+                    other => IncrementFailure::Element {
+                        element: e,
+                        message: other.to_string(),
+                    },
+                })
+        };
+        let n_el = model.elements().len();
+        let responses: Vec<ElementResponse> = if n_el >= PARALLEL_ELEMENT_THRESHOLD {
+            (0..n_el)
+                .into_par_iter()
+                .map(evaluate)
+                .collect::<Result<_, _>>()?
+        } else {
+            (0..n_el).map(evaluate).collect::<Result<_, _>>()?
+        };
+
+        let mut state = InternalState {
+            force: DVector::zeros(model.dofs().len()),
+            strain_energy: 0.0,
+            hourglass_energy: 0.0,
+        };
+        if tangent_factor.is_some() {
+            self.values.iter_mut().for_each(|v| *v = 0.0);
+        }
+        for (response, scatter) in responses.iter().zip(&self.scatter) {
+            state.strain_energy += response.strain_energy;
+            state.hourglass_energy += response.hourglass_energy;
+            for (p, eq) in scatter.eqs.iter().enumerate() {
+                if let Some(eq) = eq {
+                    state.force[*eq] += response.force[p];
+                }
+            }
+            if let (Some(c), Some(k)) = (tangent_factor, &response.stiffness) {
+                for &(p, q, slot) in &scatter.entries {
+                    self.values[slot] += c * k[(p, q)];
+                }
+            }
+        }
+        Ok(state)
+    }
+
+    /// Adds `d_i` to each diagonal entry of the effective tangent (mass terms).
+    pub fn add_diagonal(&mut self, d: &DVector<f64>) {
+        for (i, &slot) in self.diagonal.iter().enumerate() {
+            self.values[slot] += d[i];
+        }
+    }
+
+    /// Replaces the rows and columns of `held` equations by those of the identity, so that their
+    /// increments come out as zero for a zero right-hand side.
+    pub fn hold(&mut self, held: &[bool]) {
+        for (slot, &(i, j)) in self.slot_position.iter().enumerate() {
+            if held[i] || held[j] {
+                self.values[slot] = 0.0;
+            }
+        }
+        for (i, &slot) in self.diagonal.iter().enumerate() {
+            if held[i] {
+                self.values[slot] = 1.0;
+            }
+        }
+    }
+
+    /// Factorizes the current effective tangent.
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] if it is not positive definite.
+    pub fn factorize(&self) -> Result<Factorization, IncrementFailure> {
+        self.pattern.factorize(&self.values)
+    }
+}
+
+/// External nodal forces of the pressure loads at load factor `lambda`, on the current
+/// geometry (follower pressure), per equation.
+pub fn external_forces<const D: usize>(
+    model: &Model<D>,
+    x: &DVector<f64>,
+    lambda: f64,
+) -> Result<DVector<f64>, IncrementFailure> {
+    let mut f = DVector::zeros(model.dofs().len());
+    let mesh = &model.part().mesh;
+    for load in model.pressures() {
+        for face in &load.faces {
+            let xf: Vec<SVector<f64, D>> = face
+                .iter()
+                .map(|&n| mesh.nodes[n] + model.dofs().node_displacement(x, n))
+                .collect();
+            let forces = pressure_face_forces(&xf, lambda * load.pressure, model.part().thickness)
+                .map_err(|err| {
+                    IncrementFailure::Load(format!("pressure on face {face:?}: {err}"))
+                })?;
+            for (&n, fn_) in face.iter().zip(&forces) {
+                for (i, eq) in model.dofs().node(n).iter().enumerate() {
+                    if let Some(eq) = eq {
+                        f[*eq] += fn_[i];
+                    }
+                }
+            }
+        }
+    }
+    Ok(f)
+}

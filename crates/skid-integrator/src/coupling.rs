@@ -1,0 +1,155 @@
+//! Contact rows of the Newton system and its reduction to the exact-Coulomb problem.
+//!
+//! For every contact candidate `c` (a slave node of a pair) the local quantities
+//! `u_c = (g, Delta s_1[, Delta s_2])` (normal gap at the end of the increment and the slip
+//! increment in the master surface's convected coordinates) are linearised in the global
+//! unknowns: `u_c(x + dx) ~ u_c(x) + H_c dx`. The rows of `H` hold the derivatives with respect
+//! to the node's components and the carrying body's translation and rotation.
+//!
+//! One Newton step solves `K_eff dx = -R + H^T r`, hence `dx = dx_0 + Z r` with
+//! `dx_0 = -K_eff^{-1} R` and `Z = K_eff^{-1} H^T`, and the local quantities become
+//! `u = W r + q` with the Delassus operator `W = H Z` and `q = u(x) + H dx_0`. The contact
+//! forces `r` then come from the exact Coulomb law in (W, q) (see `skid_contact::coulomb`).
+
+use nalgebra::{DMatrix, DVector, Vector2, Vector3};
+use skid_contact::kinematics::{RotatingFrame, evaluate, slip_increment};
+
+use crate::error::IncrementFailure;
+use crate::model::{Model, embed};
+use crate::sparse::Factorization;
+
+/// Linearised contact kinematics at one configuration.
+#[derive(Clone, Debug)]
+pub struct ContactRows {
+    /// Components per contact: 1 normal + (D - 1) tangential.
+    pub components: usize,
+    /// Sparse rows of H: (equation, coefficient); `components` rows per contact.
+    pub rows: Vec<Vec<(usize, f64)>>,
+    /// Current local quantities u (gap, slip increment per tangent), per row.
+    pub u: DVector<f64>,
+    /// Current convected coordinates per contact.
+    pub coords: Vec<Vector2<f64>>,
+    /// Friction coefficient per contact.
+    pub mu: Vec<f64>,
+}
+
+impl ContactRows {
+    /// Number of contact candidates.
+    pub fn len(&self) -> usize {
+        self.coords.len()
+    }
+
+    /// True if there are no candidates.
+    pub fn is_empty(&self) -> bool {
+        self.coords.is_empty()
+    }
+
+    /// `H^T r`: the generalized contact forces on the equations.
+    pub fn transpose_times(&self, r: &DVector<f64>, n: usize) -> DVector<f64> {
+        let mut f = DVector::zeros(n);
+        for (row, &rk) in self.rows.iter().zip(r.iter()) {
+            for &(eq, c) in row {
+                f[eq] += c * rk;
+            }
+        }
+        f
+    }
+
+    /// `H dx`.
+    pub fn times(&self, dx: &DVector<f64>) -> DVector<f64> {
+        DVector::from_iterator(
+            self.rows.len(),
+            self.rows
+                .iter()
+                .map(|row| row.iter().map(|&(eq, c)| c * dx[eq]).sum()),
+        )
+    }
+
+    /// `Z = K^{-1} H^T` and the Delassus operator `W = H Z` (symmetrised).
+    pub fn delassus(&self, factor: &Factorization, n: usize) -> (DMatrix<f64>, DMatrix<f64>) {
+        let m = self.rows.len();
+        let mut ht = DMatrix::zeros(n, m);
+        for (k, row) in self.rows.iter().enumerate() {
+            for &(eq, c) in row {
+                ht[(eq, k)] += c;
+            }
+        }
+        let z = factor.solve_many(&ht);
+        let mut w = DMatrix::zeros(m, m);
+        for (i, row) in self.rows.iter().enumerate() {
+            for &(eq, c) in row {
+                for j in 0..m {
+                    w[(i, j)] += c * z[(eq, j)];
+                }
+            }
+        }
+        let w = (&w + w.transpose()) * 0.5;
+        (z, w)
+    }
+}
+
+/// Evaluates the contact rows of all pairs at displacement `x`. `previous` holds the convected
+/// coordinates at the start of the increment (one per candidate, pair by pair); `held` marks
+/// equations whose increment is zero in this step (their columns are dropped).
+///
+/// # Errors
+/// [`IncrementFailure::NoProjection`] if a node has no projection on its master surface.
+pub fn contact_rows<const D: usize>(
+    model: &Model<D>,
+    x: &DVector<f64>,
+    previous: &[Vector2<f64>],
+    held: &[bool],
+) -> Result<ContactRows, IncrementFailure> {
+    let components = D;
+    let dofs = model.dofs();
+    let mut out = ContactRows {
+        components,
+        rows: Vec::new(),
+        u: DVector::zeros(0),
+        coords: Vec::new(),
+        mu: Vec::new(),
+    };
+    let mut u = Vec::new();
+    let mut k = 0;
+    for (p, pair) in model.contacts().iter().enumerate() {
+        let body = &model.bodies()[pair.body];
+        let frame = RotatingFrame {
+            center: embed(&(body.reference_point + dofs.body_displacement(x, pair.body))),
+            axis: body.rotation_axis.unwrap_or_else(Vector3::z),
+            angle: dofs.body_angle(x, pair.body),
+        };
+        for &node in &pair.nodes {
+            let pos = model.node_position(x, node);
+            let kin = evaluate(pair.surface.as_ref(), &frame, &pos)
+                .ok_or(IncrementFailure::NoProjection { pair: p, node })?;
+            let slip = slip_increment(pair.surface.as_ref(), &previous[k], &kin.coords);
+            for comp in 0..components {
+                let mut row: Vec<(usize, f64)> = Vec::with_capacity(2 * D + 1);
+                let mut add = |eq: Option<usize>, c: f64| {
+                    if let Some(eq) = eq
+                        && !held[eq]
+                        && c != 0.0
+                    {
+                        match row.iter_mut().find(|(e, _)| *e == eq) {
+                            Some(entry) => entry.1 += c,
+                            None => row.push((eq, c)),
+                        }
+                    }
+                };
+                for i in 0..D {
+                    add(dofs.node(node)[i], kin.d_dx[comp][i]);
+                    // Moving the body by dc moves the body-frame point by -Q^T dc.
+                    add(dofs.body_translation(pair.body)[i], -kin.d_dx[comp][i]);
+                }
+                add(dofs.body_rotation(pair.body), kin.d_dangle[comp]);
+                out.rows.push(row);
+                u.push(if comp == 0 { kin.gap } else { slip[comp - 1] });
+            }
+            out.coords.push(kin.coords);
+            out.mu.push(pair.mu);
+            k += 1;
+        }
+    }
+    out.u = DVector::from_vec(u);
+    Ok(out)
+}

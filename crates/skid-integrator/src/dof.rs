@@ -1,0 +1,172 @@
+//! The map from physical degrees of freedom to global equations.
+//!
+//! Unknowns are numbered node components first (node-major), then rigid-body motions. A node
+//! component tied to a rigid body does not get an equation of its own: it maps to the equation
+//! of the body's translation along the same axis (or to none if that translation is fixed).
+//! Because the tie only involves translations, it is linear, `u_node,i = u_body,i`, and
+//! assembling a node's contributions into the body's equation is exactly the condensation
+//! `K' = T^T K T` with a 0/1 matrix `T`.
+
+use nalgebra::{DVector, SVector};
+
+/// What kind of motion an equation carries (decides its units in residual norms).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EquationKind {
+    /// A translation (m; its residual is a force, N).
+    Translation,
+    /// A rotation angle (rad; its residual is a moment, N m).
+    Rotation,
+}
+
+/// Global equation numbers of every node component and rigid-body motion.
+#[derive(Clone, Debug)]
+pub struct DofMap<const D: usize> {
+    node: Vec<[Option<usize>; D]>,
+    body_translation: Vec<[Option<usize>; D]>,
+    body_rotation: Vec<Option<usize>>,
+    kinds: Vec<EquationKind>,
+}
+
+impl<const D: usize> DofMap<D> {
+    /// Numbers the equations.
+    ///
+    /// - `node_count`: number of mesh nodes;
+    /// - `tied_to`: for each node, the rigid body it is tied to, if any;
+    /// - `free_translations` / `free_rotation`: per body, which motions are free.
+    pub fn new(
+        node_count: usize,
+        tied_to: &[Option<usize>],
+        free_translations: &[[bool; D]],
+        free_rotation: &[bool],
+    ) -> Self {
+        let mut kinds = Vec::new();
+        let mut next = |kind| {
+            kinds.push(kind);
+            kinds.len() - 1
+        };
+        let mut node = vec![[None; D]; node_count];
+        for (n, eqs) in node.iter_mut().enumerate() {
+            if tied_to.get(n).copied().flatten().is_none() {
+                for eq in eqs.iter_mut() {
+                    *eq = Some(next(EquationKind::Translation));
+                }
+            }
+        }
+        let mut body_translation = Vec::with_capacity(free_translations.len());
+        let mut body_rotation = Vec::with_capacity(free_rotation.len());
+        for (b, free) in free_translations.iter().enumerate() {
+            let mut eqs = [None; D];
+            for i in 0..D {
+                if free[i] {
+                    eqs[i] = Some(next(EquationKind::Translation));
+                }
+            }
+            body_translation.push(eqs);
+            body_rotation.push(
+                free_rotation
+                    .get(b)
+                    .copied()
+                    .unwrap_or(false)
+                    .then(|| next(EquationKind::Rotation)),
+            );
+        }
+        for (n, body) in tied_to.iter().enumerate() {
+            if let Some(b) = body {
+                node[n] = body_translation[*b];
+            }
+        }
+        Self {
+            node,
+            body_translation,
+            body_rotation,
+            kinds,
+        }
+    }
+
+    /// Number of global equations.
+    pub fn len(&self) -> usize {
+        self.kinds.len()
+    }
+
+    /// True if there are no unknowns at all.
+    pub fn is_empty(&self) -> bool {
+        self.kinds.is_empty()
+    }
+
+    /// Kind of each equation.
+    pub fn kinds(&self) -> &[EquationKind] {
+        &self.kinds
+    }
+
+    /// Equations of a node's components (`None` = fixed).
+    pub fn node(&self, node: usize) -> &[Option<usize>; D] {
+        &self.node[node]
+    }
+
+    /// Equations of a body's translations.
+    pub fn body_translation(&self, body: usize) -> &[Option<usize>; D] {
+        &self.body_translation[body]
+    }
+
+    /// Equation of a body's rotation angle.
+    pub fn body_rotation(&self, body: usize) -> Option<usize> {
+        self.body_rotation[body]
+    }
+
+    /// All equations of one rigid body (translations, then rotation).
+    pub fn body_equations(&self, body: usize) -> Vec<usize> {
+        self.body_translation[body]
+            .iter()
+            .flatten()
+            .copied()
+            .chain(self.body_rotation[body])
+            .collect()
+    }
+
+    /// Displacement of a node, `u_i = x[eq(node, i)]` (0 for fixed components).
+    pub fn node_displacement(&self, x: &DVector<f64>, node: usize) -> SVector<f64, D> {
+        gather(&self.node[node], x)
+    }
+
+    /// Translation of a rigid body's reference node.
+    pub fn body_displacement(&self, x: &DVector<f64>, body: usize) -> SVector<f64, D> {
+        gather(&self.body_translation[body], x)
+    }
+
+    /// Rotation angle of a rigid body (0 if it cannot rotate).
+    pub fn body_angle(&self, x: &DVector<f64>, body: usize) -> f64 {
+        self.body_rotation[body].map_or(0.0, |eq| x[eq])
+    }
+}
+
+fn gather<const D: usize>(eqs: &[Option<usize>; D], x: &DVector<f64>) -> SVector<f64, D> {
+    SVector::<f64, D>::from_fn(|i, _| eqs[i].map_or(0.0, |eq| x[eq]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tied_nodes_share_the_body_translation_equation() {
+        // 4 nodes; nodes 2 and 3 tied to body 0 which may only translate along y;
+        // body 1 may only rotate.
+        let map = DofMap::<2>::new(
+            4,
+            &[None, None, Some(0), Some(0)],
+            &[[false, true], [false, false]],
+            &[false, true],
+        );
+        assert_eq!(map.len(), 4 + 1 + 1);
+        assert_eq!(map.node(0), &[Some(0), Some(1)]);
+        assert_eq!(map.node(1), &[Some(2), Some(3)]);
+        assert_eq!(map.node(2), &[None, Some(4)]);
+        assert_eq!(map.node(3), map.node(2));
+        assert_eq!(map.body_rotation(1), Some(5));
+        assert_eq!(map.kinds()[5], EquationKind::Rotation);
+        let x = DVector::from_vec(vec![0.0, 0.0, 0.0, 0.0, -0.004, 1.5]);
+        assert_eq!(map.node_displacement(&x, 3)[1], -0.004);
+        assert_eq!(map.body_angle(&x, 1), 1.5);
+        assert_eq!(map.body_equations(0), vec![4]);
+    }
+}

@@ -1,0 +1,346 @@
+//! Newton-Raphson for one increment, static or dynamic, with exact Coulomb contact.
+//!
+//! Each iteration assembles the residual `R` (without contact) and the effective tangent at the
+//! current iterate, linearises the contact kinematics (rows `H`), reduces the linear step to the
+//! friction-cone problem in the contact forces (see [`crate::coupling`]), solves it exactly, and
+//! updates `x += dx_0 + Z r`. The increment has converged when, at the new iterate,
+//! - the force residual `R - H^T r`, scaled by the largest force in play (moments by the model
+//!   size), is below `force_tolerance`, and
+//! - the actual gaps and slips differ from those the linearised problem predicted (and for which
+//!   the Coulomb law holds exactly) by less than `contact_tolerance` times the model size.
+//!
+//! Dynamic residual (HHT): `R = M a + (1 + alpha) F(x) - alpha F_n`; tangent
+//! `M/(beta h^2) + (1 + alpha) K_T`. Static residual: `R = F(x)` with `F = f_int - lambda f_ext`;
+//! tangent `K_T + M/h_s^2`. The mass term of the static tangent only regularises the Newton
+//! step (it keeps a pad that is not yet held by contact from being singular); it is not in the
+//! residual, so the converged state is exactly static.
+
+use std::time::{Duration, Instant};
+
+use nalgebra::{DVector, Vector2};
+use skid_contact::coulomb::{FrictionProblem, solve_coulomb};
+
+use crate::assembly::{Assembler, external_forces};
+use crate::coupling::{ContactRows, contact_rows};
+use crate::dof::EquationKind;
+use crate::error::IncrementFailure;
+use crate::hht::Hht;
+use crate::model::Model;
+use crate::state::{ContactPointState, EnergyLedger, State};
+use crate::stepper::Settings;
+
+/// Newton settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NewtonSettings {
+    /// Iteration limit per increment.
+    pub max_iterations: usize,
+    /// Relative force residual tolerance.
+    pub force_tolerance: f64,
+    /// Contact kinematic tolerance, relative to the model size.
+    pub contact_tolerance: f64,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        Self {
+            max_iterations: 25,
+            force_tolerance: 1e-6,
+            contact_tolerance: 1e-9,
+        }
+    }
+}
+
+/// What kind of increment to take.
+#[derive(Clone, Copy, Debug)]
+pub enum IncrementKind {
+    /// Static equilibrium at load factor `load_factor`; `regularization` is the mass factor
+    /// `1/h_s^2` of the Newton step.
+    Static {
+        /// Load factor at the end of the increment.
+        load_factor: f64,
+        /// Factor on the mass matrix added to the Newton tangent.
+        regularization: f64,
+    },
+    /// HHT increment of size `h`.
+    Dynamic {
+        /// HHT parameters.
+        hht: Hht,
+        /// Time increment.
+        h: f64,
+    },
+}
+
+/// Wall time spent in the parts of the Newton loop.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Timings {
+    /// Element loop, loads and contact kinematics.
+    pub assembly: Duration,
+    /// Numeric factorizations and triangular solves (including the Delassus operator).
+    pub linear_solve: Duration,
+    /// Conic (clarabel) solves and their fixed point.
+    pub contact_solve: Duration,
+}
+
+/// Counters of one converged increment.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct IncrementCounters {
+    /// Newton iterations (linear solves).
+    pub newton_iterations: usize,
+    /// Conic solves.
+    pub contact_solves: usize,
+    /// De Saxce fixed-point iterations.
+    pub fixed_point_iterations: usize,
+    /// Scaled (force, contact) residuals at each convergence check.
+    pub residuals: Vec<(f64, f64)>,
+}
+
+/// Solves one increment from `start`. `held[eq]` marks equations kept at their start value.
+///
+/// # Errors
+/// An [`IncrementFailure`] saying why Newton failed; the caller cuts back.
+pub fn solve_increment<const D: usize>(
+    model: &Model<D>,
+    assembler: &mut Assembler,
+    start: &State,
+    kind: IncrementKind,
+    held: &[bool],
+    settings: &Settings,
+    timings: &mut Timings,
+) -> Result<(State, IncrementCounters), IncrementFailure> {
+    let newton = &settings.newton;
+    let n = model.dofs().len();
+    let mass = model.mass();
+    let length = model.length_scale();
+    let previous_coords: Vec<Vector2<f64>> = start.contacts.iter().map(|c| c.coords).collect();
+    let (lambda, k_factor, m_factor) = match kind {
+        IncrementKind::Static {
+            load_factor,
+            regularization,
+        } => (load_factor, 1.0, regularization),
+        IncrementKind::Dynamic { hht, h } => (1.0, 1.0 + hht.alpha, hht.mass_factor(h)),
+    };
+    let mut x = match kind {
+        IncrementKind::Static { .. } => start.x.clone(),
+        IncrementKind::Dynamic { hht, h } => hht.predict(h, &start.x, &start.v, &start.a),
+    };
+    for (eq, &h) in held.iter().enumerate() {
+        if h {
+            x[eq] = start.x[eq];
+        }
+    }
+    let mut counters = IncrementCounters::default();
+    let mut shift = start.shift.clone();
+    // Contact forces and linearised kinematics of the last conic solve.
+    let mut last: Option<(DVector<f64>, DVector<f64>)> = None;
+
+    for iteration in 0..=newton.max_iterations {
+        let clock = Instant::now();
+        let (v, a) = match kind {
+            IncrementKind::Static { .. } => (start.v.clone(), DVector::zeros(n)),
+            IncrementKind::Dynamic { hht, h } => {
+                let (mut v, mut a) =
+                    hht.velocity_and_acceleration(h, &start.x, &start.v, &start.a, &x);
+                for (eq, &h) in held.iter().enumerate() {
+                    if h {
+                        v[eq] = 0.0;
+                        a[eq] = 0.0;
+                    }
+                }
+                (v, a)
+            }
+        };
+        let internal = assembler.internal(model, &x, Some(k_factor))?;
+        let f_ext = external_forces(model, &x, lambda)?;
+        let net = &internal.force - &f_ext;
+        let inertia = mass.component_mul(&a);
+        let mut residual = match kind {
+            IncrementKind::Static { .. } => net.clone(),
+            IncrementKind::Dynamic { hht, .. } => {
+                &inertia + &net * (1.0 + hht.alpha) - &start.net_force * hht.alpha
+            }
+        };
+        assembler.add_diagonal(&(mass * m_factor));
+        let rows = contact_rows(model, &x, &previous_coords, held)?;
+        for (eq, &h) in held.iter().enumerate() {
+            if h {
+                residual[eq] = 0.0;
+            }
+        }
+        assembler.hold(held);
+        timings.assembly += clock.elapsed();
+
+        if let Some((r, u_lin)) = &last {
+            let contact_force = rows.transpose_times(r, n);
+            let full = &residual - &contact_force;
+            let force_residual = scaled_force_residual(
+                model,
+                &full,
+                &[&internal.force, &f_ext, &inertia, &contact_force],
+                length,
+            );
+            let contact_residual = if rows.is_empty() {
+                0.0
+            } else {
+                (&rows.u - u_lin).amax() / length
+            };
+            counters.residuals.push((force_residual, contact_residual));
+            if !force_residual.is_finite() || !contact_residual.is_finite() {
+                return Err(IncrementFailure::NonFinite { iteration });
+            }
+            if force_residual <= newton.force_tolerance
+                && contact_residual <= newton.contact_tolerance
+            {
+                let state = finish(
+                    model, start, kind, x, v, a, net, f_ext, &internal, &rows, r, shift,
+                );
+                return Ok((state, counters));
+            }
+            if iteration == newton.max_iterations {
+                return Err(IncrementFailure::NewtonNotConverged {
+                    iterations: iteration,
+                    force_residual,
+                    contact_residual,
+                });
+            }
+        }
+
+        let clock = Instant::now();
+        let factor = assembler.factorize()?;
+        let dx0 = factor.solve(&(-&residual));
+        let dx = if rows.is_empty() {
+            timings.linear_solve += clock.elapsed();
+            last = Some((DVector::zeros(0), DVector::zeros(0)));
+            dx0
+        } else {
+            let (z, w) = rows.delassus(&factor, n);
+            let q = &rows.u + rows.times(&dx0);
+            timings.linear_solve += clock.elapsed();
+            let clock = Instant::now();
+            let problem = FrictionProblem {
+                dim: rows.components,
+                w: &w,
+                q: &q,
+                mu: &rows.mu,
+            };
+            let warm = (shift.len() == rows.len()).then_some(shift.as_slice());
+            let solution = solve_coulomb(&problem, &settings.coulomb, warm)
+                .map_err(|e| IncrementFailure::Contact(e.to_string()))?;
+            timings.contact_solve += clock.elapsed();
+            counters.contact_solves += solution.conic_solves;
+            counters.fixed_point_iterations += solution.fixed_point_iterations;
+            let dx = dx0 + &z * &solution.r;
+            shift = solution.shift;
+            last = Some((solution.r, solution.u));
+            dx
+        };
+        counters.newton_iterations += 1;
+        if dx.iter().any(|v| !v.is_finite()) {
+            return Err(IncrementFailure::NonFinite { iteration });
+        }
+        x += dx;
+    }
+    // The loop returns from inside: either converged or at the last convergence check.
+    Err(IncrementFailure::NewtonNotConverged {
+        iterations: newton.max_iterations,
+        force_residual: f64::NAN,
+        contact_residual: f64::NAN,
+    })
+}
+
+/// `max_i |R_i| / s_i` with `s` the largest magnitude among the given force vectors; moments
+/// are divided by the model size so that both compare as forces.
+fn scaled_force_residual<const D: usize>(
+    model: &Model<D>,
+    residual: &DVector<f64>,
+    forces: &[&DVector<f64>],
+    length: f64,
+) -> f64 {
+    let kinds = model.dofs().kinds();
+    let as_force = |i: usize, v: f64| match kinds[i] {
+        EquationKind::Translation => v.abs(),
+        EquationKind::Rotation => v.abs() / length,
+    };
+    let mut scale = 0.0_f64;
+    for f in forces {
+        for (i, &v) in f.iter().enumerate() {
+            scale = scale.max(as_force(i, v));
+        }
+    }
+    let worst = residual
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| as_force(i, v))
+        .fold(0.0, f64::max);
+    if scale > 0.0 { worst / scale } else { worst }
+}
+
+/// Builds the converged state and updates the energy ledger.
+#[allow(clippy::too_many_arguments)]
+fn finish<const D: usize>(
+    model: &Model<D>,
+    start: &State,
+    kind: IncrementKind,
+    x: DVector<f64>,
+    v: DVector<f64>,
+    a: DVector<f64>,
+    net: DVector<f64>,
+    f_ext: DVector<f64>,
+    internal: &crate::assembly::InternalState,
+    rows: &ContactRows,
+    r: &DVector<f64>,
+    shift: Vec<f64>,
+) -> State {
+    let d = rows.components;
+    let mut contacts = Vec::with_capacity(rows.len());
+    let mut friction = 0.0;
+    let mut normal_work = 0.0;
+    for (k, old) in start.contacts.iter().enumerate() {
+        let force = |c: usize| r.get(k * d + c).copied().unwrap_or(0.0);
+        let slip = Vector2::from_fn(|c, _| {
+            if c + 1 < d {
+                rows.u[k * d + c + 1]
+            } else {
+                0.0
+            }
+        });
+        let tangential = Vector2::from_fn(|c, _| if c + 1 < d { force(c + 1) } else { 0.0 });
+        let gap = rows.u[k * d];
+        friction -= tangential.dot(&slip);
+        normal_work += force(0) * (gap - old.gap);
+        contacts.push(ContactPointState {
+            pair: old.pair,
+            node: old.node,
+            coords: rows.coords[k],
+            gap,
+            slip,
+            normal_force: force(0),
+            tangential_force: tangential,
+        });
+    }
+    let (time, load_factor) = match kind {
+        IncrementKind::Static { load_factor, .. } => (start.time, load_factor),
+        IncrementKind::Dynamic { h, .. } => (start.time + h, 1.0),
+    };
+    let dx = &x - &start.x;
+    let energy = EnergyLedger {
+        kinetic: 0.5 * v.component_mul(&v).dot(model.mass()),
+        strain: internal.strain_energy,
+        hourglass: internal.hourglass_energy,
+        external_work: start.energy.external_work + 0.5 * (&start.external_force + &f_ext).dot(&dx),
+        friction_dissipation: start.energy.friction_dissipation + friction,
+        normal_work: start.energy.normal_work + normal_work,
+    };
+    State {
+        time,
+        load_factor,
+        contact_reaction: rows.transpose_times(r, x.len()),
+        x,
+        v,
+        a,
+        net_force: net,
+        external_force: f_ext,
+        contacts,
+        shift,
+        energy,
+    }
+}

@@ -1,0 +1,33 @@
+//! Sparse-Newton HHT-alpha integration of a deformable solid in frictional contact with rigid
+//! bodies.
+//!
+//! The pieces, in the order a time increment uses them:
+//! - [`model`]: the assembled scene (mesh, material, rigid bodies, ties, loads, contact pairs);
+//! - [`dof`]: which global equation each node component and rigid-body motion maps to;
+//! - [`sparse`]: the fixed sparsity pattern and the Cholesky factorization whose symbolic
+//!   analysis is computed once per run and reused for every Newton iteration;
+//! - [`assembly`]: internal forces, tangent, lumped masses and follower pressure on that pattern;
+//! - [`hht`]: the HHT-alpha / Newmark relations between displacement, velocity and acceleration;
+//! - [`coupling`]: the contact rows H (gap and slip linearised in the global unknowns) and the
+//!   reduction of one Newton step to the exact-Coulomb problem in the contact forces;
+//! - [`increment`]: Newton-Raphson for one increment (static or dynamic);
+//! - [`stepper`]: steps, automatic cutback, and reporting of converged increments.
+//!
+//! Everything is generic over the spatial dimension `D` (2 = plane strain, 3 = solid): one code
+//! path serves both.
+
+pub mod assembly;
+pub mod coupling;
+pub mod dof;
+pub mod error;
+pub mod hht;
+pub mod increment;
+pub mod model;
+pub mod sparse;
+pub mod state;
+pub mod stepper;
+
+pub use error::{IncrementFailure, ModelError, RunError};
+pub use model::{ContactPair, Model, PressureLoad, SolidPart, Tie};
+pub use state::State;
+pub use stepper::{IncrementReport, Observer, RunStatistics, Settings, Step, StepKind, run};

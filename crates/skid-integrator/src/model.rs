@@ -1,0 +1,314 @@
+//! The scene the integrator solves: one deformable solid, rigid bodies, ties, pressure loads and
+//! node-to-rigid-surface contact pairs. A [`Model`] is checked once when built and is immutable
+//! during a run.
+
+use nalgebra::{DVector, SVector, Vector3};
+use skid_contact::surface::RigidSurface;
+use skid_fem::material::Hyperelastic;
+use skid_fem::mesh::SolidMesh;
+use skid_fem::rigid::RigidBody;
+use skid_fem::solid::OnePointSolid;
+
+use crate::dof::DofMap;
+use crate::error::ModelError;
+
+/// The deformable solid: mesh, material and section data.
+#[derive(Debug)]
+pub struct SolidPart<const D: usize> {
+    /// Mesh of one-point elements (quads in 2D, hexahedra in 3D).
+    pub mesh: SolidMesh<D>,
+    /// Hyperelastic material of every element.
+    pub material: Box<dyn Hyperelastic>,
+    /// Mass density, kg/m^3.
+    pub density: f64,
+    /// Out-of-plane thickness in 2D (plane strain), m; 1 in 3D.
+    pub thickness: f64,
+    /// Factor on the hourglass stabilisation stiffness (1 = default).
+    pub hourglass_scale: f64,
+}
+
+/// Nodes tied to a rigid body: they translate with its reference node.
+#[derive(Clone, Debug)]
+pub struct Tie {
+    /// Index of the rigid body.
+    pub body: usize,
+    /// Tied nodes.
+    pub nodes: Vec<usize>,
+}
+
+/// A uniform follower pressure on a set of faces (positive pushes into the solid).
+///
+/// The nodal forces follow the current face geometry. Their load stiffness, which is
+/// unsymmetric, is not assembled: it vanishes when the loaded face translates rigidly (as the
+/// pad's back face tied to the plate does), and otherwise Newton converges linearly.
+#[derive(Clone, Debug)]
+pub struct PressureLoad {
+    /// Faces (node lists with outward orientation).
+    pub faces: Vec<Vec<usize>>,
+    /// Pressure at load factor 1, Pa.
+    pub pressure: f64,
+}
+
+/// Frictional contact between slave nodes of the solid and a surface carried by a rigid body.
+#[derive(Debug)]
+pub struct ContactPair {
+    /// Name used in messages.
+    pub name: String,
+    /// Slave nodes (every one is a permanent contact candidate).
+    pub nodes: Vec<usize>,
+    /// Rigid body carrying the master surface.
+    pub body: usize,
+    /// Master surface, described in the body frame (origin at the reference node).
+    pub surface: Box<dyn RigidSurface>,
+    /// Coulomb friction coefficient.
+    pub mu: f64,
+}
+
+/// A checked scene with its equation numbering and lumped masses.
+#[derive(Debug)]
+pub struct Model<const D: usize> {
+    part: SolidPart<D>,
+    bodies: Vec<RigidBody<D>>,
+    ties: Vec<Tie>,
+    pressures: Vec<PressureLoad>,
+    contacts: Vec<ContactPair>,
+    elements: Vec<OnePointSolid<D>>,
+    dofs: DofMap<D>,
+    mass: DVector<f64>,
+    length_scale: f64,
+}
+
+fn invalid<T>(msg: String) -> Result<T, ModelError> {
+    Err(ModelError::Invalid(msg))
+}
+
+impl<const D: usize> Model<D> {
+    /// Checks the scene and numbers its equations.
+    ///
+    /// # Errors
+    /// [`ModelError`] naming the entity at fault: a bad mesh or element geometry, non-physical
+    /// density or thickness, an out-of-range node or body, a node tied twice, a tie to a body
+    /// that can rotate, a negative friction coefficient, or an equation without inertia.
+    pub fn new(
+        part: SolidPart<D>,
+        bodies: Vec<RigidBody<D>>,
+        ties: Vec<Tie>,
+        pressures: Vec<PressureLoad>,
+        contacts: Vec<ContactPair>,
+    ) -> Result<Self, ModelError> {
+        if D != 2 && D != 3 {
+            return invalid(format!("dimension must be 2 or 3, got {D}"));
+        }
+        part.mesh.validate()?;
+        if !(part.density.is_finite() && part.density > 0.0) {
+            return invalid(format!("density must be > 0, got {}", part.density));
+        }
+        if !(part.thickness.is_finite() && part.thickness > 0.0) {
+            return invalid(format!("thickness must be > 0, got {}", part.thickness));
+        }
+        if !(part.hourglass_scale.is_finite() && part.hourglass_scale > 0.0) {
+            return invalid(format!(
+                "hourglass scale must be > 0, got {}",
+                part.hourglass_scale
+            ));
+        }
+        for body in &bodies {
+            body.validate()?;
+        }
+        let n_nodes = part.mesh.nodes.len();
+        let check_node = |n: usize, what: &str| {
+            if n >= n_nodes {
+                invalid(format!("{what}: node {n} does not exist ({n_nodes} nodes)"))
+            } else {
+                Ok(())
+            }
+        };
+        let check_body = |b: usize, what: &str| {
+            if b >= bodies.len() {
+                invalid(format!("{what}: rigid body {b} does not exist"))
+            } else {
+                Ok(())
+            }
+        };
+
+        let mut tied_to = vec![None; n_nodes];
+        for tie in &ties {
+            check_body(tie.body, "tie")?;
+            if bodies[tie.body].rotation_axis.is_some() {
+                return invalid(format!(
+                    "tie to rigid body '{}': ties to rotating bodies are not supported",
+                    bodies[tie.body].name
+                ));
+            }
+            for &n in &tie.nodes {
+                check_node(n, "tie")?;
+                if tied_to[n].replace(tie.body).is_some() {
+                    return invalid(format!("node {n} is tied twice"));
+                }
+            }
+        }
+        let face_nodes = 1 << (D - 1);
+        for load in &pressures {
+            if !load.pressure.is_finite() {
+                return invalid(format!("pressure must be finite, got {}", load.pressure));
+            }
+            for face in &load.faces {
+                if face.len() != face_nodes {
+                    return invalid(format!(
+                        "pressure face {face:?} must have {face_nodes} nodes"
+                    ));
+                }
+                for &n in face {
+                    check_node(n, "pressure face")?;
+                }
+            }
+        }
+        for pair in &contacts {
+            check_body(pair.body, &format!("contact pair '{}'", pair.name))?;
+            if !(pair.mu.is_finite() && pair.mu >= 0.0) {
+                return invalid(format!(
+                    "contact pair '{}': friction coefficient must be >= 0, got {}",
+                    pair.name, pair.mu
+                ));
+            }
+            for &n in &pair.nodes {
+                check_node(n, &format!("contact pair '{}'", pair.name))?;
+            }
+        }
+
+        let mu0 = part.material.initial_shear_modulus();
+        let mut elements = Vec::with_capacity(part.mesh.elements.len());
+        for (e, conn) in part.mesh.elements.iter().enumerate() {
+            let x: Vec<SVector<f64, D>> = conn.iter().map(|&n| part.mesh.nodes[n]).collect();
+            let element = OnePointSolid::new(&x, part.thickness, mu0, part.hourglass_scale)
+                .map_err(|err| ModelError::Invalid(format!("element {e}: {err}")))?;
+            elements.push(element);
+        }
+
+        let free_translations: Vec<[bool; D]> =
+            bodies.iter().map(|b| b.free_translations).collect();
+        let free_rotation: Vec<bool> = bodies.iter().map(|b| b.rotation_axis.is_some()).collect();
+        let dofs = DofMap::new(n_nodes, &tied_to, &free_translations, &free_rotation);
+
+        let mut mass = DVector::zeros(dofs.len());
+        for (element, conn) in elements.iter().zip(&part.mesh.elements) {
+            let m = element.lumped_node_mass(part.density);
+            for &n in conn {
+                for eq in dofs.node(n).iter().flatten() {
+                    mass[*eq] += m;
+                }
+            }
+        }
+        for (b, body) in bodies.iter().enumerate() {
+            for eq in dofs.body_translation(b).iter().flatten() {
+                mass[*eq] += body.mass;
+            }
+            if let Some(eq) = dofs.body_rotation(b) {
+                mass[eq] += body.rotary_inertia;
+            }
+        }
+        for (b, body) in bodies.iter().enumerate() {
+            for eq in dofs.body_equations(b) {
+                if mass[eq] <= 0.0 {
+                    return invalid(format!(
+                        "rigid body '{}' has a free motion without inertia (give it mass, \
+                         rotary inertia, or tie nodes to it)",
+                        body.name
+                    ));
+                }
+            }
+        }
+
+        let mut lo = SVector::<f64, D>::repeat(f64::INFINITY);
+        let mut hi = SVector::<f64, D>::repeat(f64::NEG_INFINITY);
+        for p in part
+            .mesh
+            .nodes
+            .iter()
+            .chain(bodies.iter().map(|b| &b.reference_point))
+        {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        let length_scale = (hi - lo).norm().max(f64::MIN_POSITIVE);
+
+        Ok(Self {
+            part,
+            bodies,
+            ties,
+            pressures,
+            contacts,
+            elements,
+            dofs,
+            mass,
+            length_scale,
+        })
+    }
+
+    /// The deformable solid.
+    pub fn part(&self) -> &SolidPart<D> {
+        &self.part
+    }
+    /// Rigid bodies.
+    pub fn bodies(&self) -> &[RigidBody<D>] {
+        &self.bodies
+    }
+    /// Ties.
+    pub fn ties(&self) -> &[Tie] {
+        &self.ties
+    }
+    /// Pressure loads.
+    pub fn pressures(&self) -> &[PressureLoad] {
+        &self.pressures
+    }
+    /// Contact pairs.
+    pub fn contacts(&self) -> &[ContactPair] {
+        &self.contacts
+    }
+    /// Precomputed elements (same order as the mesh's elements).
+    pub fn elements(&self) -> &[OnePointSolid<D>] {
+        &self.elements
+    }
+    /// Equation numbering.
+    pub fn dofs(&self) -> &DofMap<D> {
+        &self.dofs
+    }
+    /// Lumped mass (or rotary inertia) of each equation.
+    pub fn mass(&self) -> &DVector<f64> {
+        &self.mass
+    }
+    /// Size of the scene (diagonal of the bounding box of nodes and body reference points), m.
+    pub fn length_scale(&self) -> f64 {
+        self.length_scale
+    }
+    /// Index of the rigid body with this name.
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
+    /// Current position of a node embedded in 3D (z = 0 in 2D).
+    pub fn node_position(&self, x: &DVector<f64>, node: usize) -> Vector3<f64> {
+        embed(&(self.part.mesh.nodes[node] + self.dofs.node_displacement(x, node)))
+    }
+
+    /// Initial velocity vector: rigid-body initial velocities, zero for the solid's nodes.
+    pub fn initial_velocity(&self) -> DVector<f64> {
+        let mut v = DVector::zeros(self.dofs.len());
+        for (b, body) in self.bodies.iter().enumerate() {
+            for (i, eq) in self.dofs.body_translation(b).iter().enumerate() {
+                if let Some(eq) = eq {
+                    v[*eq] = body.initial_velocity[i];
+                }
+            }
+            if let Some(eq) = self.dofs.body_rotation(b) {
+                v[eq] = body.initial_angular_velocity;
+            }
+        }
+        v
+    }
+}
+
+/// Embeds a point of the D-dimensional model in 3D (z = 0 in 2D).
+pub fn embed<const D: usize>(p: &SVector<f64, D>) -> Vector3<f64> {
+    Vector3::from_fn(|i, _| if i < D { p[i] } else { 0.0 })
+}

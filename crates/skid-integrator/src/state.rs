@@ -1,0 +1,74 @@
+//! The solution state at the end of a converged increment.
+
+use nalgebra::{DVector, Vector2};
+
+/// State of one contact candidate (slave node of a pair) at the end of an increment.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactPointState {
+    /// Contact pair index.
+    pub pair: usize,
+    /// Slave node.
+    pub node: usize,
+    /// Convected coordinates of the node's projection on the master surface (m).
+    pub coords: Vector2<f64>,
+    /// Normal gap (m, > 0 open).
+    pub gap: f64,
+    /// Slip increment of the last increment in the surface coordinates (m).
+    pub slip: Vector2<f64>,
+    /// Normal force (N, >= 0).
+    pub normal_force: f64,
+    /// Tangential force on the slave node, conjugate to the surface coordinates (N).
+    pub tangential_force: Vector2<f64>,
+}
+
+impl ContactPointState {
+    /// True if the contact carries a normal force.
+    pub fn is_closed(&self) -> bool {
+        self.normal_force > 0.0
+    }
+}
+
+/// Energies and work accumulated since the start of the run (J).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EnergyLedger {
+    /// Kinetic energy `1/2 v^T M v` (solid, plates and drums).
+    pub kinetic: f64,
+    /// Elastic strain energy of the solid.
+    pub strain: f64,
+    /// Hourglass stabilisation energy.
+    pub hourglass: f64,
+    /// Work of the external loads, trapezoidal rule over increments.
+    pub external_work: f64,
+    /// Frictional dissipation `sum -r_T . Delta s` (>= 0 for the Coulomb law).
+    pub friction_dissipation: f64,
+    /// Work of the normal contact forces `sum r_N Delta g` (zero for a persistent contact).
+    pub normal_work: f64,
+}
+
+/// Solution at the end of an increment.
+#[derive(Clone, Debug)]
+pub struct State {
+    /// Physical time, s (static steps take none).
+    pub time: f64,
+    /// Load factor of the pressure loads.
+    pub load_factor: f64,
+    /// Displacements and rotation angles per equation.
+    pub x: DVector<f64>,
+    /// Velocities per equation.
+    pub v: DVector<f64>,
+    /// Accelerations per equation.
+    pub a: DVector<f64>,
+    /// `f_int - f_ext` at `x` (the history term of HHT).
+    pub net_force: DVector<f64>,
+    /// External forces at `x` (for the work integral).
+    pub external_force: DVector<f64>,
+    /// Generalized contact forces `H^T r` per equation (forces on nodes and bodies; the
+    /// torque on a drum sits in its rotation equation).
+    pub contact_reaction: DVector<f64>,
+    /// Contact candidates, pair by pair, node by node.
+    pub contacts: Vec<ContactPointState>,
+    /// De Saxce shifts of the last contact solve (warm start of the next).
+    pub shift: Vec<f64>,
+    /// Energy bookkeeping.
+    pub energy: EnergyLedger,
+}

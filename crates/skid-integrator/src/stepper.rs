@@ -1,0 +1,424 @@
+//! Steps, increments and automatic cutback.
+//!
+//! A run is a sequence of steps. A static step ramps the loads linearly from their current
+//! factor to 1 over its increments (pseudo-time, no physical time elapses); a dynamic step
+//! advances time with HHT-alpha at full load. A failed increment (Newton, conic solve, inverted
+//! element, ...) is retried with its size multiplied by the cutback factor; after a few
+//! successes the size grows back to nominal. When the cutbacks are exhausted the run stops with
+//! an error saying where and why; every increment converged before that has already been
+//! reported to the [`Observer`].
+
+use std::time::{Duration, Instant};
+
+use nalgebra::DVector;
+use skid_contact::coulomb::CoulombSettings;
+
+use crate::assembly::{Assembler, external_forces};
+use crate::coupling::contact_rows;
+use crate::error::{IncrementFailure, RunError};
+use crate::hht::Hht;
+use crate::increment::{
+    IncrementCounters, IncrementKind, NewtonSettings, Timings, solve_increment,
+};
+use crate::model::Model;
+use crate::state::{ContactPointState, EnergyLedger, State};
+
+/// What a step does.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StepKind {
+    /// Static equilibrium, loads ramped to full value over `increments` increments.
+    Static {
+        /// Number of (nominal) increments.
+        increments: usize,
+        /// Time scale `h_s` of the mass regularisation `M/h_s^2` of the Newton tangent, s.
+        regularization_time: f64,
+    },
+    /// Implicit dynamics with HHT-alpha.
+    Dynamic {
+        /// Step duration, s.
+        duration: f64,
+        /// Nominal time increment, s.
+        dt: f64,
+        /// HHT alpha in [-1/3, 0].
+        alpha: f64,
+    },
+}
+
+/// One analysis step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Step {
+    /// Name used in outputs and messages.
+    pub name: String,
+    /// What the step does.
+    pub kind: StepKind,
+    /// Rigid bodies held fixed during the step (all their free motions).
+    pub held_bodies: Vec<usize>,
+}
+
+/// Cutback settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CutbackSettings {
+    /// Factor applied to the increment size after a failure.
+    pub factor: f64,
+    /// Consecutive cutbacks allowed before the run stops.
+    pub max_cutbacks: usize,
+    /// Successful increments before the size grows again.
+    pub growth_after: usize,
+    /// Growth factor (the size never exceeds the nominal one).
+    pub growth_factor: f64,
+}
+
+impl Default for CutbackSettings {
+    fn default() -> Self {
+        Self {
+            factor: 0.25,
+            max_cutbacks: 8,
+            growth_after: 3,
+            growth_factor: 2.0,
+        }
+    }
+}
+
+/// All solver settings.
+#[derive(Clone, Debug, Default)]
+pub struct Settings {
+    /// Newton settings.
+    pub newton: NewtonSettings,
+    /// Exact-Coulomb solver settings.
+    pub coulomb: CoulombSettings,
+    /// Cutback settings.
+    pub cutback: CutbackSettings,
+}
+
+/// What the observer is told about a converged increment.
+#[derive(Debug)]
+pub struct IncrementReport<'a> {
+    /// Step name (`"initial"` for the initial state).
+    pub step: &'a str,
+    /// Whether the step is dynamic.
+    pub dynamic: bool,
+    /// Increment number within the step (0 for the initial state).
+    pub increment: usize,
+    /// Size of the increment (time, or load-factor fraction for static steps).
+    pub size: f64,
+    /// Converged state.
+    pub state: &'a State,
+    /// Iteration counts of the increment.
+    pub counters: &'a IncrementCounters,
+}
+
+/// Receives every converged increment (history and field output).
+pub trait Observer<const D: usize> {
+    /// Called once per converged increment, and once for the initial state.
+    ///
+    /// # Errors
+    /// An I/O error stops the run.
+    fn on_increment(
+        &mut self,
+        model: &Model<D>,
+        report: &IncrementReport<'_>,
+    ) -> std::io::Result<()>;
+}
+
+/// Totals of a run.
+#[derive(Clone, Debug, Default)]
+pub struct RunStatistics {
+    /// Converged increments.
+    pub increments: usize,
+    /// Newton iterations of converged increments.
+    pub newton_iterations: usize,
+    /// Conic solves of converged increments.
+    pub contact_solves: usize,
+    /// De Saxce fixed-point iterations of converged increments.
+    pub fixed_point_iterations: usize,
+    /// Failed attempts answered by a cutback.
+    pub cutbacks: usize,
+    /// Time spent in the parts of Newton (all attempts).
+    pub timings: Timings,
+    /// Wall time of the whole run.
+    pub wall_time: Duration,
+}
+
+/// The state before the first step: undeformed, rigid bodies at their initial velocities,
+/// loads at `load_factor`.
+///
+/// # Errors
+/// If the contact projection or the loads cannot be evaluated on the initial geometry.
+pub fn initial_state<const D: usize>(
+    model: &Model<D>,
+    load_factor: f64,
+) -> Result<State, IncrementFailure> {
+    let n = model.dofs().len();
+    let x = DVector::zeros(n);
+    let v = model.initial_velocity();
+    let held = vec![false; n];
+    let coords0: Vec<_> = model
+        .contacts()
+        .iter()
+        .flat_map(|p| p.nodes.iter())
+        .map(|_| nalgebra::Vector2::zeros())
+        .collect();
+    let rows = contact_rows(model, &x, &coords0, &held)?;
+    let d = rows.components;
+    let contacts = model
+        .contacts()
+        .iter()
+        .enumerate()
+        .flat_map(|(p, pair)| pair.nodes.iter().map(move |&node| (p, node)))
+        .enumerate()
+        .map(|(k, (pair, node))| ContactPointState {
+            pair,
+            node,
+            coords: rows.coords[k],
+            gap: rows.u[k * d],
+            slip: nalgebra::Vector2::zeros(),
+            normal_force: 0.0,
+            tangential_force: nalgebra::Vector2::zeros(),
+        })
+        .collect::<Vec<_>>();
+    let f_ext = external_forces(model, &x, load_factor)?;
+    let energy = EnergyLedger {
+        kinetic: 0.5 * v.component_mul(&v).dot(model.mass()),
+        ..EnergyLedger::default()
+    };
+    Ok(State {
+        time: 0.0,
+        load_factor,
+        x,
+        v,
+        a: DVector::zeros(n),
+        net_force: -&f_ext,
+        contact_reaction: DVector::zeros(n),
+        external_force: f_ext,
+        shift: vec![0.0; contacts.len()],
+        contacts,
+        energy,
+    })
+}
+
+/// Acceleration in equilibrium with the current forces, `a = M^{-1}(f_ext - f_int + H^T r)`,
+/// used at the start of a dynamic step (zero after a converged static step, except for bodies
+/// released from a hold).
+fn consistent_acceleration<const D: usize>(
+    model: &Model<D>,
+    state: &State,
+    held: &[bool],
+) -> Result<DVector<f64>, IncrementFailure> {
+    let n = model.dofs().len();
+    let previous: Vec<_> = state.contacts.iter().map(|c| c.coords).collect();
+    let rows = contact_rows(model, &state.x, &previous, held)?;
+    let d = rows.components;
+    let mut r = DVector::zeros(rows.rows.len());
+    for (k, c) in state.contacts.iter().enumerate() {
+        r[k * d] = c.normal_force;
+        for t in 1..d {
+            r[k * d + t] = c.tangential_force[t - 1];
+        }
+    }
+    let force = rows.transpose_times(&r, n) - &state.net_force;
+    Ok(DVector::from_fn(n, |i, _| {
+        if held[i] {
+            0.0
+        } else {
+            force[i] / model.mass()[i]
+        }
+    }))
+}
+
+fn validate_steps<const D: usize>(model: &Model<D>, steps: &[Step]) -> Result<(), RunError> {
+    let bad = |s: &Step, msg: String| Err(RunError::Invalid(format!("step '{}': {msg}", s.name)));
+    for s in steps {
+        if let Some(&b) = s.held_bodies.iter().find(|&&b| b >= model.bodies().len()) {
+            return bad(s, format!("held body {b} does not exist"));
+        }
+        match s.kind {
+            StepKind::Static {
+                increments,
+                regularization_time,
+            } => {
+                if increments == 0 {
+                    return bad(s, "a static step needs at least one increment".into());
+                }
+                if !(regularization_time.is_finite() && regularization_time > 0.0) {
+                    return bad(
+                        s,
+                        format!("regularization time must be > 0, got {regularization_time}"),
+                    );
+                }
+            }
+            StepKind::Dynamic {
+                duration,
+                dt,
+                alpha,
+            } => {
+                if !(duration.is_finite() && duration > 0.0) {
+                    return bad(s, format!("duration must be > 0, got {duration}"));
+                }
+                if !(dt.is_finite() && dt > 0.0 && dt <= duration) {
+                    return bad(s, format!("dt must be in (0, duration], got {dt}"));
+                }
+                Hht::new(alpha).map_err(RunError::Invalid)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Runs the steps in order, reporting each converged increment to `observer`.
+///
+/// Returns the statistics in every case, with the final state or the error that stopped the run.
+pub fn run<const D: usize>(
+    model: &Model<D>,
+    steps: &[Step],
+    settings: &Settings,
+    observer: &mut dyn Observer<D>,
+) -> (RunStatistics, Result<State, RunError>) {
+    let clock = Instant::now();
+    let mut stats = RunStatistics::default();
+    let result = run_steps(model, steps, settings, observer, &mut stats);
+    stats.wall_time = clock.elapsed();
+    (stats, result)
+}
+
+fn run_steps<const D: usize>(
+    model: &Model<D>,
+    steps: &[Step],
+    settings: &Settings,
+    observer: &mut dyn Observer<D>,
+    stats: &mut RunStatistics,
+) -> Result<State, RunError> {
+    validate_steps(model, steps)?;
+    let starts_static = matches!(
+        steps.first().map(|s| &s.kind),
+        Some(StepKind::Static { .. })
+    );
+    let fail_initial = |cause| RunError::StepFailed {
+        step: "initial".into(),
+        increment: 0,
+        time: 0.0,
+        size: 0.0,
+        cutbacks: 0,
+        cause,
+    };
+    let mut state =
+        initial_state(model, if starts_static { 0.0 } else { 1.0 }).map_err(fail_initial)?;
+    let mut assembler = Assembler::new(model).map_err(|e| RunError::Invalid(e.to_string()))?;
+    let none = IncrementCounters::default();
+    observer.on_increment(
+        model,
+        &IncrementReport {
+            step: "initial",
+            dynamic: false,
+            increment: 0,
+            size: 0.0,
+            state: &state,
+            counters: &none,
+        },
+    )?;
+
+    let n = model.dofs().len();
+    for step in steps {
+        let mut held = vec![false; n];
+        for &b in &step.held_bodies {
+            for eq in model.dofs().body_equations(b) {
+                held[eq] = true;
+            }
+        }
+        let lambda0 = state.load_factor;
+        let t0 = state.time;
+        let (nominal, span) = match step.kind {
+            StepKind::Static { increments, .. } => (1.0 / increments as f64, 1.0),
+            StepKind::Dynamic { duration, dt, .. } => {
+                state.a = consistent_acceleration(model, &state, &held).map_err(|cause| {
+                    RunError::StepFailed {
+                        step: step.name.clone(),
+                        increment: 0,
+                        time: state.time,
+                        size: dt,
+                        cutbacks: 0,
+                        cause,
+                    }
+                })?;
+                (dt / duration, duration)
+            }
+        };
+        let mut progress = 0.0;
+        let mut size = nominal;
+        let mut consecutive_failures = 0;
+        let mut successes = 0;
+        let mut increment = 0;
+        while progress < 1.0 - 1e-12 {
+            let dp = size.min(1.0 - progress);
+            let kind = match step.kind {
+                StepKind::Static {
+                    regularization_time,
+                    ..
+                } => IncrementKind::Static {
+                    load_factor: lambda0 + (1.0 - lambda0) * (progress + dp),
+                    regularization: 1.0 / (regularization_time * regularization_time),
+                },
+                StepKind::Dynamic { alpha, .. } => IncrementKind::Dynamic {
+                    hht: Hht::new(alpha).map_err(RunError::Invalid)?,
+                    h: dp * span,
+                },
+            };
+            match solve_increment(
+                model,
+                &mut assembler,
+                &state,
+                kind,
+                &held,
+                settings,
+                &mut stats.timings,
+            ) {
+                Ok((mut next, counters)) => {
+                    progress += dp;
+                    increment += 1;
+                    if let StepKind::Dynamic { .. } = step.kind {
+                        // Land exactly on the step end despite round-off in the progress sum.
+                        next.time = t0 + progress * span;
+                    }
+                    state = next;
+                    stats.increments += 1;
+                    stats.newton_iterations += counters.newton_iterations;
+                    stats.contact_solves += counters.contact_solves;
+                    stats.fixed_point_iterations += counters.fixed_point_iterations;
+                    observer.on_increment(
+                        model,
+                        &IncrementReport {
+                            step: &step.name,
+                            dynamic: matches!(step.kind, StepKind::Dynamic { .. }),
+                            increment,
+                            size: dp * span,
+                            state: &state,
+                            counters: &counters,
+                        },
+                    )?;
+                    consecutive_failures = 0;
+                    successes += 1;
+                    if size < nominal && successes >= settings.cutback.growth_after {
+                        size = (size * settings.cutback.growth_factor).min(nominal);
+                        successes = 0;
+                    }
+                }
+                Err(cause) => {
+                    stats.cutbacks += 1;
+                    consecutive_failures += 1;
+                    successes = 0;
+                    if consecutive_failures > settings.cutback.max_cutbacks {
+                        return Err(RunError::StepFailed {
+                            step: step.name.clone(),
+                            increment: increment + 1,
+                            time: state.time,
+                            size: dp * span,
+                            cutbacks: consecutive_failures - 1,
+                            cause,
+                        });
+                    }
+                    size = dp * settings.cutback.factor;
+                }
+            }
+        }
+    }
+    Ok(state)
+}

@@ -1,0 +1,217 @@
+//! A block pressed on a rigid flat and pushed sideways: it sticks while the push is below
+//! mu N, and slides with a friction force of exactly mu N above it.
+
+use nalgebra::{SVector, Vector3};
+use skid_contact::plane::RigidPlane;
+use skid_fem::material::PolynomialN1;
+use skid_fem::mesh::SolidMesh;
+use skid_fem::rigid::RigidBody;
+use skid_integrator::stepper::{IncrementReport, Observer, Settings, Step, StepKind, run};
+use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, State, Tie};
+
+const MU: f64 = 0.3;
+const WIDTH: f64 = 0.02;
+const HEIGHT: f64 = 0.01;
+const THICKNESS: f64 = 0.01;
+const P_TOP: f64 = 1e5; // normal force N = P_TOP * WIDTH * THICKNESS = 20 N
+
+struct Record(Vec<State>);
+
+impl<const D: usize> Observer<D> for Record {
+    fn on_increment(&mut self, _: &Model<D>, r: &IncrementReport<'_>) -> std::io::Result<()> {
+        self.0.push(r.state.clone());
+        Ok(())
+    }
+}
+
+/// Block of 2 x 1 plane-strain elements on the plane y = 0; its top face is tied to a slider
+/// that may translate in x and y; pressure on top and on the left face.
+fn block(side_force: f64) -> (Model<2>, f64) {
+    let mesh = SolidMesh::<2>::structured_block(
+        SVector::<f64, 2>::new(0.0, 0.0),
+        SVector::<f64, 2>::new(WIDTH, HEIGHT),
+        [2, 1],
+    )
+    .expect("mesh");
+    let bottom = mesh.node_sets["ymin"].clone();
+    let top = mesh.node_sets["ymax"].clone();
+    let top_faces = mesh.surfaces["ymax"].clone();
+    let left_faces = mesh.surfaces["xmin"].clone();
+    let part = SolidPart {
+        mesh,
+        material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6).expect("material")),
+        density: 1000.0,
+        thickness: THICKNESS,
+        hourglass_scale: 1.0,
+    };
+    let body = |name: &str, free: [bool; 2], y: f64| RigidBody::<2> {
+        name: name.into(),
+        reference_point: SVector::<f64, 2>::new(0.0, y),
+        mass: 0.0,
+        rotary_inertia: 0.0,
+        free_translations: free,
+        rotation_axis: None,
+        initial_velocity: SVector::zeros(),
+        initial_angular_velocity: 0.0,
+    };
+    let model = Model::new(
+        part,
+        vec![
+            body("ground", [false, false], 0.0),
+            body("slider", [true, true], HEIGHT),
+        ],
+        vec![Tie {
+            body: 1,
+            nodes: top,
+        }],
+        vec![
+            PressureLoad {
+                faces: top_faces,
+                pressure: P_TOP,
+            },
+            PressureLoad {
+                faces: left_faces,
+                pressure: side_force / (HEIGHT * THICKNESS),
+            },
+        ],
+        vec![ContactPair {
+            name: "block-ground".into(),
+            nodes: bottom,
+            body: 0,
+            surface: Box::new(RigidPlane::new(Vector3::y(), Vector3::x()).expect("plane")),
+            mu: MU,
+        }],
+    )
+    .expect("model");
+    let mass = 1000.0 * WIDTH * HEIGHT * THICKNESS;
+    (model, mass)
+}
+
+/// Runs a static preload ramping both loads (if `preload`), then 2 ms of dynamics.
+fn simulate(side_force: f64, preload: bool) -> (Model<2>, f64, Vec<State>) {
+    let (model, mass) = block(side_force);
+    let mut steps = vec![Step {
+        name: "push".into(),
+        kind: StepKind::Dynamic {
+            duration: 2e-3,
+            dt: 2e-5,
+            alpha: -1.0 / 3.0,
+        },
+        held_bodies: vec![],
+    }];
+    if preload {
+        steps.insert(
+            0,
+            Step {
+                name: "preload".into(),
+                kind: StepKind::Static {
+                    increments: 4,
+                    regularization_time: 1e-2,
+                },
+                held_bodies: vec![],
+            },
+        );
+    }
+    let mut record = Record(Vec::new());
+    let (_, result) = run(&model, &steps, &Settings::default(), &mut record);
+    result.expect("run completes");
+    (model, mass, record.0)
+}
+
+#[test]
+fn block_sticks_below_mu_n() {
+    let normal = P_TOP * WIDTH * THICKNESS;
+    // Both loads ramp together in the static preload, so the push stays at half the friction
+    // limit throughout; the dynamic step that follows must keep the block stuck.
+    // (During the preload itself the bottom corners may slip outward as the block bulges.)
+    let (_, _, states) = simulate(0.5 * MU * normal, true);
+    let states: Vec<State> = states.into_iter().filter(|s| s.time > 0.0).collect();
+    assert_eq!(states.len(), 100);
+    for s in &states {
+        let n: f64 = s.contacts.iter().map(|c| c.normal_force).sum();
+        let t: f64 = s.contacts.iter().map(|c| c.tangential_force[0]).sum();
+        assert!(n > 0.0, "block must stay in contact");
+        assert!(
+            t.abs() <= MU * n * (1.0 + 1e-9),
+            "friction {t} within the cone {n}"
+        );
+        for c in &s.contacts {
+            assert!(
+                c.slip[0].abs() < 1e-10,
+                "stick: slip {} at t = {}",
+                c.slip[0],
+                s.time
+            );
+        }
+    }
+    // The mean friction force balances the push.
+    let tail = &states[states.len() / 2..];
+    let mean_t: f64 = tail
+        .iter()
+        .map(|s| {
+            s.contacts
+                .iter()
+                .map(|c| c.tangential_force[0])
+                .sum::<f64>()
+        })
+        .sum::<f64>()
+        / tail.len() as f64;
+    assert!(
+        (mean_t.abs() - 0.5 * MU * normal).abs() < 0.05 * MU * normal,
+        "{mean_t}"
+    );
+}
+
+#[test]
+fn block_slides_above_mu_n_with_friction_exactly_mu_n() {
+    let normal = P_TOP * WIDTH * THICKNESS;
+    let push = 2.0 * MU * normal;
+    // Loads applied suddenly: the block is pressed down and pushed at once.
+    let (model, mass, states) = simulate(push, false);
+    let slider_x = model.dofs().body_translation(1)[0].expect("slider x is free");
+    let mut sliding_seen = 0;
+    for s in &states[1..] {
+        for c in s.contacts.iter().filter(|c| c.is_closed()) {
+            if c.slip[0].abs() > 1e-9 {
+                sliding_seen += 1;
+                let rt = c.tangential_force[0];
+                assert!(
+                    (rt.abs() - MU * c.normal_force).abs() <= 1e-7 * MU * c.normal_force,
+                    "sliding friction {rt} vs mu N {}",
+                    MU * c.normal_force
+                );
+                assert!(rt * c.slip[0] < 0.0, "friction opposes slip");
+                assert!(
+                    c.gap.abs() < 1e-9,
+                    "no dilation while sliding: gap {}",
+                    c.gap
+                );
+            }
+        }
+    }
+    assert!(sliding_seen > 50, "the block slides");
+    // Momentum: the push and the friction forces accelerate the whole block,
+    // v(T) = sum_n h (push + sum_c r_T,c) / m, and once the normal force has settled the
+    // friction force is mu times it.
+    let mut expected = 0.0;
+    for w in states.windows(2) {
+        let friction: f64 = w[1].contacts.iter().map(|c| c.tangential_force[0]).sum();
+        expected += (w[1].time - w[0].time) * (push + friction) / mass;
+    }
+    let last = states.last().expect("states");
+    assert!(
+        (last.v[slider_x] - expected).abs() < 0.02 * expected,
+        "slider velocity {} vs {expected}",
+        last.v[slider_x]
+    );
+    let total = |s: &State, f: &dyn Fn(&skid_integrator::state::ContactPointState) -> f64| {
+        s.contacts.iter().map(f).sum::<f64>()
+    };
+    let n = total(last, &|c| c.normal_force);
+    let t = total(last, &|c| c.tangential_force[0]);
+    assert!(
+        (t + MU * n).abs() < 1e-7 * MU * n,
+        "friction {t} = -mu N {}",
+        MU * n
+    );
+}
