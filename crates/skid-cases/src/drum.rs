@@ -1,0 +1,196 @@
+//! Builds the braking-drum scene of a case as a finite-element model (2D or 3D, one code path).
+//!
+//! - the pad: a structured block of one-point elements; its front face (`ymin`) is the slave
+//!   side of the contact, its back face (`ymax`) is tied to the back plate and loaded by the
+//!   pressure;
+//! - the drum: a rigid body whose only free motion is the spin about +z, carrying all the
+//!   drum's inertia at its reference node on the axis; its surface has no mass and no degrees
+//!   of freedom of its own;
+//! - the back plate: a rigid body whose only free motion is the radial (y) translation.
+
+use nalgebra::{SVector, Vector3};
+use skid_contact::surface::AnalyticCylinder;
+use skid_fem::material::PolynomialN1;
+use skid_fem::mesh::SolidMesh;
+use skid_fem::rigid::RigidBody;
+use skid_integrator::increment::NewtonSettings;
+use skid_integrator::stepper::{CutbackSettings, Settings, Step, StepKind};
+use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, Tie};
+
+use crate::schema::{Case, DrumSurfaceSpec, MaterialSpec, StepSpec};
+
+/// Index of the drum among the model's rigid bodies.
+pub const DRUM: usize = 0;
+/// Index of the back plate among the model's rigid bodies.
+pub const BACK_PLATE: usize = 1;
+
+/// A built scene: model, steps and solver settings.
+#[derive(Debug)]
+pub struct DrumScene<const D: usize> {
+    /// The model.
+    pub model: Model<D>,
+    /// Analysis steps.
+    pub steps: Vec<Step>,
+    /// Solver settings.
+    pub settings: Settings,
+}
+
+/// Builds the scene of a validated case in dimension `D` (which must equal `case.dimension`).
+///
+/// # Errors
+/// A message if the model is inconsistent (the case was validated, so this means a mesh or
+/// element problem such as a degenerate geometry).
+pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
+    if case.dimension != D {
+        return Err(format!("case is {}D, builder is {D}D", case.dimension));
+    }
+    let pad = &case.pad;
+    let r = case.drum.radius;
+    let extent = [pad.length, pad.thickness, pad.width];
+    let corner = [-0.5 * pad.length, r + pad.standoff, -0.5 * pad.width];
+    let counts = [
+        pad.elements.circumferential,
+        pad.elements.radial,
+        pad.elements.axial,
+    ];
+    let mesh = SolidMesh::<D>::structured_block(
+        SVector::<f64, D>::from_fn(|i, _| corner[i]),
+        SVector::<f64, D>::from_fn(|i, _| extent[i]),
+        std::array::from_fn(|i| counts[i]),
+    )
+    .map_err(|e| format!("pad mesh: {e}"))?;
+    let material = match pad.material {
+        MaterialSpec::PolynomialN1 { c10, c01, d1 } => {
+            PolynomialN1::new(c10, c01, d1).map_err(|e| format!("pad.material: {e}"))?
+        }
+    };
+    let set = |name: &str| {
+        mesh.node_sets
+            .get(name)
+            .cloned()
+            .ok_or_else(|| format!("pad mesh has no node set '{name}'"))
+    };
+    let front = set("ymin")?;
+    let back = set("ymax")?;
+    let back_faces = mesh
+        .surfaces
+        .get("ymax")
+        .cloned()
+        .ok_or("pad mesh has no surface 'ymax'")?;
+
+    let drum = RigidBody::<D> {
+        name: "drum".into(),
+        reference_point: SVector::zeros(),
+        mass: case.drum.mass,
+        rotary_inertia: case.drum.rotary_inertia,
+        free_translations: [false; D],
+        rotation_axis: Some(Vector3::z()),
+        initial_velocity: SVector::zeros(),
+        initial_angular_velocity: case.drum.omega0,
+    };
+    let mut plate_point = SVector::<f64, D>::zeros();
+    plate_point[1] = r + pad.standoff + pad.thickness;
+    let mut free = [false; D];
+    free[1] = true;
+    let plate = RigidBody::<D> {
+        name: "back_plate".into(),
+        reference_point: plate_point,
+        mass: case.back_plate.mass,
+        rotary_inertia: 0.0,
+        free_translations: free,
+        rotation_axis: None,
+        initial_velocity: SVector::zeros(),
+        initial_angular_velocity: 0.0,
+    };
+    let surface = match case.drum.surface {
+        DrumSurfaceSpec::Analytic => {
+            AnalyticCylinder::new(r, Vector3::z()).map_err(|e| format!("drum.surface: {e}"))?
+        }
+    };
+    let part = SolidPart {
+        mesh,
+        material: Box::new(material),
+        density: pad.density,
+        thickness: if D == 2 { pad.width } else { 1.0 },
+        hourglass_scale: pad.hourglass_scale,
+    };
+    let model = Model::new(
+        part,
+        vec![drum, plate],
+        vec![Tie {
+            body: BACK_PLATE,
+            nodes: back,
+        }],
+        vec![PressureLoad {
+            faces: back_faces,
+            pressure: case.back_plate.pressure,
+        }],
+        vec![ContactPair {
+            name: "pad-drum".into(),
+            nodes: front,
+            body: DRUM,
+            surface: Box::new(surface),
+            mu: case.contact.mu,
+        }],
+    )
+    .map_err(|e| e.to_string())?;
+
+    let body_index = |name: &str| if name == "drum" { DRUM } else { BACK_PLATE };
+    let steps = case
+        .steps
+        .iter()
+        .map(|s| match s {
+            StepSpec::Static {
+                name,
+                increments,
+                hold,
+                regularization_time,
+            } => Step {
+                name: name.clone(),
+                kind: StepKind::Static {
+                    increments: *increments,
+                    regularization_time: *regularization_time,
+                },
+                held_bodies: hold.iter().map(|h| body_index(h)).collect(),
+            },
+            StepSpec::Dynamic {
+                name,
+                duration,
+                dt,
+                alpha,
+                hold,
+            } => Step {
+                name: name.clone(),
+                kind: StepKind::Dynamic {
+                    duration: *duration,
+                    dt: *dt,
+                    alpha: *alpha,
+                },
+                held_bodies: hold.iter().map(|h| body_index(h)).collect(),
+            },
+        })
+        .collect();
+    let s = &case.solver;
+    let settings = Settings {
+        newton: NewtonSettings {
+            max_iterations: s.max_newton_iterations,
+            force_tolerance: s.force_tolerance,
+            contact_tolerance: s.contact_tolerance,
+        },
+        coulomb: skid_contact::coulomb::CoulombSettings {
+            tolerance: s.coulomb_tolerance,
+            max_fixed_point_iterations: s.max_fixed_point_iterations,
+            ..Default::default()
+        },
+        cutback: CutbackSettings {
+            factor: s.cutback_factor,
+            max_cutbacks: s.max_cutbacks,
+            ..Default::default()
+        },
+    };
+    Ok(DrumScene {
+        model,
+        steps,
+        settings,
+    })
+}

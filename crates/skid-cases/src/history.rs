@@ -1,0 +1,190 @@
+//! The drum's history: one CSV row per converged increment, and the samples the summary is
+//! computed from.
+//!
+//! The CSV is written to `history.csv.partial` and renamed to `history.csv` only when the run
+//! has ended (completed, or stopped with an error that the summary reports), so an interrupted
+//! process never leaves a file that looks complete.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use skid_integrator::Model;
+use skid_integrator::stepper::{IncrementReport, Observer};
+
+use crate::drum::{BACK_PLATE, DRUM};
+
+/// Column names of `history.csv`.
+pub const COLUMNS: [&str; 22] = [
+    "time",
+    "step",
+    "increment",
+    "load_factor",
+    "drum_angle",
+    "drum_omega",
+    "plate_displacement",
+    "normal_force",
+    "friction_force",
+    "friction_torque",
+    "active_contacts",
+    "sliding_contacts",
+    "newton_iterations",
+    "contact_solves",
+    "max_penetration",
+    "kinetic_energy",
+    "strain_energy",
+    "hourglass_energy",
+    "external_work",
+    "friction_dissipation",
+    "normal_work",
+    "dt",
+];
+
+/// What the summary needs of one converged increment.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Sample {
+    /// Time, s.
+    pub time: f64,
+    /// Whether it belongs to a dynamic step.
+    pub dynamic: bool,
+    /// Drum angle, rad.
+    pub angle: f64,
+    /// Drum angular velocity, rad/s.
+    pub omega: f64,
+    /// Total normal contact force, N.
+    pub normal_force: f64,
+    /// Kinetic + strain + hourglass energy, J.
+    pub mechanical_energy: f64,
+    /// Hourglass energy, J.
+    pub hourglass_energy: f64,
+    /// Strain energy, J.
+    pub strain_energy: f64,
+    /// Accumulated external work, J.
+    pub external_work: f64,
+    /// Accumulated frictional dissipation, J.
+    pub friction_dissipation: f64,
+    /// Accumulated normal contact work, J.
+    pub normal_work: f64,
+    /// Deepest penetration among the contacts, m (0 if none).
+    pub max_penetration: f64,
+    /// Largest gap at a contact that carries force while sliding, m.
+    pub sliding_separation: f64,
+}
+
+/// Observer writing `history.csv` and keeping the samples.
+pub struct DrumRecorder {
+    writer: BufWriter<File>,
+    partial: PathBuf,
+    final_path: PathBuf,
+    /// Samples of all converged increments (and the initial state).
+    pub samples: Vec<Sample>,
+}
+
+impl DrumRecorder {
+    /// Creates `dir/history.csv.partial` and writes the header.
+    ///
+    /// # Errors
+    /// I/O errors.
+    pub fn create(dir: &Path) -> std::io::Result<Self> {
+        let final_path = dir.join("history.csv");
+        let partial = dir.join("history.csv.partial");
+        let mut writer = BufWriter::new(File::create(&partial)?);
+        writeln!(writer, "{}", COLUMNS.join(","))?;
+        Ok(Self {
+            writer,
+            partial,
+            final_path,
+            samples: Vec::new(),
+        })
+    }
+
+    /// Flushes and renames the file to `history.csv`.
+    ///
+    /// # Errors
+    /// I/O errors.
+    pub fn finish(mut self) -> std::io::Result<Vec<Sample>> {
+        self.writer.flush()?;
+        self.writer.get_ref().sync_all()?;
+        std::fs::rename(&self.partial, &self.final_path)?;
+        Ok(self.samples)
+    }
+}
+
+impl<const D: usize> Observer<D> for DrumRecorder {
+    fn on_increment(
+        &mut self,
+        model: &Model<D>,
+        report: &IncrementReport<'_>,
+    ) -> std::io::Result<()> {
+        let s = report.state;
+        let dofs = model.dofs();
+        let drum_eq = dofs.body_rotation(DRUM);
+        let omega = drum_eq.map_or(0.0, |eq| s.v[eq]);
+        let angle = drum_eq.map_or(0.0, |eq| s.x[eq]);
+        let torque = drum_eq.map_or(0.0, |eq| s.contact_reaction[eq]);
+        let plate = dofs.body_displacement(&s.x, BACK_PLATE)[1];
+        let mut normal = 0.0;
+        let mut friction = 0.0;
+        let mut active = 0;
+        let mut sliding = 0;
+        let mut penetration = 0.0_f64;
+        let mut separation = 0.0_f64;
+        for c in &s.contacts {
+            penetration = penetration.max(-c.gap);
+            if !c.is_closed() {
+                continue;
+            }
+            active += 1;
+            normal += c.normal_force;
+            friction += c.tangential_force[0];
+            let mu = model.contacts()[c.pair].mu;
+            if c.tangential_force.norm() >= mu * c.normal_force * (1.0 - 1e-6) && mu > 0.0 {
+                sliding += 1;
+                separation = separation.max(c.gap);
+            }
+        }
+        let e = &s.energy;
+        writeln!(
+            self.writer,
+            "{:.9e},{},{},{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{},{},{},{},{:.3e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e}",
+            s.time,
+            report.step,
+            report.increment,
+            s.load_factor,
+            angle,
+            omega,
+            plate,
+            normal,
+            friction,
+            torque,
+            active,
+            sliding,
+            report.counters.newton_iterations,
+            report.counters.contact_solves,
+            penetration.max(0.0),
+            e.kinetic,
+            e.strain,
+            e.hourglass,
+            e.external_work,
+            e.friction_dissipation,
+            e.normal_work,
+            report.size,
+        )?;
+        self.samples.push(Sample {
+            time: s.time,
+            dynamic: report.dynamic,
+            angle,
+            omega,
+            normal_force: normal,
+            mechanical_energy: e.kinetic + e.strain + e.hourglass,
+            hourglass_energy: e.hourglass,
+            strain_energy: e.strain,
+            external_work: e.external_work,
+            friction_dissipation: e.friction_dissipation,
+            normal_work: e.normal_work,
+            max_penetration: penetration.max(0.0),
+            sliding_separation: separation,
+        });
+        Ok(())
+    }
+}

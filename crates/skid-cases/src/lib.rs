@@ -1,0 +1,20 @@
+//! Case files and the braking-drum benchmark.
+//!
+//! - [`schema`]: the JSON case-file format;
+//! - [`validate`]: reading a case with field-level error messages and overrides;
+//! - [`drum`]: building the drum scene (any idealization, 2D or 3D) as a model;
+//! - [`history`]: the per-increment history of the drum (`history.csv`);
+//! - [`summary`]: stop time, spin-down straightness, post-stop motion, energy balance;
+//! - [`runner`]: running one case into an output directory.
+
+pub mod drum;
+pub mod history;
+pub mod runner;
+pub mod schema;
+pub mod summary;
+pub mod validate;
+
+pub use runner::{default_output_dir, run_case, run_case_file};
+pub use schema::Case;
+pub use summary::Summary;
+pub use validate::{CaseError, load_case, parse_case};

@@ -1,0 +1,86 @@
+//! Runs one case: builds the scene, integrates it, writes `history.csv` and `summary.json`.
+
+use std::path::{Path, PathBuf};
+
+use skid_integrator::stepper::run;
+
+use crate::drum::build;
+use crate::history::DrumRecorder;
+use crate::schema::Case;
+use crate::summary::{Summary, summarize};
+use crate::validate::{CaseError, load_case};
+
+/// Default output directory of a case: `out/<case name>`.
+pub fn default_output_dir(case: &Case) -> PathBuf {
+    Path::new("out").join(&case.name)
+}
+
+/// Loads `path` (with `overrides`) and runs it into `out_dir` (default `out/<name>`).
+///
+/// # Errors
+/// [`CaseError`] for a bad case file, an inconsistent model or unwritable outputs. A run that
+/// stops early (cutbacks exhausted) is not an error here: its summary says `"failed"` and why.
+pub fn run_case_file(
+    path: &Path,
+    overrides: &[String],
+    out_dir: Option<&Path>,
+) -> Result<Summary, CaseError> {
+    let case = load_case(path, overrides)?;
+    let dir = out_dir.map_or_else(|| default_output_dir(&case), Path::to_path_buf);
+    run_case(&case, path, &dir)
+}
+
+/// Runs a validated case into `dir`.
+///
+/// # Errors
+/// See [`run_case_file`].
+pub fn run_case(case: &Case, source: &Path, dir: &Path) -> Result<Summary, CaseError> {
+    match case.dimension {
+        2 => run_in::<2>(case, source, dir),
+        3 => run_in::<3>(case, source, dir),
+        d => Err(CaseError::Invalid {
+            path: source.to_path_buf(),
+            field: "dimension".into(),
+            message: format!("expected 2 or 3, got {d}"),
+        }),
+    }
+}
+
+fn run_in<const D: usize>(case: &Case, source: &Path, dir: &Path) -> Result<Summary, CaseError> {
+    let scene = build::<D>(case).map_err(|message| CaseError::Model {
+        path: source.to_path_buf(),
+        message,
+    })?;
+    let output = |path: PathBuf| move |source| CaseError::Output { path, source };
+    std::fs::create_dir_all(dir).map_err(output(dir.to_path_buf()))?;
+    // Stale results of an earlier run must not survive next to a new, possibly interrupted one.
+    for stale in ["history.csv", "summary.json"] {
+        let p = dir.join(stale);
+        if p.exists() {
+            std::fs::remove_file(&p).map_err(output(p.clone()))?;
+        }
+    }
+    let mut recorder = DrumRecorder::create(dir).map_err(output(dir.join("history.csv")))?;
+    let (stats, result) = run(&scene.model, &scene.steps, &scene.settings, &mut recorder);
+    let samples = recorder.finish().map_err(output(dir.join("history.csv")))?;
+    let error = result.err().map(|e| e.to_string());
+    let summary = summarize(case, &samples, &stats, error);
+    write_atomic(
+        &dir.join("summary.json"),
+        &serde_json::to_string_pretty(&summary).unwrap_or_default(),
+    )
+    .map_err(output(dir.join("summary.json")))?;
+    Ok(summary)
+}
+
+/// Writes `path` through a temporary sibling and a rename, so readers never see half a file.
+///
+/// # Errors
+/// I/O errors.
+pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".partial");
+    let tmp = PathBuf::from(tmp);
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, path)
+}

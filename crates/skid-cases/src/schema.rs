@@ -1,0 +1,222 @@
+//! The case-file schema (JSON).
+//!
+//! A case describes the braking-drum scene by its physical parameters; the builder
+//! ([`crate::drum`]) turns it into a finite-element model. Every object rejects unknown fields,
+//! and every value is checked by [`crate::validate`] before anything is built. Units are SI.
+//!
+//! Geometry convention: the drum axis is z through the origin, the pad sits on top with its
+//! front face in the plane `y = R + standoff` and its back face `thickness` above, spanning
+//! `x in [-length/2, length/2]` (and `z in [-width/2, width/2]` in 3D). The drum spins about +z.
+
+use serde::{Deserialize, Serialize};
+
+/// A complete case.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// Case name (output directory and report label).
+    pub name: String,
+    /// Free text.
+    #[serde(default)]
+    pub description: String,
+    /// Spatial dimension: 2 (plane strain) or 3.
+    pub dimension: usize,
+    /// The rigid drum.
+    pub drum: DrumSpec,
+    /// The deformable pad.
+    pub pad: PadSpec,
+    /// The rigid back plate and its load.
+    pub back_plate: BackPlateSpec,
+    /// Friction between the pad's front face and the drum.
+    pub contact: ContactSpec,
+    /// Analysis steps, in order.
+    pub steps: Vec<StepSpec>,
+    /// Solver settings (all optional).
+    #[serde(default)]
+    pub solver: SolverSpec,
+}
+
+/// The rigid drum: its inertia sits at the reference node on the axis.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DrumSpec {
+    /// Radius, m.
+    pub radius: f64,
+    /// Axial width, m (3D surface extent; informative in 2D).
+    pub width: f64,
+    /// Mass, kg (its reference node cannot translate).
+    pub mass: f64,
+    /// Rotary inertia about the axis, kg m^2.
+    pub rotary_inertia: f64,
+    /// Initial angular velocity about +z, rad/s.
+    pub omega0: f64,
+    /// How the drum surface is represented.
+    pub surface: DrumSurfaceSpec,
+}
+
+/// Drum surface idealization.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum DrumSurfaceSpec {
+    /// Analytical circle (2D) or cylinder (3D).
+    Analytic,
+}
+
+/// The pad block and its mesh.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PadSpec {
+    /// Circumferential length (along x), m.
+    pub length: f64,
+    /// Axial width (along z), m; the plane-strain thickness in 2D.
+    pub width: f64,
+    /// Radial thickness (along y), m.
+    pub thickness: f64,
+    /// Elements along x, y (radial) and z (ignored in 2D).
+    pub elements: ElementCounts,
+    /// Initial distance of the front face above the drum's top, m.
+    #[serde(default)]
+    pub standoff: f64,
+    /// Mass density, kg/m^3.
+    pub density: f64,
+    /// Hyperelastic material.
+    pub material: MaterialSpec,
+    /// Factor on the hourglass stabilisation stiffness.
+    #[serde(default = "one")]
+    pub hourglass_scale: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// Element counts of the structured pad mesh.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ElementCounts {
+    /// Along the circumference (x).
+    pub circumferential: usize,
+    /// Through the thickness (y).
+    pub radial: usize,
+    /// Across the width (z, 3D only).
+    #[serde(default = "one_usize")]
+    pub axial: usize,
+}
+
+fn one_usize() -> usize {
+    1
+}
+
+/// Material laws.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum MaterialSpec {
+    /// Polynomial hyperelasticity of order 1:
+    /// `U = C10 (I1bar - 3) + C01 (I2bar - 3) + (J - 1)^2 / D1`.
+    PolynomialN1 {
+        /// C10, Pa.
+        c10: f64,
+        /// C01, Pa.
+        c01: f64,
+        /// D1, 1/Pa.
+        d1: f64,
+    },
+}
+
+/// The rigid plate tied to the pad's back face; it may only translate radially (along y).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BackPlateSpec {
+    /// Pressure on the back face, Pa (pushes the pad onto the drum).
+    pub pressure: f64,
+    /// Mass of the plate itself, kg (the tied pad nodes add theirs).
+    #[serde(default)]
+    pub mass: f64,
+}
+
+/// Coulomb friction between the pad's front face and the drum.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Friction coefficient.
+    pub mu: f64,
+}
+
+/// One analysis step.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum StepSpec {
+    /// Static equilibrium with loads ramped to full value.
+    Static {
+        /// Step name.
+        name: String,
+        /// Number of increments.
+        increments: usize,
+        /// Rigid bodies held fixed ("drum", "back_plate").
+        #[serde(default)]
+        hold: Vec<String>,
+        /// Time scale of the Newton regularisation `M/h_s^2`, s.
+        #[serde(default = "default_regularization_time")]
+        regularization_time: f64,
+    },
+    /// HHT-alpha dynamics.
+    Dynamic {
+        /// Step name.
+        name: String,
+        /// Duration, s.
+        duration: f64,
+        /// Time increment, s.
+        dt: f64,
+        /// HHT alpha in [-1/3, 0].
+        #[serde(default = "default_alpha")]
+        alpha: f64,
+        /// Rigid bodies held fixed.
+        #[serde(default)]
+        hold: Vec<String>,
+    },
+}
+
+fn default_regularization_time() -> f64 {
+    1e-2
+}
+
+fn default_alpha() -> f64 {
+    -0.3
+}
+
+/// Solver settings; every field is optional.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct SolverSpec {
+    /// Newton iteration limit per increment.
+    pub max_newton_iterations: usize,
+    /// Relative force residual tolerance.
+    pub force_tolerance: f64,
+    /// Contact kinematic tolerance relative to the model size.
+    pub contact_tolerance: f64,
+    /// Natural-map tolerance of the Coulomb solve.
+    pub coulomb_tolerance: f64,
+    /// Fixed-point iteration limit of the Coulomb solve.
+    pub max_fixed_point_iterations: usize,
+    /// Increment size factor after a failure.
+    pub cutback_factor: f64,
+    /// Consecutive cutbacks before the run stops.
+    pub max_cutbacks: usize,
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        let newton = skid_integrator::increment::NewtonSettings::default();
+        let coulomb = skid_contact::coulomb::CoulombSettings::default();
+        let cutback = skid_integrator::stepper::CutbackSettings::default();
+        Self {
+            max_newton_iterations: newton.max_iterations,
+            force_tolerance: newton.force_tolerance,
+            contact_tolerance: newton.contact_tolerance,
+            coulomb_tolerance: coulomb.tolerance,
+            max_fixed_point_iterations: coulomb.max_fixed_point_iterations,
+            cutback_factor: cutback.factor,
+            max_cutbacks: cutback.max_cutbacks,
+        }
+    }
+}

@@ -1,0 +1,291 @@
+//! The run summary: the drum's stop time, the straightness of its spin-down, what happens after
+//! the stop, the energy balance and the contact accuracy, with the cost of the run.
+
+use serde::Serialize;
+use skid_integrator::RunStatistics;
+
+use crate::history::Sample;
+use crate::schema::Case;
+
+/// `summary.json`.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct Summary {
+    /// Case name.
+    pub case: String,
+    /// Spatial dimension.
+    pub dimension: usize,
+    /// `"completed"` or `"failed"`.
+    pub status: String,
+    /// Why the run stopped early, if it did.
+    pub error: Option<String>,
+    /// First time the drum's angular velocity reaches zero (interpolated), s.
+    pub t_stop: Option<f64>,
+    /// Initial angular velocity, rad/s.
+    pub omega0: f64,
+    /// Least-squares deceleration over `[0.1, 0.9] t_stop` (over the run if no stop), rad/s^2.
+    pub deceleration: Option<f64>,
+    /// Deceleration of the analytic estimate `mu p A R / I`, rad/s^2.
+    pub deceleration_analytic: f64,
+    /// `max |omega - (omega0 - decel_analytic t)| / omega0` over `t <= 0.9 t_stop`.
+    pub e_slide_analytic: Option<f64>,
+    /// Largest `|omega|` after the stop, rad/s.
+    pub post_stop_max_abs_omega: Option<f64>,
+    /// Largest `|angle - angle(t_stop)|` after the stop, rad.
+    pub post_stop_max_angle_change: Option<f64>,
+    /// Mean total normal force over `[0.1, 0.9] t_stop`, N.
+    pub mean_normal_force_sliding: Option<f64>,
+    /// Time reached, s.
+    pub final_time: f64,
+    /// Converged increments.
+    pub increments: usize,
+    /// Newton iterations.
+    pub newton_iterations: usize,
+    /// Conic (clarabel) solves.
+    pub contact_solves: usize,
+    /// De Saxce fixed-point iterations.
+    pub fixed_point_iterations: usize,
+    /// Failed attempts answered by a cutback.
+    pub cutbacks: usize,
+    /// Wall time of the run, s.
+    pub wall_time_s: f64,
+    /// Of which: element loop, loads and contact kinematics, s.
+    pub assembly_s: f64,
+    /// Of which: factorizations and solves, s.
+    pub linear_solve_s: f64,
+    /// Of which: conic solves, s.
+    pub contact_solve_s: f64,
+    /// Drum kinetic energy lost over the dynamic steps, J.
+    pub drum_energy_lost_j: Option<f64>,
+    /// Frictional dissipation over the dynamic steps, J.
+    pub friction_work_j: Option<f64>,
+    /// `|drum energy lost - friction work - other work| / drum energy lost`, where the other
+    /// work is the change of the pad's kinetic, strain and hourglass energy minus the work of
+    /// the pressure and of the normal contact forces.
+    pub energy_balance_error: Option<f64>,
+    /// Largest hourglass energy / strain energy over the dynamic steps.
+    pub max_hourglass_ratio: Option<f64>,
+    /// Deepest penetration over the run, m.
+    pub max_gap_violation_m: f64,
+    /// Largest gap at a contact carrying force while sliding, m.
+    pub max_sliding_separation_m: f64,
+}
+
+/// Linear interpolation of `f` at the first time `omega` crosses zero (from the sign of omega0).
+fn first_stop(samples: &[&Sample], omega0: f64) -> Option<(f64, f64)> {
+    let sign = omega0.signum();
+    samples.windows(2).find_map(|w| {
+        let (a, b) = (w[0], w[1]);
+        (a.omega * sign > 0.0 && b.omega * sign <= 0.0).then(|| {
+            let s = a.omega / (a.omega - b.omega);
+            (
+                a.time + s * (b.time - a.time),
+                a.angle + s * (b.angle - a.angle),
+            )
+        })
+    })
+}
+
+/// Least-squares slope of omega(t).
+fn slope(samples: &[&Sample]) -> Option<f64> {
+    let n = samples.len() as f64;
+    if samples.len() < 2 {
+        return None;
+    }
+    let mt = samples.iter().map(|s| s.time).sum::<f64>() / n;
+    let mw = samples.iter().map(|s| s.omega).sum::<f64>() / n;
+    let sxy: f64 = samples.iter().map(|s| (s.time - mt) * (s.omega - mw)).sum();
+    let sxx: f64 = samples.iter().map(|s| (s.time - mt).powi(2)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// Computes the summary from the recorded samples and run statistics.
+pub fn summarize(
+    case: &Case,
+    samples: &[Sample],
+    stats: &RunStatistics,
+    error: Option<String>,
+) -> Summary {
+    let omega0 = case.drum.omega0;
+    let area = case.pad.length * case.pad.width;
+    let decel_analytic = case.contact.mu * case.back_plate.pressure * area * case.drum.radius
+        / case.drum.rotary_inertia;
+    // The dynamic history, starting from the state the first dynamic step started from.
+    let first_dynamic = samples.iter().position(|s| s.dynamic);
+    let dynamic: Vec<&Sample> = match first_dynamic {
+        Some(i) => samples[i.saturating_sub(1)..]
+            .iter()
+            .enumerate()
+            .filter(|(k, s)| *k == 0 || s.dynamic)
+            .map(|(_, s)| s)
+            .collect(),
+        None => Vec::new(),
+    };
+    let t0 = dynamic.first().map_or(0.0, |s| s.time);
+    let stop = first_stop(&dynamic, omega0);
+    let t_stop = stop.map(|(t, _)| t - t0);
+    let window = |lo: f64, hi: f64| -> Vec<&Sample> {
+        dynamic
+            .iter()
+            .copied()
+            .filter(|s| s.time - t0 >= lo && s.time - t0 <= hi)
+            .collect()
+    };
+    let sliding = match t_stop {
+        Some(ts) => window(0.1 * ts, 0.9 * ts),
+        None => dynamic.clone(),
+    };
+    let deceleration = slope(&sliding).map(|s| -s * omega0.signum());
+    let e_slide_analytic = t_stop.map(|ts| {
+        window(0.0, 0.9 * ts)
+            .iter()
+            .map(|s| {
+                let reference = omega0 - omega0.signum() * decel_analytic * (s.time - t0);
+                (s.omega - reference).abs() / omega0.abs()
+            })
+            .fold(0.0, f64::max)
+    });
+    let after: Vec<&Sample> = match stop {
+        Some((ts, _)) => dynamic.iter().copied().filter(|s| s.time > ts).collect(),
+        None => Vec::new(),
+    };
+    let post_omega = stop.map(|_| after.iter().map(|s| s.omega.abs()).fold(0.0, f64::max));
+    let post_angle = stop.map(|(_, angle)| {
+        after
+            .iter()
+            .map(|s| (s.angle - angle).abs())
+            .fold(0.0, f64::max)
+    });
+    let mean_normal = (!sliding.is_empty() && t_stop.is_some())
+        .then(|| sliding.iter().map(|s| s.normal_force).sum::<f64>() / sliding.len() as f64);
+
+    let (mut lost, mut friction, mut balance) = (None, None, None);
+    if let (Some(b), Some(e)) = (dynamic.first(), dynamic.last()) {
+        let inertia = case.drum.rotary_inertia;
+        let drum_lost = 0.5 * inertia * (b.omega * b.omega - e.omega * e.omega);
+        let d_friction = e.friction_dissipation - b.friction_dissipation;
+        let residual = (e.mechanical_energy - b.mechanical_energy)
+            - (e.external_work - b.external_work)
+            - (e.normal_work - b.normal_work)
+            + d_friction;
+        lost = Some(drum_lost);
+        friction = Some(d_friction);
+        balance = (drum_lost.abs() > 0.0).then(|| residual.abs() / drum_lost.abs());
+    }
+    let max_hourglass_ratio = (!dynamic.is_empty()).then(|| {
+        dynamic
+            .iter()
+            .filter(|s| s.strain_energy > 0.0)
+            .map(|s| s.hourglass_energy / s.strain_energy)
+            .fold(0.0, f64::max)
+    });
+
+    Summary {
+        case: case.name.clone(),
+        dimension: case.dimension,
+        status: if error.is_none() {
+            "completed"
+        } else {
+            "failed"
+        }
+        .into(),
+        error,
+        t_stop,
+        omega0,
+        deceleration,
+        deceleration_analytic: decel_analytic,
+        e_slide_analytic,
+        post_stop_max_abs_omega: post_omega,
+        post_stop_max_angle_change: post_angle,
+        mean_normal_force_sliding: mean_normal,
+        final_time: samples.last().map_or(0.0, |s| s.time),
+        increments: stats.increments,
+        newton_iterations: stats.newton_iterations,
+        contact_solves: stats.contact_solves,
+        fixed_point_iterations: stats.fixed_point_iterations,
+        cutbacks: stats.cutbacks,
+        wall_time_s: stats.wall_time.as_secs_f64(),
+        assembly_s: stats.timings.assembly.as_secs_f64(),
+        linear_solve_s: stats.timings.linear_solve.as_secs_f64(),
+        contact_solve_s: stats.timings.contact_solve.as_secs_f64(),
+        drum_energy_lost_j: lost,
+        friction_work_j: friction,
+        energy_balance_error: balance,
+        max_hourglass_ratio,
+        max_gap_violation_m: samples
+            .iter()
+            .map(|s| s.max_penetration)
+            .fold(0.0, f64::max),
+        max_sliding_separation_m: samples
+            .iter()
+            .map(|s| s.sliding_separation)
+            .fold(0.0, f64::max),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::validate::parse_case;
+    use std::path::Path;
+
+    fn case() -> Case {
+        let text = include_str!("../../../cases/drum/2d-analytic.json");
+        parse_case(text, Path::new("2d-analytic.json"), &[]).expect("shipped case parses")
+    }
+
+    /// A synthetic spin-down: omega = 60 - 600 t, then a small oscillation after the stop.
+    fn samples() -> Vec<Sample> {
+        let mut out = vec![Sample::default()];
+        out[0].omega = 60.0;
+        for k in 1..=150 {
+            let t = k as f64 * 1e-3;
+            let (omega, angle) = if t <= 0.1 {
+                (60.0 - 600.0 * t, 60.0 * t - 300.0 * t * t)
+            } else {
+                let s = t - 0.1;
+                (
+                    -2.0 * (s * 200.0).sin(),
+                    3.0 - 0.01 * (1.0 - (s * 200.0).cos()),
+                )
+            };
+            out.push(Sample {
+                time: t,
+                dynamic: true,
+                omega,
+                angle,
+                ..Sample::default()
+            });
+        }
+        out
+    }
+
+    #[test]
+    fn stop_time_deceleration_and_post_stop_motion_are_measured() {
+        let s = summarize(&case(), &samples(), &RunStatistics::default(), None);
+        let t_stop = s.t_stop.expect("stops");
+        assert!((t_stop - 0.1).abs() < 1e-9, "{t_stop}");
+        assert!((s.deceleration.expect("fit") - 600.0).abs() < 1e-6);
+        assert!((s.deceleration_analytic - 600.0).abs() < 1e-9);
+        assert!(s.e_slide_analytic.expect("e_slide") < 1e-12);
+        let post = s.post_stop_max_abs_omega.expect("post");
+        assert!((post - 2.0).abs() < 0.01, "{post}");
+        let excursion = s.post_stop_max_angle_change.expect("angle");
+        assert!((excursion - 0.02).abs() < 1e-3, "{excursion}");
+        assert_eq!(s.status, "completed");
+    }
+
+    #[test]
+    fn a_drum_that_never_stops_has_no_stop_time_and_a_failure_is_reported() {
+        let mut samples = samples();
+        samples.truncate(50);
+        let s = summarize(
+            &case(),
+            &samples,
+            &RunStatistics::default(),
+            Some("boom".into()),
+        );
+        assert_eq!(s.t_stop, None);
+        assert_eq!(s.status, "failed");
+        assert!((s.deceleration.expect("fit over the run") - 600.0).abs() < 1e-6);
+    }
+}
