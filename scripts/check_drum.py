@@ -24,8 +24,9 @@ def main(out):
     def check(label, value, ok, fmt="{:.6g}"):
         checks.append((label, fmt.format(value) if value is not None else "none", bool(ok)))
 
-    for run in (base, half, heavy):
-        checks.append((f"-- {run['case']} ({run['increments']} increments, {run['wall_time_s']:.2f} s)", "", run["status"] == "completed"))
+
+    for label, run in (("benchmark", base), ("dt / 2", half), ("density x 2", heavy)):
+        checks.append((f"{label}: {run['case']} completed ({run['increments']} increments, {run['wall_time_s']:.2f} s)", run["status"], run["status"] == "completed"))
     ts = base["t_stop"]
     check("t_stop [s] in [0.0990, 0.1015]", ts, ts is not None and 0.0990 <= ts <= 0.1015)
     dec = base["deceleration"]

@@ -278,7 +278,7 @@ pub fn validate(case: &Case) -> Result<(), Problem> {
         if let Some(h) = hold.iter().find(|h| *h != "drum" && *h != "back_plate") {
             return Err((
                 f("hold"),
-                format!("unknown body '{h}': expected \"drum\" or \"back_plate\""),
+                format!("expected \"drum\" or \"back_plate\", got \"{h}\""),
             ));
         }
     }

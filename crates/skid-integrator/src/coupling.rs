@@ -153,3 +153,103 @@ pub fn contact_rows<const D: usize>(
     out.u = DVector::from_vec(u);
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{ContactPair, SolidPart};
+    use nalgebra::SVector;
+    use skid_contact::surface::AnalyticCylinder;
+    use skid_fem::material::PolynomialN1;
+    use skid_fem::mesh::SolidMesh;
+    use skid_fem::rigid::RigidBody;
+
+    /// A block above a drum of radius 0.2 that spins about z and may also translate in x.
+    fn block_on_drum<const D: usize>() -> Model<D> {
+        let mut corner = SVector::<f64, D>::zeros();
+        corner[0] = -0.05;
+        corner[1] = 0.2;
+        let mesh = SolidMesh::<D>::structured_block(
+            corner,
+            SVector::from_fn(|i, _| [0.1, 0.05, 0.1][i]),
+            std::array::from_fn(|i| [4, 1, 2][i]),
+        )
+        .expect("mesh");
+        let front = mesh.node_sets["ymin"].clone();
+        let mut free = [false; D];
+        free[0] = true;
+        let drum = RigidBody::<D> {
+            name: "drum".into(),
+            reference_point: SVector::zeros(),
+            mass: 5.0,
+            rotary_inertia: 0.175,
+            free_translations: free,
+            rotation_axis: Some(Vector3::z()),
+            initial_velocity: SVector::zeros(),
+            initial_angular_velocity: 0.0,
+        };
+        let part = SolidPart {
+            mesh,
+            material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6).expect("material")),
+            density: 1000.0,
+            thickness: 0.1,
+            hourglass_scale: 1.0,
+        };
+        let pair = ContactPair {
+            name: "pad-drum".into(),
+            nodes: front,
+            body: 0,
+            surface: Box::new(AnalyticCylinder::new(0.2, Vector3::z()).expect("surface")),
+            mu: 0.15,
+        };
+        Model::new(part, vec![drum], vec![], vec![], vec![pair]).expect("model")
+    }
+
+    /// `H dx` predicts the change of gaps and slips for a small motion of nodes and drum.
+    fn rows_are_the_derivative_of_the_kinematics<const D: usize>() {
+        let model = block_on_drum::<D>();
+        let n = model.dofs().len();
+        let held = vec![false; n];
+        let x = DVector::from_fn(n, |i, _| 1e-3 * (i as f64 * 0.9).sin());
+        let start: Vec<Vector2<f64>> = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
+        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let previous = rows.coords.clone();
+        let dx = DVector::from_fn(n, |i, _| 1e-7 * (i as f64 * 2.3).cos());
+        let plus = contact_rows(&model, &(&x + &dx), &previous, &held).expect("rows");
+        let minus = contact_rows(&model, &(&x - &dx), &previous, &held).expect("rows");
+        let predicted = rows.times(&dx);
+        let measured = (&plus.u - &minus.u) / 2.0;
+        assert!(
+            (&predicted - &measured).amax() < 1e-6 * predicted.amax(),
+            "{D}D: {predicted} vs {measured}"
+        );
+        // The drum's rotation and translation both enter the rows.
+        let drum_eqs = model.dofs().body_equations(0);
+        assert!(
+            rows.rows
+                .iter()
+                .any(|r| r.iter().any(|(eq, _)| drum_eqs.contains(eq)))
+        );
+        // Held equations are dropped.
+        let mut held = held;
+        for &eq in &drum_eqs {
+            held[eq] = true;
+        }
+        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        assert!(
+            rows.rows
+                .iter()
+                .all(|r| r.iter().all(|(eq, _)| !drum_eqs.contains(eq)))
+        );
+    }
+
+    #[test]
+    fn rows_are_the_derivative_of_the_kinematics_2d() {
+        rows_are_the_derivative_of_the_kinematics::<2>();
+    }
+
+    #[test]
+    fn rows_are_the_derivative_of_the_kinematics_3d() {
+        rows_are_the_derivative_of_the_kinematics::<3>();
+    }
+}

@@ -1,0 +1,72 @@
+//! End to end: the 2D drum against the analytical circle spins down as the benchmark says
+//! (../shared/DRUM.md sections 2.2 and 3), and without friction it keeps spinning.
+
+use std::path::Path;
+
+use skid_cases::{Summary, parse_case, run_case};
+
+const SHIPPED: &str = include_str!("../../../cases/drum/2d-analytic.json");
+
+fn run(overrides: &[&str]) -> (Summary, tempfile::TempDir) {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let case = parse_case(SHIPPED, Path::new("2d-analytic.json"), &overrides).expect("case");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let summary = run_case(&case, Path::new("2d-analytic.json"), dir.path()).expect("run");
+    (summary, dir)
+}
+
+#[test]
+fn drum_spins_down_in_a_straight_line_and_rocks_in_stick_after_the_stop() {
+    let (s, dir) = run(&[]);
+    assert_eq!(s.status, "completed", "{:?}", s.error);
+    let t_stop = s.t_stop.expect("the drum stops");
+    assert!((0.0990..=0.1015).contains(&t_stop), "t_stop {t_stop}");
+    let decel = s.deceleration.expect("fit");
+    assert!(
+        (decel - 600.0).abs() < 0.015 * 600.0,
+        "deceleration {decel}"
+    );
+    // While sliding the normal force is the plate force plus the tilt of the side contacts
+    // (3510.6 N in the independent model).
+    let n = s.mean_normal_force_sliding.expect("normal force");
+    assert!((n - 3510.6).abs() < 10.0, "normal force {n}");
+    assert!(s.post_stop_max_abs_omega.expect("post") < 5.0);
+    assert!(s.post_stop_max_angle_change.expect("post") < 0.03);
+    assert!(s.energy_balance_error.expect("balance") < 0.005);
+    assert!(s.max_gap_violation_m < 1e-6 && s.max_sliding_separation_m < 1e-6);
+    // 315 J of kinetic energy go into friction.
+    let friction = s.friction_work_j.expect("friction");
+    assert!((friction - 315.0).abs() < 2.0, "friction work {friction}");
+    // Outputs are complete: renamed from .partial, one history row per increment plus the
+    // initial state.
+    let history = std::fs::read_to_string(dir.path().join("history.csv")).expect("history");
+    assert_eq!(history.lines().count(), s.increments + 2);
+    assert!(!dir.path().join("history.csv.partial").exists());
+    let written: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("summary.json")).expect("summary"),
+    )
+    .expect("json");
+    assert_eq!(written["t_stop"].as_f64(), Some(t_stop));
+}
+
+#[test]
+fn without_friction_the_drum_keeps_its_speed() {
+    let (s, dir) = run(&["contact.mu=0", "steps[1].duration=0.01"]);
+    assert_eq!(s.status, "completed", "{:?}", s.error);
+    assert_eq!(s.t_stop, None);
+    let history = std::fs::read_to_string(dir.path().join("history.csv")).expect("history");
+    let header: Vec<&str> = history.lines().next().expect("header").split(',').collect();
+    let col = header
+        .iter()
+        .position(|c| *c == "drum_omega")
+        .expect("column");
+    for line in history.lines().skip(1) {
+        let omega: f64 = line
+            .split(',')
+            .nth(col)
+            .expect("cell")
+            .parse()
+            .expect("number");
+        assert!((omega - 60.0).abs() < 1e-9 * 60.0, "omega {omega}");
+    }
+}

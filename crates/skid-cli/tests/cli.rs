@@ -1,0 +1,121 @@
+//! The `skid` binary: exit codes, messages and output files.
+
+use std::process::Command;
+
+fn skid() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_skid"))
+}
+
+const CASE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../cases/drum/2d-analytic.json"
+);
+
+#[test]
+fn run_writes_history_and_summary_and_prints_one_json_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = skid()
+        .args(["run", CASE, "--out"])
+        .arg(dir.path())
+        .args(["--set", "steps[1].duration=0.005"])
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).expect("utf8");
+    assert_eq!(stdout.lines().count(), 1);
+    let summary: serde_json::Value = serde_json::from_str(&stdout).expect("json line");
+    assert_eq!(summary["case"], "2d-analytic");
+    assert_eq!(summary["status"], "completed");
+    for key in [
+        "t_stop",
+        "omega0",
+        "increments",
+        "newton_iterations",
+        "contact_solves",
+        "wall_time_s",
+        "energy_balance_error",
+        "max_gap_violation_m",
+        "max_sliding_separation_m",
+    ] {
+        assert!(summary.get(key).is_some(), "summary lacks {key}");
+    }
+    let history = std::fs::read_to_string(dir.path().join("history.csv")).expect("history");
+    let header = history.lines().next().expect("header");
+    for column in [
+        "time",
+        "drum_angle",
+        "drum_omega",
+        "normal_force",
+        "friction_force",
+        "friction_torque",
+        "active_contacts",
+        "newton_iterations",
+        "contact_solves",
+    ] {
+        assert!(
+            header.split(',').any(|c| c == column),
+            "history lacks {column}"
+        );
+    }
+    assert!(dir.path().join("summary.json").exists());
+}
+
+#[test]
+fn bad_case_file_exits_2_naming_file_and_field() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let bad = dir.path().join("bad.json");
+    let text = std::fs::read_to_string(CASE)
+        .expect("case")
+        .replace("\"density\": 1000.0", "\"density\": -1000.0");
+    std::fs::write(&bad, text).expect("write");
+    let out = skid().arg("run").arg(&bad).output().expect("runs");
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("bad.json"), "{stderr}");
+    assert!(stderr.contains("pad.density"), "{stderr}");
+    assert!(stderr.contains("expected a finite value > 0"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+
+    let missing = skid()
+        .args(["run", "/nonexistent.json"])
+        .output()
+        .expect("runs");
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("cannot read"));
+}
+
+#[test]
+fn a_run_that_cannot_converge_exits_1_and_says_where() {
+    // One Newton iteration with no cutback cannot converge the preload.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = skid()
+        .args(["run", CASE, "--out"])
+        .arg(dir.path())
+        .args([
+            "--set",
+            "solver.max_newton_iterations=1",
+            "--set",
+            "solver.max_cutbacks=0",
+        ])
+        .output()
+        .expect("runs");
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("step 'preload' failed at increment 1"),
+        "{stderr}"
+    );
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("summary.json")).expect("summary kept"),
+    )
+    .expect("json");
+    assert_eq!(summary["status"], "failed");
+    assert!(
+        dir.path().join("history.csv").exists(),
+        "results so far are kept"
+    );
+}
