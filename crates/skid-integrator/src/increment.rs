@@ -18,10 +18,9 @@
 use std::time::{Duration, Instant};
 
 use nalgebra::{DVector, Vector2};
-use skid_contact::coulomb::{FrictionProblem, solve_coulomb};
 
 use crate::assembly::{Assembler, external_forces};
-use crate::coupling::{ContactRows, contact_rows};
+use crate::coupling::{ContactRows, contact_rows, solve_contact_forces};
 use crate::dof::EquationKind;
 use crate::error::IncrementFailure;
 use crate::hht::Hht;
@@ -216,16 +215,10 @@ pub fn solve_increment<const D: usize>(
             let q = &rows.u + rows.times(&dx0);
             timings.linear_solve += clock.elapsed();
             let clock = Instant::now();
-            let problem = FrictionProblem {
-                dim: rows.components,
-                w: &w,
-                q: &q,
-                mu: &rows.mu,
-            };
-            let warm = (shift.len() == rows.len()).then_some(shift.as_slice());
-            let solution = solve_coulomb(&problem, &settings.coulomb, warm)
-                .map_err(|e| IncrementFailure::Contact(e.to_string()))?;
+            let solution = solve_contact_forces(&rows, &w, &q, &shift, &settings.coulomb);
+            // Failed solves cost time too: count it before reporting the failure.
             timings.contact_solve += clock.elapsed();
+            let solution = solution.map_err(|e| IncrementFailure::Contact(e.to_string()))?;
             counters.contact_solves += solution.conic_solves;
             counters.fixed_point_iterations += solution.fixed_point_iterations;
             let dx = dx0 + &z * &solution.r;

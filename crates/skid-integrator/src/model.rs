@@ -4,6 +4,7 @@
 
 use nalgebra::{DVector, SVector, Vector3};
 use skid_contact::surface::RigidSurface;
+use skid_fem::cell::embed;
 use skid_fem::material::Hyperelastic;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
@@ -306,9 +307,4 @@ impl<const D: usize> Model<D> {
         }
         v
     }
-}
-
-/// Embeds a point of the D-dimensional model in 3D (z = 0 in 2D).
-pub fn embed<const D: usize>(p: &SVector<f64, D>) -> Vector3<f64> {
-    Vector3::from_fn(|i, _| if i < D { p[i] } else { 0.0 })
 }
