@@ -219,11 +219,9 @@ pub fn external_forces<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{SolidPart, Tie};
+    use crate::model::Tie;
+    use crate::test_support::{body, pad_block};
     use nalgebra::DMatrix;
-    use skid_fem::material::PolynomialN1;
-    use skid_fem::mesh::SolidMesh;
-    use skid_fem::rigid::RigidBody;
 
     impl Assembler {
         /// The stored lower triangle expanded to a dense symmetric matrix.
@@ -241,43 +239,16 @@ mod tests {
 
     /// A 3 x 2 block whose top nodes are tied to a plate translating in y, in 2D or 3D.
     fn tied_block<const D: usize>() -> Model<D> {
-        let mesh = SolidMesh::<D>::structured_block(
-            SVector::zeros(),
-            SVector::from_fn(|i, _| [0.03, 0.02, 0.01][i]),
-            std::array::from_fn(|i| [3, 2, 1][i]),
-        )
-        .expect("mesh");
-        let top = mesh.node_sets["ymax"].clone();
+        let part = pad_block::<D>([0.0; 3], [0.03, 0.02, 0.01], [3, 2, 1]);
+        let top = part.mesh.node_sets["ymax"].clone();
         let mut free = [false; D];
         free[1] = true;
-        let plate = RigidBody::<D> {
-            name: "plate".into(),
-            reference_point: SVector::zeros(),
-            mass: 0.0,
-            rotary_inertia: 0.0,
-            free_translations: free,
-            rotation_axis: None,
-            initial_velocity: SVector::zeros(),
-            initial_angular_velocity: 0.0,
+        let plate = body::<D>("plate", free, None, 0.0, 0.0);
+        let tie = Tie {
+            body: 0,
+            nodes: top,
         };
-        let part = SolidPart {
-            mesh,
-            material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6).expect("material")),
-            density: 1000.0,
-            thickness: 0.1,
-            hourglass_scale: 1.0,
-        };
-        Model::new(
-            part,
-            vec![plate],
-            vec![Tie {
-                body: 0,
-                nodes: top,
-            }],
-            vec![],
-            vec![],
-        )
-        .expect("model")
+        Model::new(part, vec![plate], vec![tie], vec![], vec![]).expect("model")
     }
 
     /// The assembled tangent (through the DOF map, ties included) is the derivative of the

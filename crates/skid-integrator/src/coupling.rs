@@ -246,44 +246,17 @@ pub fn contact_rows<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{ContactPair, SolidPart};
-    use nalgebra::SVector;
+    use crate::model::ContactPair;
+    use crate::test_support::{body, pad_block};
     use skid_contact::surface::AnalyticCylinder;
-    use skid_fem::material::PolynomialN1;
-    use skid_fem::mesh::SolidMesh;
-    use skid_fem::rigid::RigidBody;
 
     /// A block above a drum of radius 0.2 that spins about z and may also translate in x.
     fn block_on_drum<const D: usize>() -> Model<D> {
-        let mut corner = SVector::<f64, D>::zeros();
-        corner[0] = -0.05;
-        corner[1] = 0.2;
-        let mesh = SolidMesh::<D>::structured_block(
-            corner,
-            SVector::from_fn(|i, _| [0.1, 0.05, 0.1][i]),
-            std::array::from_fn(|i| [4, 1, 2][i]),
-        )
-        .expect("mesh");
-        let front = mesh.node_sets["ymin"].clone();
+        let part = pad_block::<D>([-0.05, 0.2, -0.05], [0.1, 0.05, 0.1], [4, 1, 2]);
+        let front = part.mesh.node_sets["ymin"].clone();
         let mut free = [false; D];
         free[0] = true;
-        let drum = RigidBody::<D> {
-            name: "drum".into(),
-            reference_point: SVector::zeros(),
-            mass: 5.0,
-            rotary_inertia: 0.175,
-            free_translations: free,
-            rotation_axis: Some(Vector3::z()),
-            initial_velocity: SVector::zeros(),
-            initial_angular_velocity: 0.0,
-        };
-        let part = SolidPart {
-            mesh,
-            material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6).expect("material")),
-            density: 1000.0,
-            thickness: 0.1,
-            hourglass_scale: 1.0,
-        };
+        let drum = body::<D>("drum", free, Some(Vector3::z()), 5.0, 0.175);
         let pair = ContactPair {
             name: "pad-drum".into(),
             nodes: front,

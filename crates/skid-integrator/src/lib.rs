@@ -26,6 +26,8 @@ pub mod model;
 pub mod sparse;
 pub mod state;
 pub mod stepper;
+#[cfg(test)]
+mod test_support;
 
 pub use error::{IncrementFailure, ModelError, RunError};
 pub use model::{ContactPair, Model, PressureLoad, SolidPart, Tie};

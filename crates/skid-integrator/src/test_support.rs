@@ -1,0 +1,49 @@
+//! Small scenes shared by the unit tests.
+
+use nalgebra::{SVector, Vector3};
+use skid_fem::material::PolynomialN1;
+use skid_fem::mesh::SolidMesh;
+use skid_fem::rigid::RigidBody;
+
+use crate::model::SolidPart;
+
+/// A structured block of the benchmark pad material (first D entries of each array are used).
+pub(crate) fn pad_block<const D: usize>(
+    corner: [f64; 3],
+    size: [f64; 3],
+    divisions: [usize; 3],
+) -> SolidPart<D> {
+    let mesh = SolidMesh::<D>::structured_block(
+        SVector::from_fn(|i, _| corner[i]),
+        SVector::from_fn(|i, _| size[i]),
+        std::array::from_fn(|i| divisions[i]),
+    )
+    .expect("mesh");
+    SolidPart {
+        mesh,
+        material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6).expect("material")),
+        density: 1000.0,
+        thickness: 0.1,
+        hourglass_scale: 1.0,
+    }
+}
+
+/// A rigid body at the origin, at rest, with the given free translations and rotation axis.
+pub(crate) fn body<const D: usize>(
+    name: &str,
+    free_translations: [bool; D],
+    rotation_axis: Option<Vector3<f64>>,
+    mass: f64,
+    rotary_inertia: f64,
+) -> RigidBody<D> {
+    RigidBody {
+        name: name.into(),
+        reference_point: SVector::zeros(),
+        mass,
+        rotary_inertia,
+        free_translations,
+        rotation_axis,
+        initial_velocity: SVector::zeros(),
+        initial_angular_velocity: 0.0,
+    }
+}
