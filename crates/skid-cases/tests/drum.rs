@@ -1,23 +1,27 @@
-//! End to end: the 2D drum against the analytical circle spins down as the benchmark says
-//! (../shared/DRUM.md sections 2.2 and 3), and without friction it keeps spinning.
+//! End to end: the drum against the analytical circle (2D) and cylinder (3D) spins down as the
+//! benchmark says (../shared/DRUM.md sections 2.2 and 3), and without friction it keeps spinning.
 
 use std::path::Path;
 
 use skid_cases::{Summary, parse_case, run_case};
 
-const SHIPPED: &str = include_str!("../../../cases/drum/2d-analytic.json");
+const CASE_2D: &str = include_str!("../../../cases/drum/2d-analytic.json");
+const CASE_3D: &str = include_str!("../../../cases/drum/3d-analytic.json");
 
-fn run(overrides: &[&str]) -> (Summary, tempfile::TempDir) {
+fn run_text(text: &str, overrides: &[&str]) -> (Summary, tempfile::TempDir) {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let case = parse_case(SHIPPED, Path::new("2d-analytic.json"), &overrides).expect("case");
+    let case = parse_case(text, Path::new("case.json"), &overrides).expect("case");
     let dir = tempfile::tempdir().expect("tempdir");
-    let summary = run_case(&case, Path::new("2d-analytic.json"), dir.path()).expect("run");
+    let summary = run_case(&case, Path::new("case.json"), dir.path()).expect("run");
     (summary, dir)
 }
 
-#[test]
-fn drum_spins_down_in_a_straight_line_and_rocks_in_stick_after_the_stop() {
-    let (s, dir) = run(&[]);
+fn run(overrides: &[&str]) -> (Summary, tempfile::TempDir) {
+    run_text(CASE_2D, overrides)
+}
+
+/// The benchmark's acceptance band for one run.
+fn assert_benchmark_spin_down(s: &Summary) {
     assert_eq!(s.status, "completed", "{:?}", s.error);
     let t_stop = s.t_stop.expect("the drum stops");
     assert!((0.0990..=0.1015).contains(&t_stop), "t_stop {t_stop}");
@@ -27,7 +31,7 @@ fn drum_spins_down_in_a_straight_line_and_rocks_in_stick_after_the_stop() {
         "deceleration {decel}"
     );
     // While sliding the normal force is the plate force plus the tilt of the side contacts
-    // (3510.6 N in the independent model).
+    // (3510.6 N in the independent 2D model).
     let n = s.mean_normal_force_sliding.expect("normal force");
     assert!((n - 3510.6).abs() < 10.0, "normal force {n}");
     assert!(s.post_stop_max_abs_omega.expect("post") < 5.0);
@@ -37,6 +41,20 @@ fn drum_spins_down_in_a_straight_line_and_rocks_in_stick_after_the_stop() {
     // 315 J of kinetic energy go into friction.
     let friction = s.friction_work_j.expect("friction");
     assert!((friction - 315.0).abs() < 2.0, "friction work {friction}");
+}
+
+#[test]
+fn drum_3d_spins_down_like_the_2d_one() {
+    let (s3, _dir) = run_text(CASE_3D, &[]);
+    assert_eq!(s3.dimension, 3);
+    assert_benchmark_spin_down(&s3);
+}
+
+#[test]
+fn drum_spins_down_in_a_straight_line_and_rocks_in_stick_after_the_stop() {
+    let (s, dir) = run(&[]);
+    assert_benchmark_spin_down(&s);
+    let t_stop = s.t_stop.expect("the drum stops");
     // Outputs are complete: renamed from .partial, one history row per increment plus the
     // initial state.
     let history = std::fs::read_to_string(dir.path().join("history.csv")).expect("history");
