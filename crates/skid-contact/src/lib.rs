@@ -4,6 +4,8 @@
 //! * [`surface`]: rigid surfaces described in the body frame of their rigid body, with closest-point
 //!   projections giving the signed gap and convected (arc-length, axial) coordinates.
 //! * [`plane`]: the analytical rigid plane (a line in 2D).
+//! * [`facets`]: the faceted cylinder (rigid line, quad, membrane or shell facets of a drum).
+//! * [`triangles`]: triangulated surfaces (exterior faces of a tetrahedral drum).
 //! * [`kinematics`]: gap, convected coordinates and their exact first derivatives for a slave node
 //!   against a surface carried by a body rotating about a fixed axis; slip increments unwrapped
 //!   across periodic coordinates.
@@ -14,14 +16,18 @@
 
 pub mod coulomb;
 pub mod error;
+pub mod facets;
 pub mod kinematics;
 pub mod plane;
 pub mod surface;
+pub mod triangles;
 
 pub use coulomb::{
     CoulombSettings, CoulombSolution, FrictionProblem, natural_map_error, solve_coulomb,
 };
 pub use error::ContactError;
+pub use facets::FacetedCylinder;
 pub use kinematics::{ContactKinematics, RotatingFrame, evaluate, slip_increment};
 pub use plane::RigidPlane;
 pub use surface::{AnalyticCylinder, Projection, RigidSurface};
+pub use triangles::{CylinderChart, TriangulatedSurface};

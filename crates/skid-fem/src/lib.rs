@@ -8,6 +8,7 @@
 //!   code path for 2D plane strain (D = 2) and 3D (D = 3).
 //! * [`pressure`]: follower pressure on element faces.
 //! * [`mesh`]: solid meshes with node sets and surfaces ([`SolidMesh`]).
+//! * [`tetra`]: tetrahedral meshes (the C3D4 drum) and their exterior faces.
 //! * [`rigid`]: rigid bodies (reference node with point mass and rotary inertia).
 //!
 //! All kernels work in SI units and report failures as [`FemError`].
@@ -19,6 +20,7 @@ pub mod mesh;
 pub mod pressure;
 pub mod rigid;
 pub mod solid;
+pub mod tetra;
 
 pub use error::FemError;
 pub use material::{Hyperelastic, PolynomialN1, SpatialTangent};

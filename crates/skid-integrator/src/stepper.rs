@@ -66,6 +66,9 @@ pub struct CutbackSettings {
     pub growth_after: usize,
     /// Growth factor (the size never exceeds the nominal one).
     pub growth_factor: f64,
+    /// Smallest increment, as a fraction of the nominal one: a failure that would need a
+    /// smaller one stops the run (crawling on with vanishing increments only hides it).
+    pub min_fraction: f64,
 }
 
 impl Default for CutbackSettings {
@@ -75,6 +78,7 @@ impl Default for CutbackSettings {
             max_cutbacks: 8,
             growth_after: 3,
             growth_factor: 2.0,
+            min_fraction: 1e-4,
         }
     }
 }
@@ -405,7 +409,9 @@ fn run_steps<const D: usize>(
                     stats.cutbacks += 1;
                     consecutive_failures += 1;
                     successes = 0;
-                    if consecutive_failures > settings.cutback.max_cutbacks {
+                    if consecutive_failures > settings.cutback.max_cutbacks
+                        || dp * settings.cutback.factor < nominal * settings.cutback.min_fraction
+                    {
                         return Err(RunError::StepFailed {
                             step: step.name.clone(),
                             increment: increment + 1,

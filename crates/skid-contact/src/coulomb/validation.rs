@@ -13,7 +13,9 @@ fn invalid(message: String) -> Result<(), ContactError> {
 }
 
 /// Check sizes, finiteness, `dim ∈ {2, 3}`, `mu_i >= 0`, `W` square, symmetric (to
-/// [`SYMMETRY_TOLERANCE`]) with a positive diagonal. Returns the number of contacts.
+/// [`SYMMETRY_TOLERANCE`]) with a positive normal diagonal and a non-negative tangential one (a
+/// zero tangential compliance is legitimate: a node on a facet vertex whose slip the forces
+/// cannot change). Returns the number of contacts.
 pub(crate) fn check_problem(problem: &FrictionProblem) -> Result<usize, ContactError> {
     let dim = problem.dim;
     if dim != 2 && dim != 3 {
@@ -47,17 +49,18 @@ pub(crate) fn check_problem(problem: &FrictionProblem) -> Result<usize, ContactE
     if !problem.q.iter().all(|v| v.is_finite()) {
         invalid("q has non-finite entries".into())?;
     }
-    check_delassus(problem.w)?;
+    check_delassus(problem.w, dim)?;
     Ok(n_contacts)
 }
 
-fn check_delassus(w: &DMatrix<f64>) -> Result<(), ContactError> {
+fn check_delassus(w: &DMatrix<f64>, dim: usize) -> Result<(), ContactError> {
     if !w.iter().all(|v| v.is_finite()) {
         invalid("W has non-finite entries".into())?;
     }
-    if let Some(i) = (0..w.nrows()).find(|&i| w[(i, i)] <= 0.0) {
+    if let Some(i) = (0..w.nrows()).find(|&i| w[(i, i)] < 0.0 || (i % dim == 0 && w[(i, i)] <= 0.0))
+    {
         invalid(format!(
-            "W must have a positive diagonal, W[{i},{i}] = {}",
+            "W must have a positive normal and non-negative tangential diagonal, W[{i},{i}] = {}",
             w[(i, i)]
         ))?;
     }

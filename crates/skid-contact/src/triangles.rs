@@ -1,0 +1,619 @@
+//! Rigid triangle mesh (the exterior faces of a tetrahedral C3D4 drum) with exact closest points
+//! and cylinder-chart convected coordinates.
+
+use std::collections::BTreeMap;
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::error::ContactError;
+use crate::facets::FacetedCylinder;
+use crate::surface::{AnalyticCylinder, Projection, RigidSurface};
+
+/// Cylinder whose coordinates label points of a triangulated drum: `xi_0 = R atan2(p.b2, p.b1)`,
+/// `xi_1 = e.p` for a surface point `p`, with `b1`, `b2` as in [`AnalyticCylinder`].
+#[derive(Clone, Copy, Debug)]
+pub struct CylinderChart {
+    /// Radius `R > 0` scaling the angle into an arc length.
+    pub radius: f64,
+    /// Axis `e` through the body-frame origin (normalised on use).
+    pub axis: Vector3<f64>,
+}
+
+/// Closest feature of one triangle to a point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Feature {
+    /// Interior of the triangle.
+    Face,
+    /// Interior of edge `i`, from corner `i` to corner `i + 1 (mod 3)`.
+    Edge(usize),
+    /// Corner `i`.
+    Vertex(usize),
+}
+
+impl Feature {
+    /// Preference among equally distant features: the face, then an edge, then a vertex.
+    fn rank(self) -> u8 {
+        match self {
+            Feature::Face => 2,
+            Feature::Edge(_) => 1,
+            Feature::Vertex(_) => 0,
+        }
+    }
+}
+
+/// One triangle with its angle-weighted pseudo-normals and bounding sphere.
+#[derive(Clone, Debug)]
+struct Triangle {
+    corners: [Vector3<f64>; 3],
+    /// Outward unit normal `(b - a) x (c - a) / |(b - a) x (c - a)|`.
+    normal: Vector3<f64>,
+    /// Pseudo-normal of edge `i`: the sum of the unit normals of the triangles sharing it.
+    edge_normals: [Vector3<f64>; 3],
+    /// Pseudo-normal of corner `i`: `sum_t alpha_t n_t` over incident triangles `t`, `alpha_t` the
+    /// triangle's angle at the corner.
+    vertex_normals: [Vector3<f64>; 3],
+    centre: Vector3<f64>,
+    bound: f64,
+}
+
+/// Closest point of one triangle.
+struct Closest {
+    point: Vector3<f64>,
+    feature: Feature,
+    distance: f64,
+}
+
+impl Triangle {
+    /// Closest point to `y`: the plane projection `p = y - (n.(y - a)) n` if it lies in the
+    /// (closed) triangle, otherwise the closest of the three edges' clamped segment projections
+    /// `a_i + clamp(t, 0, 1) (a_{i+1} - a_i)`, `t = (y - a_i).(a_{i+1} - a_i) / |a_{i+1} - a_i|^2`
+    /// (an edge for `0 < t < 1`, else a corner).
+    fn closest(&self, y: &Vector3<f64>) -> Closest {
+        let height = self.normal.dot(&(y - self.corners[0]));
+        let in_plane = y - self.normal * height;
+        let inside = (0..3).all(|i| {
+            let (a, b) = (self.corners[i], self.corners[(i + 1) % 3]);
+            (b - a).cross(&(in_plane - a)).dot(&self.normal) >= 0.0
+        });
+        if inside {
+            return Closest {
+                point: in_plane,
+                feature: Feature::Face,
+                distance: height.abs(),
+            };
+        }
+        let on_edge = |i: usize| {
+            let (a, b) = (self.corners[i], self.corners[(i + 1) % 3]);
+            let edge = b - a;
+            let t = (y - a).dot(&edge) / edge.norm_squared();
+            let (point, feature) = if t <= 0.0 {
+                (a, Feature::Vertex(i))
+            } else if t >= 1.0 {
+                (b, Feature::Vertex((i + 1) % 3))
+            } else {
+                (a + edge * t, Feature::Edge(i))
+            };
+            Closest {
+                point,
+                feature,
+                distance: (y - point).norm(),
+            }
+        };
+        let mut best = on_edge(0);
+        for i in 1..3 {
+            let candidate = on_edge(i);
+            if candidate.distance < best.distance {
+                best = candidate;
+            }
+        }
+        best
+    }
+
+    fn pseudo_normal(&self, feature: Feature) -> Vector3<f64> {
+        match feature {
+            Feature::Face => self.normal,
+            Feature::Edge(i) => self.edge_normals[i],
+            Feature::Vertex(i) => self.vertex_normals[i],
+        }
+    }
+
+    /// `dp/dy` of the closest point: `I - n n^T` on the face, `u u^T` on an edge of unit
+    /// direction `u`, zero at a corner (all symmetric).
+    fn closest_point_jacobian(&self, feature: Feature) -> Matrix3<f64> {
+        match feature {
+            Feature::Face => Matrix3::identity() - self.normal * self.normal.transpose(),
+            Feature::Edge(i) => {
+                let u = (self.corners[(i + 1) % 3] - self.corners[i]).normalize();
+                u * u.transpose()
+            }
+            Feature::Vertex(_) => Matrix3::zeros(),
+        }
+    }
+}
+
+/// Triangle mesh (body frame), triangles counter-clockwise seen from outside.
+///
+/// With `p` the closest point of the mesh to `y` (over all triangles; face, edge or vertex
+/// Voronoi region, Ericson 2005 §5.1.5) and `N` the angle-weighted pseudo-normal of its feature
+/// (Baerentzen & Aanaes 2005), `s = sign((y - p).N)` (`+` on ties):
+/// * `g = s |y - p|` (`= n.(y - a)` in a face region), `dg/dy = s (y - p)/|y - p|` (`= n` in a
+///   face region; `N/|N|` when `|y - p| ~ 0`);
+/// * `xi = (R atan2(p.b2, p.b1), e.p)` from the [`CylinderChart`], with
+///   `d xi/dy = (dp/dy)^T d xi/dp`, `dp/dy = I - n n^T` (face), `u u^T` (edge of direction `u`),
+///   `0` (vertex); `xi_0` has period `2 pi R`.
+///
+/// The sign is that of a closed, consistently oriented mesh; on an open mesh it is only
+/// meaningful near the surface. Equally distant features (to round-off) resolve to the face,
+/// then the edge, then the lowest triangle index. The projection is undefined (`None`) if `p`
+/// lies on the chart axis.
+#[derive(Clone, Debug)]
+pub struct TriangulatedSurface {
+    triangles: Vec<Triangle>,
+    chart: AnalyticCylinder,
+    /// Largest vertex norm, the length scale of round-off tolerances.
+    scale: f64,
+}
+
+impl TriangulatedSurface {
+    /// Mesh of `triangles` (indices into `vertices`, counter-clockwise seen from outside) with
+    /// convected coordinates from `chart`.
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidSurface`] for no triangles, non-finite vertices, out-of-range or
+    /// repeated indices, degenerate triangles (`|(b - a) x (c - a)| <= 1e-12 l_max^2`), or an
+    /// invalid chart.
+    pub fn new(
+        vertices: Vec<Vector3<f64>>,
+        triangles: Vec<[usize; 3]>,
+        chart: CylinderChart,
+    ) -> Result<Self, ContactError> {
+        let chart = AnalyticCylinder::new(chart.radius, chart.axis)?;
+        let invalid = |message: String| Err(ContactError::InvalidSurface(message));
+        if triangles.is_empty() {
+            return invalid("triangle mesh has no triangles".into());
+        }
+        if let Some(v) = vertices.iter().find(|v| !v.iter().all(|c| c.is_finite())) {
+            return invalid(format!("non-finite mesh vertex {v:?}"));
+        }
+        let mut normals = Vec::with_capacity(triangles.len());
+        for (t, tri) in triangles.iter().enumerate() {
+            if let Some(i) = tri.iter().find(|&&i| i >= vertices.len()) {
+                return invalid(format!(
+                    "triangle {t} refers to vertex {i} of {}",
+                    vertices.len()
+                ));
+            }
+            let [a, b, c] = tri.map(|i| vertices[i]);
+            let cross = (b - a).cross(&(c - a));
+            let longest = [b - a, c - b, a - c]
+                .iter()
+                .map(|e| e.norm_squared())
+                .fold(0.0, f64::max);
+            if tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0] {
+                return invalid(format!("triangle {t} repeats a vertex: {tri:?}"));
+            }
+            if cross.norm() <= 1e-12 * longest {
+                return invalid(format!("triangle {t} is degenerate: {tri:?}"));
+            }
+            normals.push(cross.normalize());
+        }
+        let mut edge_sums: BTreeMap<(usize, usize), Vector3<f64>> = BTreeMap::new();
+        let mut vertex_sums = vec![Vector3::zeros(); vertices.len()];
+        for (tri, normal) in triangles.iter().zip(&normals) {
+            for i in 0..3 {
+                let (a, b, c) = (tri[i], tri[(i + 1) % 3], tri[(i + 2) % 3]);
+                *edge_sums.entry((a.min(b), a.max(b))).or_default() += normal;
+                let angle = (vertices[b] - vertices[a]).angle(&(vertices[c] - vertices[a]));
+                vertex_sums[a] += normal * angle;
+            }
+        }
+        let built = triangles
+            .iter()
+            .zip(&normals)
+            .map(|(tri, normal)| {
+                let corners = tri.map(|i| vertices[i]);
+                let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
+                let edge = |i: usize| {
+                    let (a, b) = (tri[i], tri[(i + 1) % 3]);
+                    edge_sums
+                        .get(&(a.min(b), a.max(b)))
+                        .copied()
+                        .unwrap_or(*normal)
+                };
+                Triangle {
+                    corners,
+                    normal: *normal,
+                    edge_normals: [edge(0), edge(1), edge(2)],
+                    vertex_normals: tri.map(|i| vertex_sums[i]),
+                    centre,
+                    bound: corners
+                        .iter()
+                        .map(|c| (c - centre).norm())
+                        .fold(0.0, f64::max),
+                }
+            })
+            .collect();
+        let scale = vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        Ok(Self {
+            triangles: built,
+            chart,
+            scale,
+        })
+    }
+
+    /// Closed triangulation of the prism `drum` between the axial positions `axial_range[0] <
+    /// axial_range[1]`: each rectangular facet split into two coplanar triangles along the
+    /// diagonal from `V_k` at the low end to `V_{k+1}` at the high end, plus fan end caps around
+    /// the axis points, outward oriented; chart `(R, e)` of the drum.
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidSurface`] for a non-finite or empty axial range.
+    pub fn closed_prism(
+        drum: &FacetedCylinder,
+        axial_range: [f64; 2],
+    ) -> Result<Self, ContactError> {
+        let [low, high] = axial_range;
+        if !(low.is_finite() && high.is_finite() && low < high) {
+            return Err(ContactError::InvalidSurface(format!(
+                "prism needs a finite axial range low < high, got {axial_range:?}"
+            )));
+        }
+        let n = drum.facet_count();
+        let e = drum.axis();
+        // vertices: ring at `low` (0..n), ring at `high` (n..2n), then the two axis points
+        let mut vertices: Vec<Vector3<f64>> = (0..n).map(|k| drum.vertex(k) + e * low).collect();
+        vertices.extend((0..n).map(|k| drum.vertex(k) + e * high));
+        vertices.push(e * low);
+        vertices.push(e * high);
+        let mut triangles = Vec::with_capacity(4 * n);
+        for k in 0..n {
+            let next = (k + 1) % n;
+            triangles.push([k, next, n + next]);
+            triangles.push([k, n + next, n + k]);
+            triangles.push([2 * n, next, k]);
+            triangles.push([2 * n + 1, n + k, n + next]);
+        }
+        Self::new(
+            vertices,
+            triangles,
+            CylinderChart {
+                radius: drum.radius(),
+                axis: e,
+            },
+        )
+    }
+
+    /// Closest feature over all triangles: `(triangle index, closest point)`; triangles whose
+    /// bounding sphere lies farther than the best distance so far are skipped.
+    fn nearest(&self, y: &Vector3<f64>, tolerance: f64) -> Option<(usize, Closest)> {
+        let mut best: Option<(usize, Closest)> = None;
+        for (index, triangle) in self.triangles.iter().enumerate() {
+            if let Some((_, b)) = &best
+                && (y - triangle.centre).norm() - triangle.bound > b.distance + tolerance
+            {
+                continue;
+            }
+            let candidate = triangle.closest(y);
+            let better = match &best {
+                None => true,
+                Some((_, b)) => {
+                    candidate.distance < b.distance - tolerance
+                        || (candidate.distance <= b.distance + tolerance
+                            && candidate.feature.rank() > b.feature.rank())
+                }
+            };
+            if better {
+                best = Some((index, candidate));
+            }
+        }
+        best
+    }
+}
+
+impl RigidSurface for TriangulatedSurface {
+    fn project(&self, y: &Vector3<f64>) -> Option<Projection> {
+        if !y.iter().all(|c| c.is_finite()) {
+            return None;
+        }
+        let tiny = 64.0 * f64::EPSILON * (self.scale + y.norm());
+        let (index, closest) = self.nearest(y, tiny)?;
+        let triangle = &self.triangles[index];
+        let (gap, gap_gradient) = if closest.feature == Feature::Face {
+            let height = triangle.normal.dot(&(y - triangle.corners[0]));
+            (height, triangle.normal)
+        } else {
+            let offset = y - closest.point;
+            let pseudo = triangle.pseudo_normal(closest.feature);
+            let sign = if offset.dot(&pseudo) >= 0.0 {
+                1.0
+            } else {
+                -1.0
+            };
+            let gradient = if closest.distance > tiny {
+                offset * (sign / closest.distance)
+            } else {
+                pseudo.try_normalize(0.0).unwrap_or(triangle.normal)
+            };
+            (sign * closest.distance, gradient)
+        };
+        let chart = self.chart.project(&closest.point)?;
+        let jacobian = triangle.closest_point_jacobian(closest.feature);
+        Some(Projection {
+            gap,
+            gap_gradient,
+            coords: chart.coords,
+            coords_gradient: chart.coords_gradient.map(|g| jacobian * g),
+        })
+    }
+
+    fn coords_period(&self) -> [Option<f64>; 2] {
+        self.chart.coords_period()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::facets::tests::check_gradients;
+    use crate::kinematics::slip_increment;
+    use approx::assert_relative_eq;
+    use std::f64::consts::{PI, TAU};
+
+    const R: f64 = 0.2;
+
+    fn project(surface: &dyn RigidSurface, y: &Vector3<f64>) -> Projection {
+        surface.project(y).expect("projection defined")
+    }
+
+    fn z_chart(radius: f64) -> CylinderChart {
+        CylinderChart {
+            radius,
+            axis: Vector3::z(),
+        }
+    }
+
+    /// Cube `[-1, 1]^3`, vertex `i` at `(+-1, +-1, +-1)` with the bits of `i` giving `x, y, z`.
+    fn cube() -> TriangulatedSurface {
+        let vertices = (0..8)
+            .map(|i| {
+                Vector3::new(
+                    if i & 1 == 0 { -1.0 } else { 1.0 },
+                    if i & 2 == 0 { -1.0 } else { 1.0 },
+                    if i & 4 == 0 { -1.0 } else { 1.0 },
+                )
+            })
+            .collect();
+        let triangles = vec![
+            [4, 5, 7],
+            [4, 7, 6],
+            [0, 2, 3],
+            [0, 3, 1],
+            [1, 3, 7],
+            [1, 7, 5],
+            [0, 4, 6],
+            [0, 6, 2],
+            [2, 6, 7],
+            [2, 7, 3],
+            [0, 1, 5],
+            [0, 5, 4],
+        ];
+        TriangulatedSurface::new(vertices, triangles, z_chart(1.0)).expect("cube")
+    }
+
+    fn drum_72() -> FacetedCylinder {
+        FacetedCylinder::new(R, Vector3::z(), 72, PI / 72.0).expect("drum")
+    }
+
+    #[test]
+    fn rejects_invalid_data() {
+        let invalid = |r: Result<TriangulatedSurface, ContactError>| {
+            matches!(r, Err(ContactError::InvalidSurface(_)))
+        };
+        let v = vec![Vector3::zeros(), Vector3::x(), Vector3::y()];
+        assert!(!invalid(TriangulatedSurface::new(
+            v.clone(),
+            vec![[0, 1, 2]],
+            z_chart(1.0)
+        )));
+        assert!(invalid(TriangulatedSurface::new(
+            v.clone(),
+            vec![[0, 1, 3]],
+            z_chart(1.0)
+        )));
+        assert!(invalid(TriangulatedSurface::new(
+            v.clone(),
+            vec![[0, 1, 1]],
+            z_chart(1.0)
+        )));
+        assert!(invalid(TriangulatedSurface::new(
+            v.clone(),
+            vec![],
+            z_chart(1.0)
+        )));
+        assert!(invalid(TriangulatedSurface::new(
+            v.clone(),
+            vec![[0, 1, 2]],
+            z_chart(0.0)
+        )));
+        let chart = CylinderChart {
+            radius: 1.0,
+            axis: Vector3::zeros(),
+        };
+        assert!(invalid(TriangulatedSurface::new(
+            v.clone(),
+            vec![[0, 1, 2]],
+            chart
+        )));
+        let collinear = vec![Vector3::zeros(), Vector3::x(), Vector3::x() * 2.0];
+        assert!(invalid(TriangulatedSurface::new(
+            collinear,
+            vec![[0, 1, 2]],
+            z_chart(1.0)
+        )));
+        let nan = vec![
+            Vector3::zeros(),
+            Vector3::x(),
+            Vector3::new(f64::NAN, 1.0, 0.0),
+        ];
+        assert!(invalid(TriangulatedSurface::new(
+            nan,
+            vec![[0, 1, 2]],
+            z_chart(1.0)
+        )));
+        let drum = drum_72();
+        assert!(invalid(TriangulatedSurface::closed_prism(
+            &drum,
+            [0.1, 0.1]
+        )));
+        assert!(invalid(TriangulatedSurface::closed_prism(
+            &drum,
+            [0.0, f64::INFINITY]
+        )));
+    }
+
+    #[test]
+    fn single_triangle_voronoi_regions() {
+        // triangle a = o, b = o + x, c = o + y with normal +z, away from the chart axis
+        let o = Vector3::new(1.0, 1.0, 0.0);
+        let mesh = TriangulatedSurface::new(
+            vec![o, o + Vector3::x(), o + Vector3::y()],
+            vec![[0, 1, 2]],
+            z_chart(0.5),
+        )
+        .expect("triangle");
+        // (point relative to o, closest point relative to o, signed distance)
+        let cases = [
+            ((0.2, 0.3, 0.5), (0.2, 0.3, 0.0), 0.5),   // face, above
+            ((0.2, 0.3, -0.5), (0.2, 0.3, 0.0), -0.5), // face, below
+            ((0.5, -0.3, 0.4), (0.5, 0.0, 0.0), 0.5),  // edge ab
+            ((0.8, 0.8, 0.1), (0.5, 0.5, 0.0), 0.19f64.sqrt()), // edge bc
+            ((-0.3, 0.5, -0.4), (0.0, 0.5, 0.0), -0.5), // edge ca
+            ((-0.2, -0.1, 0.2), (0.0, 0.0, 0.0), 0.3), // vertex a
+            ((1.3, -0.4, -1.2), (1.0, 0.0, 0.0), -1.3), // vertex b
+            ((-0.3, 1.4, 1.2), (0.0, 1.0, 0.0), 1.3),  // vertex c
+        ];
+        for ((yx, yy, yz), (px, py, pz), gap) in cases {
+            let y = o + Vector3::new(yx, yy, yz);
+            let p = o + Vector3::new(px, py, pz);
+            let proj = project(&mesh, &y);
+            assert_relative_eq!(proj.gap, gap, epsilon = 1e-14);
+            let normal = (y - p) * (gap.signum() / (y - p).norm());
+            assert_relative_eq!(proj.gap_gradient, normal, epsilon = 1e-14);
+            assert_relative_eq!(proj.coords[0], 0.5 * p.y.atan2(p.x), epsilon = 1e-14);
+            assert_relative_eq!(proj.coords[1], p.z, epsilon = 1e-14);
+            check_gradients(&mesh, &y, 1e-6);
+        }
+        // vertex region: the closest point does not move
+        let corner = project(&mesh, &(o + Vector3::new(-0.2, -0.1, 0.2)));
+        assert_eq!(corner.coords_gradient, [Vector3::zeros(); 2]);
+        // on the surface the gradient is the pseudo-normal, here the face normal
+        let on_edge = project(&mesh, &(o + Vector3::new(0.5, 0.0, 0.0)));
+        assert_relative_eq!(on_edge.gap, 0.0, epsilon = 1e-15);
+        assert_relative_eq!(on_edge.gap_gradient, Vector3::z(), epsilon = 1e-15);
+        // chart coordinates are undefined for a closest point on the chart axis
+        let on_axis = TriangulatedSurface::new(
+            vec![Vector3::zeros(), Vector3::x(), Vector3::y()],
+            vec![[0, 1, 2]],
+            z_chart(0.5),
+        )
+        .expect("triangle");
+        assert!(on_axis.project(&Vector3::new(-0.1, -0.1, 0.3)).is_none());
+        assert!(mesh.project(&Vector3::new(f64::NAN, 0.0, 0.0)).is_none());
+    }
+
+    #[test]
+    fn cube_signs_and_pseudo_normals() {
+        let cube = cube();
+        for t in &cube.triangles {
+            assert!(t.normal.dot(&t.centre) > 0.0, "outward orientation");
+            // every cube corner sees each incident face under a total angle pi/2
+            for v in t.vertex_normals {
+                assert_relative_eq!(v.abs(), Vector3::repeat(PI / 2.0), epsilon = 1e-14);
+            }
+            // cube edges join perpendicular faces, face diagonals coplanar triangles
+            for e in t.edge_normals {
+                let norm = e.norm();
+                assert!((norm - 2f64.sqrt()).abs() < 1e-14 || (norm - 2.0).abs() < 1e-14);
+            }
+        }
+        let cases = [
+            (Vector3::new(0.3, 0.2, 0.5), -0.5),           // inside, top face
+            (Vector3::new(0.9, 0.8, 0.95), -0.05),         // inside near a corner
+            (Vector3::new(-0.7, 0.99, 0.1), -0.01),        // inside near +y face
+            (Vector3::new(0.3, 0.2, 1.5), 0.5),            // outside, face
+            (Vector3::new(1.2, 1.1, 0.5), 0.05f64.sqrt()), // outside, edge
+            (Vector3::new(1.2, 1.3, 1.1), 0.14f64.sqrt()), // outside, corner
+            (Vector3::new(-1.2, 0.5, -1.1), 0.05f64.sqrt()), // outside, edge
+            (Vector3::new(-1.1, -1.2, -1.3), 0.14f64.sqrt()), // outside, corner
+        ];
+        for (y, gap) in cases {
+            assert_relative_eq!(project(&cube, &y).gap, gap, epsilon = 1e-14);
+            check_gradients(&cube, &y, 1e-6);
+        }
+    }
+
+    #[test]
+    fn closed_prism_matches_faceted_cylinder_on_the_lateral_surface() {
+        let drum = drum_72();
+        let mesh = TriangulatedSurface::closed_prism(&drum, [-0.05, 0.05]).expect("prism");
+        assert_eq!(mesh.triangles.len(), 4 * 72);
+        for t in &mesh.triangles {
+            assert!(t.normal.dot(&t.centre) > 0.0, "outward orientation");
+        }
+        for i in 0..720 {
+            let angle = TAU * (i as f64 + 0.123) / 720.0 - PI;
+            // inside, the lateral faces stay nearer than the caps (depth < 0.01)
+            for radius in [0.192, 0.1995, 0.2, 0.2003, 0.21, 0.3] {
+                let z = 0.04 * ((i % 7) as f64 / 3.0 - 1.0);
+                let y = Vector3::new(radius * angle.cos(), radius * angle.sin(), z);
+                let (m, f) = (project(&mesh, &y), project(&drum, &y));
+                assert_relative_eq!(m.gap, f.gap, epsilon = 1e-13);
+                assert_relative_eq!(m.gap_gradient, f.gap_gradient, epsilon = 1e-9);
+                assert_relative_eq!(m.coords[1], z, epsilon = 1e-15);
+            }
+        }
+    }
+
+    #[test]
+    fn closed_prism_gradients_match_finite_differences() {
+        let drum = drum_72();
+        let mesh = TriangulatedSurface::closed_prism(&drum, [-0.05, 0.05]).expect("prism");
+        let v = drum.vertex(9);
+        let mid = (drum.vertex(9) + drum.vertex(10)) * 0.5;
+        let points = [
+            mid * 1.01 + Vector3::z() * 0.02,                   // face
+            mid * 1.01 + (v - mid) * 0.3 - Vector3::z() * 0.01, // face, other triangle
+            v * 1.02 + Vector3::z() * 0.013,                    // lateral edge (vertex line)
+            mid * 1.01 + Vector3::z() * 0.06,                   // rim edge
+            v * 1.02 + Vector3::z() * 0.051,                    // rim corner
+            mid * 0.99 + Vector3::z() * 0.03,                   // inside, face
+            v * 0.5 + Vector3::z() * 0.045,                     // inside, cap
+        ];
+        for y in &points {
+            check_gradients(&mesh, y, 1e-6);
+        }
+        // the lateral-edge and rim-edge points lie in edge regions, the rim corner in a vertex one
+        assert!(project(&mesh, &points[2]).coords_gradient[0].norm() < 1e-12);
+        assert!(project(&mesh, &points[3]).coords_gradient[1].norm() < 1e-12);
+        assert_eq!(
+            project(&mesh, &points[4]).coords_gradient,
+            [Vector3::zeros(); 2]
+        );
+    }
+
+    #[test]
+    fn slip_unwraps_across_the_chart_cut() {
+        // facet 35 of this drum is centred on the -x axis, where atan2 jumps from pi to -pi
+        let drum = drum_72();
+        let mesh = TriangulatedSurface::closed_prism(&drum, [-0.05, 0.05]).expect("prism");
+        let d = drum.apothem();
+        let before = project(&mesh, &Vector3::new(-d - 0.001, 0.004, 0.01));
+        let after = project(&mesh, &Vector3::new(-d - 0.002, -0.003, -0.02));
+        assert!(before.coords[0] > 0.0 && after.coords[0] < 0.0);
+        let slip = slip_increment(&mesh, &before.coords, &after.coords);
+        let expected = R * ((0.004 / d).atan() + (0.003 / d).atan());
+        assert_relative_eq!(slip[0], expected, epsilon = 1e-14);
+        assert_relative_eq!(slip[1], -0.03, epsilon = 1e-15);
+        check_gradients(&mesh, &Vector3::new(-d - 0.001, 1e-8, 0.01), 1e-6);
+    }
+}
