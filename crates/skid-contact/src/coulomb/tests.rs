@@ -101,13 +101,25 @@ fn check_coulomb_law(
                 );
                 State::Stick
             } else {
-                // sliding: no dilation, friction on the cone boundary opposing the slip
+                // sliding: no dilation, friction on the cone boundary opposing the slip. The
+                // slip direction is only determined to the solution's accuracy divided by the
+                // slip, so the direction is checked where the slip is well above that.
                 assert!(u[0].abs() <= tol_l, "contact {i}: dilation u_N = {}", u[0]);
-                for k in 1..dim {
-                    let expected = -mu[i] * r[0] * u[k] / u_t;
+                // The natural map weighs a direction error by rho |u_T| / |r_T|, which is small
+                // here, so the direction is checked as an angle: friction opposes the slip to
+                // 1e-4 rad, with magnitude mu r_N.
+                assert!(
+                    (r_t - mu[i] * r[0]).abs() <= tol_f,
+                    "contact {i}: |r_T| != mu r_N"
+                );
+                if u_t > 100.0 * tol_l && r_t > tol_f {
+                    let misalignment: f64 = (1..dim)
+                        .map(|k| (r[k] / r_t + u[k] / u_t).powi(2))
+                        .sum::<f64>()
+                        .sqrt();
                     assert!(
-                        (r[k] - expected).abs() <= tol_f,
-                        "contact {i}: r_T not opposing slip"
+                        misalignment <= 1e-4,
+                        "contact {i}: r_T not opposing slip (angle {misalignment:e})"
                     );
                 }
                 State::Slide
@@ -494,7 +506,12 @@ fn empty_problem_is_trivial() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    // A fixed seed keeps CI deterministic; the regression file replays past failures first.
+    #![proptest_config(ProptestConfig {
+        cases: 64,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x5eed_d0c5),
+        ..ProptestConfig::default()
+    })]
 
     /// Random coupled SPD instances with mixed states satisfy the exact law, and the relaxed
     /// problem dilates at each of its sliding contacts.
