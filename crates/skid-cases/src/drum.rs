@@ -9,15 +9,20 @@
 //! - the back plate: a rigid body whose only free motion is the radial (y) translation.
 
 use nalgebra::{SVector, Vector3};
-use skid_contact::surface::AnalyticCylinder;
+use skid_contact::error::ContactError;
+use skid_contact::facets::FacetedCylinder;
+use skid_contact::surface::{AnalyticCylinder, RigidSurface};
+use skid_contact::triangles::{CylinderChart, TriangulatedSurface};
+use skid_fem::cell::embed;
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
+use skid_fem::tetra::TetMesh;
 use skid_integrator::increment::NewtonSettings;
 use skid_integrator::stepper::{CutbackSettings, Settings, Step, StepKind};
 use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, Tie};
 
-use crate::schema::{Case, DrumSurfaceSpec, MaterialSpec, StepSpec};
+use crate::schema::{Case, ContactFormulation, DrumSurfaceSpec, MaterialSpec, StepSpec};
 
 /// Index of the drum among the model's rigid bodies.
 pub const DRUM: usize = 0;
@@ -102,9 +107,11 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
         initial_velocity: SVector::zeros(),
         initial_angular_velocity: 0.0,
     };
-    let surface = match case.drum.surface {
-        DrumSurfaceSpec::Analytic => {
-            AnalyticCylinder::new(r, Vector3::z()).map_err(|e| format!("drum.surface: {e}"))?
+    let surface = drum_surface(case).map_err(|e| format!("drum.surface: {e}"))?;
+    let contact_nodes = match case.contact.formulation {
+        ContactFormulation::Pair => front,
+        ContactFormulation::General { search_distance } => {
+            general_contact_candidates(&mesh, surface.as_ref(), search_distance)
         }
     };
     let part = SolidPart {
@@ -127,9 +134,9 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
         }],
         vec![ContactPair {
             name: "pad-drum".into(),
-            nodes: front,
+            nodes: contact_nodes,
             body: DRUM,
-            surface: Box::new(surface),
+            surface,
             mu: case.contact.mu,
         }],
     )
@@ -193,4 +200,97 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
         steps,
         settings,
     })
+}
+
+/// The drum's contact surface in its body frame (origin on the axis, axis +z). Faceted and
+/// tetrahedral drums have their vertices at `(2 k + 1) pi / n` from +x (n facets or sectors), so
+/// that for the benchmark's 72 a facet's midpoint, not a vertex, lies under the pad's centre
+/// (the statement does not say; a vertex there would hold the pad's centre node on a corner).
+///
+/// # Errors
+/// If the surface geometry is invalid.
+pub fn drum_surface(case: &Case) -> Result<Box<dyn RigidSurface>, ContactError> {
+    let r = case.drum.radius;
+    Ok(match case.drum.surface {
+        DrumSurfaceSpec::Analytic => Box::new(AnalyticCylinder::new(r, Vector3::z())?),
+        DrumSurfaceSpec::Facets { count, .. } => Box::new(FacetedCylinder::new(
+            r,
+            Vector3::z(),
+            count,
+            std::f64::consts::PI / count as f64,
+        )?),
+        DrumSurfaceSpec::Tetrahedra {
+            sectors,
+            rings,
+            layers,
+            inner_radius,
+        } => {
+            let mesh = TetMesh::annular_drum(
+                r,
+                inner_radius,
+                case.drum.width,
+                [sectors, rings, layers],
+                std::f64::consts::PI / sectors as f64,
+            )
+            .map_err(|e| ContactError::InvalidSurface(e.to_string()))?;
+            let faces = mesh.exterior_faces();
+            Box::new(TriangulatedSurface::new(
+                mesh.nodes,
+                faces,
+                CylinderChart {
+                    radius: r,
+                    axis: Vector3::z(),
+                },
+            )?)
+        }
+    })
+}
+
+/// General contact: the nodes of every exterior face of the pad whose distance to the drum
+/// surface (in the initial configuration) is below `search_distance`, sorted.
+fn general_contact_candidates<const D: usize>(
+    mesh: &SolidMesh<D>,
+    surface: &dyn RigidSurface,
+    search_distance: f64,
+) -> Vec<usize> {
+    let mut nodes: Vec<usize> = mesh
+        .surfaces
+        .values()
+        .flat_map(|faces| faces.iter().flatten().copied())
+        .filter(|&n| {
+            surface
+                .project(&embed(&mesh.nodes[n]))
+                .is_some_and(|p| p.gap < search_distance)
+        })
+        .collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::validate::parse_case;
+    use std::path::Path;
+
+    /// General contact finds, by distance, exactly the front-face nodes the pair names: the
+    /// back face stands a pad thickness away.
+    #[test]
+    fn general_contact_search_finds_the_front_face() {
+        let text = include_str!("../../../cases/drum/3d-analytic-general.json");
+        let case = parse_case(text, Path::new("g.json"), &[]).expect("case");
+        let scene = build::<3>(&case).expect("scene");
+        let mesh = &scene.model.part().mesh;
+        assert_eq!(scene.model.contacts()[0].nodes, mesh.node_sets["ymin"]);
+        // A search distance beyond the pad thickness also takes the back face.
+        let wide = parse_case(
+            text,
+            Path::new("g.json"),
+            &["contact.formulation.search_distance=0.2".into()],
+        )
+        .expect("case");
+        let scene = build::<3>(&wide).expect("scene");
+        assert_eq!(scene.model.contacts()[0].nodes.len(), mesh.nodes.len());
+    }
 }

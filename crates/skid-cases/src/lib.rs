@@ -8,6 +8,7 @@
 //! - [`runner`]: running one case into an output directory.
 
 pub mod drum;
+pub mod fields;
 pub mod history;
 pub mod runner;
 pub mod schema;

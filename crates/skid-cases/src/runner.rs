@@ -1,10 +1,13 @@
-//! Runs one case: builds the scene, integrates it, writes `history.csv` and `summary.json`.
+//! Runs one case: builds the scene, integrates it, writes `history.csv`, `summary.json` and,
+//! if the case asks for it, the ParaView field output in `fields/`.
 
 use std::path::{Path, PathBuf};
 
-use skid_integrator::stepper::run;
+use skid_integrator::Model;
+use skid_integrator::stepper::{IncrementReport, Observer, run};
 
 use crate::drum::build;
+use crate::fields::{self, DrumOutline, FieldWriter};
 use crate::history::DrumRecorder;
 use crate::schema::Case;
 use crate::summary::{Summary, summarize};
@@ -60,9 +63,32 @@ fn run_in<const D: usize>(case: &Case, source: &Path, dir: &Path) -> Result<Summ
             std::fs::remove_file(&p).map_err(output(p.clone()))?;
         }
     }
+    let fields_dir = dir.join(fields::FIELDS_DIR);
+    fields::clear(dir).map_err(output(fields_dir.clone()))?;
     let mut recorder = DrumRecorder::create(dir).map_err(output(dir.join("history.csv")))?;
-    let (stats, result) = run(&scene.model, &scene.steps, &scene.settings, &mut recorder);
+    let mut field_writer = case
+        .output
+        .field_interval
+        .map(|interval| {
+            let drum = DrumOutline {
+                radius: case.drum.radius,
+                width: case.drum.width,
+            };
+            FieldWriter::create(dir, interval, drum)
+        })
+        .transpose()
+        .map_err(output(fields_dir.clone()))?;
+    let mut observers = Observers {
+        history: &mut recorder,
+        fields: field_writer.as_mut(),
+    };
+    let (stats, result) = run(&scene.model, &scene.steps, &scene.settings, &mut observers);
     let samples = recorder.finish().map_err(output(dir.join("history.csv")))?;
+    if let Some(writer) = field_writer {
+        writer
+            .finish(&scene.model)
+            .map_err(output(fields_dir.clone()))?;
+    }
     let error = result.err().map(|e| e.to_string());
     let summary = summarize(case, &samples, &stats, error);
     write_atomic(
@@ -71,6 +97,26 @@ fn run_in<const D: usize>(case: &Case, source: &Path, dir: &Path) -> Result<Summ
     )
     .map_err(output(dir.join("summary.json")))?;
     Ok(summary)
+}
+
+/// The observers of a run: the history and, optionally, the field output.
+struct Observers<'a> {
+    history: &'a mut DrumRecorder,
+    fields: Option<&'a mut FieldWriter>,
+}
+
+impl<const D: usize> Observer<D> for Observers<'_> {
+    fn on_increment(
+        &mut self,
+        model: &Model<D>,
+        report: &IncrementReport<'_>,
+    ) -> std::io::Result<()> {
+        self.history.on_increment(model, report)?;
+        if let Some(fields) = self.fields.as_deref_mut() {
+            fields.on_increment(model, report)?;
+        }
+        Ok(())
+    }
 }
 
 /// Writes `path` through a temporary sibling and a rename, so readers never see half a file.

@@ -34,6 +34,9 @@ pub struct Case {
     /// Solver settings (all optional).
     #[serde(default)]
     pub solver: SolverSpec,
+    /// Field output (optional; none by default).
+    #[serde(default)]
+    pub output: OutputSpec,
 }
 
 /// The rigid drum: its inertia sits at the reference node on the axis.
@@ -54,12 +57,50 @@ pub struct DrumSpec {
     pub surface: DrumSurfaceSpec,
 }
 
-/// Drum surface idealization.
+/// Drum surface idealization. Whatever the idealization, the drum's inertia sits at its
+/// reference node and its surface carries no mass and no degrees of freedom.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum DrumSurfaceSpec {
     /// Analytical circle (2D) or cylinder (3D).
     Analytic,
+    /// `count` flat facets around the circumference, the elements of the rigid drum:
+    /// two-node rigid lines in 2D (R2D2); in 3D four-node rigid quads (R3D4), or membranes
+    /// (M3D4R) or shells (S4R) made rigid, with zero density and a zero-thickness contact
+    /// surface. Being rigid and massless, the three 3D element types share one contact geometry:
+    /// the polygon prism inscribed in the drum circle.
+    Facets {
+        /// Element type of the facets.
+        element: FacetElement,
+        /// Number of facets around the circumference.
+        count: usize,
+    },
+    /// A solid annular drum of four-node tetrahedra (C3D4) made rigid, zero density; contact
+    /// on its exterior faces (3D only).
+    Tetrahedra {
+        /// Cells around the circumference.
+        sectors: usize,
+        /// Cells through the wall.
+        rings: usize,
+        /// Cells across the width.
+        layers: usize,
+        /// Inner radius of the annulus, m.
+        inner_radius: f64,
+    },
+}
+
+/// Element types of a faceted drum.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum FacetElement {
+    /// Two-node rigid line (2D).
+    R2d2,
+    /// Four-node rigid quad (3D).
+    R3d4,
+    /// Four-node membrane made rigid (3D).
+    M3d4r,
+    /// Four-node shell made rigid (3D).
+    S4r,
 }
 
 /// The pad block and its mesh.
@@ -134,12 +175,31 @@ pub struct BackPlateSpec {
     pub mass: f64,
 }
 
-/// Coulomb friction between the pad's front face and the drum.
+/// Coulomb friction between the pad and the drum.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
     /// Friction coefficient.
     pub mu: f64,
+    /// How contact candidates are chosen.
+    #[serde(default)]
+    pub formulation: ContactFormulation,
+}
+
+/// How contact candidates are chosen.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ContactFormulation {
+    /// A contact pair: the pad's front face (slave) against the drum surface (master).
+    #[default]
+    Pair,
+    /// General contact: every node on any exterior face of the pad is tested against every
+    /// rigid surface, and kept as a candidate if its initial distance is below
+    /// `search_distance`.
+    General {
+        /// Search distance, m.
+        search_distance: f64,
+    },
 }
 
 /// One analysis step.
@@ -219,4 +279,14 @@ impl Default for SolverSpec {
             max_cutbacks: cutback.max_cutbacks,
         }
     }
+}
+
+/// Output settings; every field is optional.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Physical time between ParaView field frames in dynamic steps, s (`<out>/fields/`, see
+    /// [`crate::fields`]); frames are also written for the initial state, at the end of every
+    /// static step and at the end of the run. `None`: no field output.
+    pub field_interval: Option<f64>,
 }

@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 use thiserror::Error;
 
-use crate::schema::{Case, MaterialSpec, StepSpec};
+use crate::schema::{
+    Case, ContactFormulation, DrumSurfaceSpec, FacetElement, MaterialSpec, StepSpec,
+};
 
 /// A problem with a case file or its run.
 #[derive(Debug, Error)]
@@ -189,6 +191,66 @@ pub fn validate(case: &Case) -> Result<(), Problem> {
     if !d.omega0.is_finite() {
         return Err(("drum.omega0".into(), "expected a finite value".into()));
     }
+    match d.surface {
+        DrumSurfaceSpec::Analytic => {}
+        DrumSurfaceSpec::Facets { element, count } => {
+            let two_d = element == FacetElement::R2d2;
+            if two_d != (case.dimension == 2) {
+                return Err((
+                    "drum.surface.element".into(),
+                    format!(
+                        "expected {} in {}D, got {element:?}",
+                        if case.dimension == 2 {
+                            "r2d2"
+                        } else {
+                            "r3d4, m3d4r or s4r"
+                        },
+                        case.dimension
+                    ),
+                ));
+            }
+            if !(3..=100_000).contains(&count) {
+                return Err((
+                    "drum.surface.count".into(),
+                    format!("expected 3..=100000 facets, got {count}"),
+                ));
+            }
+        }
+        DrumSurfaceSpec::Tetrahedra {
+            sectors,
+            rings,
+            layers,
+            inner_radius,
+        } => {
+            if case.dimension != 3 {
+                return Err((
+                    "drum.surface".into(),
+                    "expected a 3D case for a tetrahedral drum".into(),
+                ));
+            }
+            if !(3..=100_000).contains(&sectors) {
+                return Err((
+                    "drum.surface.sectors".into(),
+                    format!("expected 3..=100000, got {sectors}"),
+                ));
+            }
+            for (field, n) in [
+                ("drum.surface.rings", rings),
+                ("drum.surface.layers", layers),
+            ] {
+                if !(1..=1000).contains(&n) {
+                    return Err((field.into(), format!("expected 1..=1000, got {n}")));
+                }
+            }
+            positive("drum.surface.inner_radius", inner_radius)?;
+            if inner_radius >= d.radius {
+                return Err((
+                    "drum.surface.inner_radius".into(),
+                    format!("expected less than the drum radius {}", d.radius),
+                ));
+            }
+        }
+    }
     let p = &case.pad;
     positive("pad.length", p.length)?;
     positive("pad.width", p.width)?;
@@ -230,6 +292,9 @@ pub fn validate(case: &Case) -> Result<(), Problem> {
     non_negative("back_plate.pressure", case.back_plate.pressure)?;
     non_negative("back_plate.mass", case.back_plate.mass)?;
     non_negative("contact.mu", case.contact.mu)?;
+    if let ContactFormulation::General { search_distance } = case.contact.formulation {
+        positive("contact.formulation.search_distance", search_distance)?;
+    }
     if case.steps.is_empty() {
         return Err(("steps".into(), "expected at least one step".into()));
     }
@@ -303,6 +368,9 @@ pub fn validate(case: &Case) -> Result<(), Problem> {
             "solver.cutback_factor".into(),
             format!("expected a value in (0, 1), got {}", s.cutback_factor),
         ));
+    }
+    if let Some(interval) = case.output.field_interval {
+        positive("output.field_interval", interval)?;
     }
     Ok(())
 }

@@ -78,6 +78,34 @@ fn non_physical_values_are_rejected_with_the_expected_range() {
         ),
         (with(|v| v["dimension"] = 4.into()), "dimension"),
         (with(|v| v["pad"]["length"] = 0.5.into()), "pad.length"),
+        (
+            with(|v| {
+                v["drum"]["surface"] =
+                    serde_json::json!({"type": "facets", "element": "r3d4", "count": 72})
+            }),
+            "drum.surface.element",
+        ),
+        (
+            with(|v| {
+                v["drum"]["surface"] =
+                    serde_json::json!({"type": "facets", "element": "r2d2", "count": 2})
+            }),
+            "drum.surface.count",
+        ),
+        (
+            with(|v| {
+                v["dimension"] = 3.into();
+                v["drum"]["surface"] = serde_json::json!({"type": "tetrahedra", "sectors": 72, "rings": 2, "layers": 1, "inner_radius": 0.3});
+            }),
+            "drum.surface.inner_radius",
+        ),
+        (
+            with(|v| {
+                v["contact"]["formulation"] =
+                    serde_json::json!({"type": "general", "search_distance": 0.0})
+            }),
+            "contact.formulation.search_distance",
+        ),
     ] {
         let (field, message) = error(&edit);
         assert_eq!(field, expected_field, "{message}");
