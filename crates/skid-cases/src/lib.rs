@@ -5,16 +5,23 @@
 //! - [`drum`]: building the drum scene (any idealization, 2D or 3D) as a model;
 //! - [`history`]: the per-increment history of the drum (`history.csv`);
 //! - [`summary`]: stop time, spin-down straightness, post-stop motion, energy balance;
-//! - [`runner`]: running one case into an output directory.
+//! - [`fields`]: ParaView field output (VTU frames and a PVD collection);
+//! - [`runner`]: running one case into an output directory;
+//! - [`batch`]: running many cases in parallel;
+//! - [`report`]: the validation report comparing the runs of a batch.
 
+pub mod batch;
 pub mod drum;
 pub mod fields;
 pub mod history;
+pub mod report;
 pub mod runner;
 pub mod schema;
 pub mod summary;
 pub mod validate;
 
+pub use batch::{BatchEntry, BatchError, BatchStatus, collect_case_files, run_batch};
+pub use report::{ReportError, ReportOutcome, write_report};
 pub use runner::{default_output_dir, run_case, run_case_file};
 pub use schema::Case;
 pub use summary::Summary;

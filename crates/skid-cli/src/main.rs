@@ -1,7 +1,11 @@
 //! `skid`: run braking-drum cases from the command line.
 //!
-//! Exit codes: 0 the run completed; 1 the run stopped early (its summary says where and why);
-//! 2 the case file or the command line is invalid; 3 results could not be written.
+//! Exit codes of `skid run`: 0 the run completed; 1 the run stopped early (its summary says
+//! where and why); 2 the case file or the command line is invalid; 3 results could not be
+//! written. `skid batch` and `skid report`: see [`batch`] and [`report`].
+
+mod batch;
+mod report;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -34,6 +38,30 @@ enum Command {
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         overrides: Vec<String>,
     },
+    /// Run case files in parallel, each into <out>/<case name>/; writes <out>/batch.json.
+    Batch {
+        /// Case files, or directories whose *.json files are run (sorted by name).
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        /// Output directory.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Cases run at once [default: one per core].
+        #[arg(long)]
+        jobs: Option<usize>,
+    },
+    /// Compare the runs of a batch with a reference run: a markdown report and two SVG plots.
+    Report {
+        /// Directory holding one subdirectory per run (summary.json, history.csv).
+        #[arg(long, default_value = "out")]
+        runs: PathBuf,
+        /// Reference run [default: 3d-analytic-fine, else the first 3d-analytic* run].
+        #[arg(long)]
+        reference: Option<String>,
+        /// The markdown report; the plots are written beside it.
+        #[arg(long, default_value = "validation/report.md")]
+        out: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -41,6 +69,12 @@ fn main() -> ExitCode {
     // The systems are small: threads inside one factorization cost more than they save.
     faer::set_global_parallelism(faer::Par::Seq);
     match cli.command {
+        Command::Batch { paths, out, jobs } => batch::run(&paths, &out, jobs.unwrap_or(0)),
+        Command::Report {
+            runs,
+            reference,
+            out,
+        } => report::run(&runs, reference.as_deref(), &out),
         Command::Run {
             case,
             out,

@@ -1,0 +1,473 @@
+//! The validation report: reads the runs of a batch (`<runs>/*/summary.json` and
+//! `history.csv`), compares every run's drum spin-down with a reference run (DRUM.md section 3)
+//! and writes a markdown report with two SVG plots next to it.
+//!
+//! - this module: reading runs, and the comparison math (interpolation, `e_slide`);
+//! - [`plot`]: the SVG plots;
+//! - [`markdown`]: the report text, its table and acceptance checks.
+
+pub mod markdown;
+pub mod plot;
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::runner::write_atomic;
+
+/// The run used as reference when none is requested.
+pub const DEFAULT_REFERENCE: &str = "3d-analytic-fine";
+
+/// Errors of the report.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    /// A file or directory could not be read.
+    #[error("{path}: cannot read: {source}")]
+    Read {
+        /// File or directory.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// A file is not what was expected.
+    #[error("{path}: {message}")]
+    Parse {
+        /// File.
+        path: PathBuf,
+        /// What was expected.
+        message: String,
+    },
+    /// No run directory (with a `summary.json`) was found.
+    #[error("{0}: no runs found (expected subdirectories with summary.json and history.csv)")]
+    NoRuns(PathBuf),
+    /// The reference run is absent.
+    #[error("{0}")]
+    Reference(String),
+    /// A plot could not be drawn.
+    #[error("{path}: cannot draw the plot: {message}")]
+    Plot {
+        /// The SVG file.
+        path: PathBuf,
+        /// Cause.
+        message: String,
+    },
+    /// An output could not be written.
+    #[error("{path}: cannot write: {source}")]
+    Write {
+        /// File or directory.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+}
+
+/// The fields of `summary.json` the report uses.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+pub struct RunSummary {
+    /// Case name.
+    pub case: String,
+    /// Spatial dimension.
+    pub dimension: usize,
+    /// `"completed"` or `"failed"`.
+    pub status: String,
+    /// Stop time from the start of the dynamic step, s.
+    pub t_stop: Option<f64>,
+    /// Initial angular velocity, rad/s.
+    pub omega0: f64,
+    /// Deceleration of the analytic estimate, rad/s^2.
+    pub deceleration_analytic: f64,
+    /// Largest `|omega|` after the stop, rad/s.
+    pub post_stop_max_abs_omega: Option<f64>,
+    /// Largest angle change after the stop, rad.
+    pub post_stop_max_angle_change: Option<f64>,
+    /// Relative energy balance error.
+    pub energy_balance_error: Option<f64>,
+    /// Converged increments.
+    pub increments: usize,
+    /// Newton iterations.
+    pub newton_iterations: usize,
+    /// Conic solves.
+    pub contact_solves: usize,
+    /// Wall time of the run, s.
+    pub wall_time_s: f64,
+}
+
+/// The drum's angular velocity over the dynamic part of a run.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct History {
+    /// Time from the start of the dynamic part, s (non-decreasing).
+    pub time: Vec<f64>,
+    /// Drum angular velocity, rad/s.
+    pub omega: Vec<f64>,
+}
+
+/// One run of a batch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Run {
+    /// The run's directory name (what the report calls it).
+    pub name: String,
+    /// Its summary.
+    pub summary: RunSummary,
+    /// Its dynamic history.
+    pub history: History,
+}
+
+/// Keeps the dynamic part of a history: the last row before time first advances (the state the
+/// dynamics starts from), then every row where time advances, shifted to start at zero. Static
+/// steps take no time, so their rows drop out. Rows beyond the shorter slice are ignored.
+pub fn dynamic_part(time: &[f64], omega: &[f64]) -> History {
+    let n = time.len().min(omega.len());
+    let (time, omega) = (&time[..n], &omega[..n]);
+    let mut out = History::default();
+    let Some(first) = time.windows(2).position(|w| w[1] > w[0]) else {
+        return out;
+    };
+    let t0 = time[first];
+    out.time.push(0.0);
+    out.omega.push(omega[first]);
+    let mut last = t0;
+    for (&t, &w) in time.iter().zip(omega).skip(first + 1) {
+        if t > last {
+            out.time.push(t - t0);
+            out.omega.push(w);
+            last = t;
+        }
+    }
+    out
+}
+
+/// Reads `history.csv` text (columns found by name: `time`, `drum_omega`) and keeps its
+/// dynamic part ([`dynamic_part`]); `path` is only used in messages.
+///
+/// # Errors
+/// [`ReportError::Parse`] naming the line and column at fault.
+pub fn parse_history(text: &str, path: &Path) -> Result<History, ReportError> {
+    let parse_error = |message: String| ReportError::Parse {
+        path: path.to_path_buf(),
+        message,
+    };
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines
+        .next()
+        .ok_or_else(|| parse_error("empty file, expected a CSV header".into()))?
+        .split(',')
+        .collect();
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|c| c.trim() == name)
+            .ok_or_else(|| parse_error(format!("no column '{name}' in the header")))
+    };
+    let (it, iw) = (column("time")?, column("drum_omega")?);
+    let (mut time, mut omega) = (Vec::new(), Vec::new());
+    for (k, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+        let fields: Vec<&str> = line.split(',').collect();
+        let value = |i: usize, name: &str| {
+            fields
+                .get(i)
+                .and_then(|f| f.trim().parse::<f64>().ok())
+                .ok_or_else(|| {
+                    parse_error(format!("line {}: expected a number in '{name}'", k + 2))
+                })
+        };
+        time.push(value(it, "time")?);
+        omega.push(value(iw, "drum_omega")?);
+    }
+    Ok(dynamic_part(&time, &omega))
+}
+
+/// Linear interpolation of `values(times)` at `t`; `None` outside `[times[0], times[last]]`
+/// or if the slices differ in length. `times` must be non-decreasing.
+pub fn interpolate(times: &[f64], values: &[f64], t: f64) -> Option<f64> {
+    if times.len() != values.len() {
+        return None;
+    }
+    let (&first, &last) = (times.first()?, times.last()?);
+    if !(first..=last).contains(&t) {
+        return None;
+    }
+    let k = times.partition_point(|&x| x < t);
+    if times[k] == t || k == 0 {
+        return Some(values[k]);
+    }
+    let (t0, t1) = (times[k - 1], times[k]);
+    let s = (t - t0) / (t1 - t0);
+    Some(values[k - 1] + s * (values[k] - values[k - 1]))
+}
+
+/// `omega(t) - omega_ref(t)` at each of the run's times that the reference covers.
+pub fn omega_difference(run: &History, reference: &History) -> Vec<(f64, f64)> {
+    run.time
+        .iter()
+        .zip(&run.omega)
+        .filter_map(|(&t, &w)| {
+            interpolate(&reference.time, &reference.omega, t).map(|r| (t, w - r))
+        })
+        .collect()
+}
+
+/// `e_slide = max |omega(t) - omega_ref(t)| / |omega0|` over the run's times `t <= 0.9 t_stop`
+/// (DRUM.md section 3); `None` if the reference does not cover that interval.
+pub fn e_slide(run: &History, t_stop: f64, omega0: f64, reference: &History) -> Option<f64> {
+    let mut worst = 0.0_f64;
+    for (&t, &w) in run.time.iter().zip(&run.omega) {
+        if t > 0.9 * t_stop {
+            break;
+        }
+        let r = interpolate(&reference.time, &reference.omega, t)?;
+        worst = worst.max((w - r).abs() / omega0.abs());
+    }
+    Some(worst)
+}
+
+fn read(path: &Path) -> Result<String, ReportError> {
+    std::fs::read_to_string(path).map_err(|source| ReportError::Read {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Reads one run directory.
+///
+/// # Errors
+/// [`ReportError`] naming the file that is missing or malformed.
+pub fn load_run(dir: &Path) -> Result<Run, ReportError> {
+    let summary_path = dir.join("summary.json");
+    let summary: RunSummary =
+        serde_json::from_str(&read(&summary_path)?).map_err(|e| ReportError::Parse {
+            path: summary_path.clone(),
+            message: format!("expected a skid run summary: {e}"),
+        })?;
+    let history_path = dir.join("history.csv");
+    let history = parse_history(&read(&history_path)?, &history_path)?;
+    let name = dir
+        .file_name()
+        .map_or_else(|| summary.case.clone(), |n| n.to_string_lossy().into());
+    Ok(Run {
+        name,
+        summary,
+        history,
+    })
+}
+
+/// Reads every subdirectory of `runs` that holds a `summary.json`, sorted by name.
+///
+/// # Errors
+/// [`ReportError`] if `runs` cannot be listed, a run is malformed, or there is none.
+pub fn load_runs(runs: &Path) -> Result<Vec<Run>, ReportError> {
+    let list = |source| ReportError::Read {
+        path: runs.to_path_buf(),
+        source,
+    };
+    let mut dirs = Vec::new();
+    for entry in std::fs::read_dir(runs).map_err(list)? {
+        let dir = entry.map_err(list)?.path();
+        if dir.join("summary.json").is_file() {
+            dirs.push(dir);
+        }
+    }
+    if dirs.is_empty() {
+        return Err(ReportError::NoRuns(runs.to_path_buf()));
+    }
+    dirs.sort();
+    dirs.iter().map(|d| load_run(d)).collect()
+}
+
+/// Index of the reference run: `requested`, else [`DEFAULT_REFERENCE`], else the first run
+/// whose name starts with `3d-analytic`.
+///
+/// # Errors
+/// [`ReportError::Reference`] listing the runs present if there is no such run.
+pub fn choose_reference(runs: &[Run], requested: Option<&str>) -> Result<usize, ReportError> {
+    let find = |name: &str| runs.iter().position(|r| r.name == name);
+    let found = match requested {
+        Some(name) => find(name),
+        None => find(DEFAULT_REFERENCE)
+            .or_else(|| runs.iter().position(|r| r.name.starts_with("3d-analytic"))),
+    };
+    found.ok_or_else(|| {
+        let names: Vec<&str> = runs.iter().map(|r| r.name.as_str()).collect();
+        let wanted = requested.map_or_else(
+            || format!("{DEFAULT_REFERENCE} or a 3d-analytic* run (pass --reference NAME)"),
+            |n| format!("'{n}'"),
+        );
+        ReportError::Reference(format!(
+            "no reference run {wanted}; runs present: {}",
+            names.join(", ")
+        ))
+    })
+}
+
+/// What [`write_report`] wrote and found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReportOutcome {
+    /// The reference run's name.
+    pub reference: String,
+    /// Files written: the markdown report and the plots.
+    pub files: Vec<PathBuf>,
+    /// Acceptance checks passed, failed and skipped.
+    pub counts: markdown::Counts,
+}
+
+/// Reads the runs in `runs`, and writes the report `out` with `omega.svg` and
+/// `omega-difference.svg` beside it.
+///
+/// # Errors
+/// [`ReportError`] for unreadable runs, an absent reference, or outputs that cannot be written.
+pub fn write_report(
+    runs_dir: &Path,
+    reference: Option<&str>,
+    out: &Path,
+) -> Result<ReportOutcome, ReportError> {
+    let runs = load_runs(runs_dir)?;
+    let r = choose_reference(&runs, reference)?;
+    let dir = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(|source| ReportError::Write {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let omega_svg = dir.join(plot::OMEGA_SVG);
+    let difference_svg = dir.join(plot::DIFFERENCE_SVG);
+    plot::plot_omega(&runs, &runs[r], &omega_svg)?;
+    plot::plot_difference(&runs, &runs[r], &difference_svg)?;
+    let (text, counts) = markdown::render(runs_dir, &runs, r);
+    write_atomic(out, &text).map_err(|source| ReportError::Write {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    Ok(ReportOutcome {
+        reference: runs[r].name.clone(),
+        files: vec![out.to_path_buf(), omega_svg, difference_svg],
+        counts,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn linear(omega0: f64, decel: f64, dt: f64, n: usize) -> History {
+        let time: Vec<f64> = (0..=n).map(|k| k as f64 * dt).collect();
+        let omega = time.iter().map(|t| omega0 - decel * t).collect();
+        History { time, omega }
+    }
+
+    #[test]
+    fn interpolation_is_exact_on_lines_and_undefined_outside() {
+        let h = History {
+            time: vec![0.0, 1.0, 3.0],
+            omega: vec![10.0, 8.0, 0.0],
+        };
+        assert_eq!(interpolate(&h.time, &h.omega, 0.0), Some(10.0));
+        assert_eq!(interpolate(&h.time, &h.omega, 0.5), Some(9.0));
+        assert_eq!(interpolate(&h.time, &h.omega, 2.0), Some(4.0));
+        assert_eq!(interpolate(&h.time, &h.omega, 3.0), Some(0.0));
+        assert_eq!(interpolate(&h.time, &h.omega, 3.5), None);
+        assert_eq!(interpolate(&h.time, &h.omega, -0.1), None);
+        assert_eq!(interpolate(&[], &[], 0.0), None);
+        assert_eq!(interpolate(&h.time, &h.omega[..2], 0.5), None);
+    }
+
+    #[test]
+    fn e_slide_of_a_steeper_line_is_the_gap_at_ninety_percent_of_its_stop() {
+        // Reference 60 - 600 t on a fine grid; run 60 - 606 t on a coarser, offset grid.
+        let reference = linear(60.0, 600.0, 1e-4, 1500);
+        let run = linear(60.0, 606.0, 3e-4, 500);
+        let t_stop = 60.0 / 606.0;
+        // The largest gap 6 t is at the last sample with t <= 0.9 t_stop.
+        let last = run
+            .time
+            .iter()
+            .copied()
+            .filter(|&t| t <= 0.9 * t_stop)
+            .fold(0.0, f64::max);
+        let e = e_slide(&run, t_stop, 60.0, &reference).expect("covered");
+        assert!((e - 6.0 * last / 60.0).abs() < 1e-12, "{e}");
+        assert!(e > 0.0085 && e < 0.0091, "{e}");
+        assert_eq!(e_slide(&reference, 0.1, 60.0, &reference), Some(0.0));
+    }
+
+    #[test]
+    fn e_slide_needs_a_reference_that_covers_the_sliding_phase() {
+        let reference = linear(60.0, 600.0, 1e-3, 50);
+        let run = linear(60.0, 600.0, 1e-3, 150);
+        assert_eq!(e_slide(&run, 0.1, 60.0, &reference), None);
+    }
+
+    #[test]
+    fn difference_is_taken_where_the_reference_is_defined() {
+        let reference = linear(60.0, 600.0, 1e-3, 10);
+        let run = linear(61.0, 600.0, 2e-3, 10);
+        let d = omega_difference(&run, &reference);
+        assert_eq!(d.len(), 6);
+        assert!(d.iter().all(|&(_, e)| (e - 1.0).abs() < 1e-12));
+    }
+
+    #[test]
+    fn history_keeps_the_dynamic_rows_from_the_state_the_dynamics_starts_from() {
+        let text = "time,step,drum_omega\n\
+                    0.0,initial,60\n\
+                    0.0,preload,60\n\
+                    0.0,preload,60.5\n\
+                    0.5,spin,50\n\
+                    1.0,spin,40\n\
+                    1.0,settle,41\n";
+        let h = parse_history(text, Path::new("h.csv")).expect("parses");
+        assert_eq!(h.time, vec![0.0, 0.5, 1.0]);
+        assert_eq!(h.omega, vec![60.5, 50.0, 40.0]);
+    }
+
+    #[test]
+    fn malformed_histories_name_the_file_line_and_column() {
+        let e = parse_history("time,x\n0,1\n", Path::new("run/history.csv"))
+            .expect_err("no omega column");
+        assert!(e.to_string().contains("run/history.csv"), "{e}");
+        assert!(e.to_string().contains("drum_omega"), "{e}");
+        let e = parse_history("time,drum_omega\n0,1\n0.1,oops\n", Path::new("h.csv"))
+            .expect_err("not a number");
+        assert!(e.to_string().contains("line 3"), "{e}");
+    }
+
+    fn run(name: &str) -> Run {
+        Run {
+            name: name.into(),
+            summary: RunSummary {
+                case: name.into(),
+                dimension: 3,
+                status: "completed".into(),
+                t_stop: Some(0.1),
+                omega0: 60.0,
+                deceleration_analytic: 600.0,
+                post_stop_max_abs_omega: None,
+                post_stop_max_angle_change: None,
+                energy_balance_error: None,
+                increments: 0,
+                newton_iterations: 0,
+                contact_solves: 0,
+                wall_time_s: 0.0,
+            },
+            history: History::default(),
+        }
+    }
+
+    #[test]
+    fn the_reference_defaults_to_the_fine_run_then_to_the_first_analytic_3d_run() {
+        let runs = [
+            run("2d-analytic"),
+            run("3d-analytic"),
+            run("3d-analytic-fine"),
+        ];
+        assert_eq!(choose_reference(&runs, None).expect("fine"), 2);
+        assert_eq!(choose_reference(&runs[..2], None).expect("pair"), 1);
+        assert_eq!(
+            choose_reference(&runs, Some("2d-analytic")).expect("asked"),
+            0
+        );
+        let e = choose_reference(&runs[..1], None).expect_err("none");
+        assert!(e.to_string().contains("2d-analytic"), "{e}");
+        assert!(choose_reference(&runs, Some("nope")).is_err());
+    }
+}

@@ -1,0 +1,216 @@
+//! The report's SVG plots (plotters' SVG backend: text is written as SVG `<text>` elements, so
+//! no font files are needed).
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use super::{ReportError, Run, omega_difference};
+use crate::runner::write_atomic;
+
+/// File name of the omega(t) plot.
+pub const OMEGA_SVG: &str = "omega.svg";
+/// File name of the omega(t) - omega_ref(t) plot.
+pub const DIFFERENCE_SVG: &str = "omega-difference.svg";
+
+const SIZE: (u32, u32) = (960, 600);
+
+/// One curve of a plot.
+struct Curve {
+    label: String,
+    points: Vec<(f64, f64)>,
+    /// Drawn dashed in black (the analytic estimate) rather than in a palette colour.
+    dashed: bool,
+}
+
+/// The range of `values` with 5 % margins (a unit-wide range around a single value).
+fn padded_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if lo > hi {
+        return 0.0..1.0;
+    }
+    let pad = if hi > lo { 0.05 * (hi - lo) } else { 0.5 };
+    (lo - pad)..(hi + pad)
+}
+
+/// Draws `curves` into the SVG file `path`.
+fn draw(
+    path: &Path,
+    title: &str,
+    y_label: &str,
+    curves: &[Curve],
+    legend: SeriesLabelPosition,
+) -> Result<(), ReportError> {
+    let error = |e: &dyn std::fmt::Display| ReportError::Plot {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let points = || curves.iter().flat_map(|c| c.points.iter());
+    let x = padded_range(points().map(|p| p.0));
+    let x = x.start.max(0.0)..x.end;
+    let y = padded_range(points().map(|p| p.1));
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| error(&e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(72)
+            .build_cartesian_2d(x, y)
+            .map_err(|e| error(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("t [s] (from the start of the dynamic step)")
+            .y_desc(y_label)
+            .draw()
+            .map_err(|e| error(&e))?;
+        let mut palette = 0;
+        for curve in curves {
+            let color = if curve.dashed {
+                BLACK.to_rgba()
+            } else {
+                palette += 1;
+                Palette99::pick(palette - 1).to_rgba()
+            };
+            let style = color.stroke_width(2);
+            let points = curve.points.iter().copied();
+            if curve.dashed {
+                chart.draw_series(DashedLineSeries::new(points, 8, 6, style))
+            } else {
+                chart.draw_series(LineSeries::new(points, style))
+            }
+            .map_err(|e| error(&e))?
+            .label(curve.label.as_str())
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color));
+        }
+        chart
+            .configure_series_labels()
+            .position(legend)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| error(&e))?;
+        root.present().map_err(|e| error(&e))?;
+    }
+    write_atomic(path, &svg).map_err(|source| ReportError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn points(times: &[f64], values: &[f64]) -> Vec<(f64, f64)> {
+    times.iter().copied().zip(values.iter().copied()).collect()
+}
+
+/// `omega.svg`: omega(t) of every run, and the analytic line `omega0 - decel t` of the
+/// reference's case (60 - 600 t for the drum) down to zero.
+///
+/// # Errors
+/// [`ReportError`] if the plot cannot be drawn or written.
+pub fn plot_omega(runs: &[Run], reference: &Run, path: &Path) -> Result<(), ReportError> {
+    let mut curves: Vec<Curve> = runs
+        .iter()
+        .map(|r| Curve {
+            label: r.name.clone(),
+            points: points(&r.history.time, &r.history.omega),
+            dashed: false,
+        })
+        .collect();
+    let (w0, decel) = (
+        reference.summary.omega0,
+        reference.summary.deceleration_analytic,
+    );
+    if decel.abs() > 0.0 {
+        curves.push(Curve {
+            label: format!("analytic {w0} - {decel:.0} t"),
+            points: vec![(0.0, w0), (w0 / decel, 0.0)],
+            dashed: true,
+        });
+    }
+    draw(
+        path,
+        "Drum angular velocity",
+        "omega [rad/s]",
+        &curves,
+        SeriesLabelPosition::UpperRight,
+    )
+}
+
+/// `omega-difference.svg`: omega(t) - omega_ref(t) of every run but the reference, the
+/// reference interpolated at the run's times.
+///
+/// # Errors
+/// [`ReportError`] if the plot cannot be drawn or written.
+pub fn plot_difference(runs: &[Run], reference: &Run, path: &Path) -> Result<(), ReportError> {
+    let curves: Vec<Curve> = runs
+        .iter()
+        .filter(|r| r.name != reference.name)
+        .map(|r| Curve {
+            label: r.name.clone(),
+            points: omega_difference(&r.history, &reference.history),
+            dashed: false,
+        })
+        .collect();
+    let title = format!("Difference to the reference {}", reference.name);
+    draw(
+        path,
+        &title,
+        "omega - omega_ref [rad/s]",
+        &curves,
+        SeriesLabelPosition::LowerLeft,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_are_padded_and_degenerate_ones_widened() {
+        assert_eq!(padded_range([0.0, 10.0].into_iter()), -0.5..10.5);
+        assert_eq!(padded_range([2.0].into_iter()), 1.5..2.5);
+        assert_eq!(padded_range(std::iter::empty()), 0.0..1.0);
+        assert_eq!(padded_range([f64::NAN, 1.0, 3.0].into_iter()), 0.9..3.1);
+    }
+
+    #[test]
+    fn plots_are_svg_with_text_labels_and_one_path_per_curve() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("p.svg");
+        let curves = [
+            Curve {
+                label: "run-a".into(),
+                points: vec![(0.0, 60.0), (0.1, 0.0)],
+                dashed: false,
+            },
+            Curve {
+                label: "analytic".into(),
+                points: vec![(0.0, 60.0), (0.1, 0.0)],
+                dashed: true,
+            },
+        ];
+        draw(
+            &path,
+            "title",
+            "omega [rad/s]",
+            &curves,
+            SeriesLabelPosition::UpperRight,
+        )
+        .expect("draws");
+        let svg = std::fs::read_to_string(&path).expect("written");
+        assert!(svg.starts_with("<svg"), "{}", &svg[..50]);
+        for text in ["title", "omega [rad/s]", "run-a", "analytic"] {
+            assert!(
+                svg.contains(&format!("\n{text}\n</text>")),
+                "no text {text}"
+            );
+        }
+        assert!(svg.contains("<polyline"));
+    }
+}

@@ -1,0 +1,94 @@
+//! `skid batch`: runs case files in parallel with a progress bar and lists the outcomes.
+//!
+//! Exit codes: 0 every case completed; 1 some case could not be run or stopped early; 2 no case
+//! files were found; 3 `batch.json` could not be written.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Duration;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use skid_cases::{BatchEntry, BatchError, BatchStatus, collect_case_files, run_batch};
+
+/// The progress bar on stderr; indicatif hides it when stderr is not a terminal.
+fn progress_bar(cases: usize) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(Some(cases as u64), ProgressDrawTarget::stderr());
+    if let Ok(style) =
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} cases {msg}")
+    {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.enable_steady_tick(Duration::from_millis(250));
+    bar
+}
+
+/// One line of the final listing.
+fn line(entry: &BatchEntry, width: usize) -> String {
+    let t_stop = entry
+        .summary
+        .as_ref()
+        .and_then(|s| s.t_stop)
+        .map_or_else(|| "-".to_string(), |t| format!("{t:.6}"));
+    format!(
+        "{:<width$}  {:<9}  t_stop {:>8} s  wall {:>8.2} s",
+        entry.name,
+        entry.status.as_str(),
+        t_stop,
+        entry.wall_time_s,
+    )
+}
+
+/// Runs `paths` into `out` on `jobs` threads (0: one per core).
+pub fn run(paths: &[PathBuf], out: &Path, jobs: usize) -> ExitCode {
+    let files = match collect_case_files(paths) {
+        Ok(files) => files,
+        Err(e) => {
+            eprintln!("skid: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let bar = progress_bar(files.len());
+    let entries = run_batch(&files, out, jobs, |entry| {
+        if let Some(error) = &entry.error {
+            bar.suspend(|| {
+                eprintln!(
+                    "skid: {} ({}): {}: {error}",
+                    entry.name,
+                    entry.case_file.display(),
+                    entry.status.as_str()
+                );
+            });
+        }
+        bar.set_message(format!("{} {}", entry.name, entry.status.as_str()));
+        bar.inc(1);
+    });
+    bar.finish_and_clear();
+    let entries = match entries {
+        Ok(entries) => entries,
+        Err(e) => {
+            eprintln!("skid: {e}");
+            return ExitCode::from(match e {
+                BatchError::Output { .. } => 3,
+                _ => 2,
+            });
+        }
+    };
+    let width = entries.iter().map(|e| e.name.len()).max().unwrap_or(0);
+    for entry in &entries {
+        println!("{}", line(entry, width));
+    }
+    let completed = entries
+        .iter()
+        .filter(|e| e.status == BatchStatus::Completed)
+        .count();
+    println!(
+        "{completed} of {} cases completed; see {}",
+        entries.len(),
+        out.join("batch.json").display()
+    );
+    if completed == entries.len() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}
