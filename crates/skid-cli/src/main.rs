@@ -1,17 +1,15 @@
 //! `skid`: run braking-drum cases from the command line.
 //!
-//! Exit codes of `skid run`: 0 the run completed; 1 the run stopped early (its summary says
-//! where and why); 2 the case file or the command line is invalid; 3 results could not be
-//! written. `skid batch` and `skid report`: see [`batch`] and [`report`].
+//! One module per command, each documenting its exit codes: [`run`], [`batch`], [`report`].
 
 mod batch;
 mod report;
+mod run;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use skid_cases::{CaseError, run_case_file};
 
 #[derive(Parser)]
 #[command(
@@ -79,26 +77,6 @@ fn main() -> ExitCode {
             case,
             out,
             overrides,
-        } => match run_case_file(&case, &overrides, out.as_deref()) {
-            Ok(summary) => {
-                match serde_json::to_string(&summary) {
-                    Ok(line) => println!("{line}"),
-                    Err(e) => eprintln!("skid: cannot print the summary: {e}"),
-                }
-                if let Some(error) = &summary.error {
-                    eprintln!("skid: {}: run stopped early: {error}", case.display());
-                    ExitCode::from(1)
-                } else {
-                    ExitCode::SUCCESS
-                }
-            }
-            Err(e) => {
-                eprintln!("skid: {e}");
-                ExitCode::from(match e {
-                    CaseError::Output { .. } => 3,
-                    _ => 2,
-                })
-            }
-        },
+        } => run::run(&case, &overrides, out.as_deref()),
     }
 }
