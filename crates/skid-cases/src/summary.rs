@@ -60,8 +60,13 @@ pub struct Summary {
     pub friction_work_j: Option<f64>,
     /// `|drum energy lost - friction work - other work| / drum energy lost`, where the other
     /// work is the change of the pad's kinetic, strain and hourglass energy minus the work of
-    /// the pressure and of the normal contact forces.
+    /// the pressure and of the normal contact forces. `None` when the drum loses less than a
+    /// millionth of its initial kinetic energy (frictionless runs): the ratio has no meaning
+    /// there, and `energy_balance_residual_j` says how well energy is conserved.
     pub energy_balance_error: Option<f64>,
+    /// The numerator of `energy_balance_error`, J (signed: positive when energy is lost to
+    /// the time integration's numerical dissipation).
+    pub energy_balance_residual_j: Option<f64>,
     /// Largest hourglass energy / strain energy over the dynamic steps.
     pub max_hourglass_ratio: Option<f64>,
     /// Deepest penetration over the run, m.
@@ -158,18 +163,23 @@ pub fn summarize(
     let mean_normal = (!sliding.is_empty() && t_stop.is_some())
         .then(|| sliding.iter().map(|s| s.normal_force).sum::<f64>() / sliding.len() as f64);
 
-    let (mut lost, mut friction, mut balance) = (None, None, None);
+    let (mut lost, mut friction, mut balance, mut residual_j) = (None, None, None, None);
     if let (Some(b), Some(e)) = (dynamic.first(), dynamic.last()) {
         let inertia = case.drum.rotary_inertia;
         let drum_lost = 0.5 * inertia * (b.omega * b.omega - e.omega * e.omega);
         let d_friction = e.friction_dissipation - b.friction_dissipation;
-        let residual = (e.mechanical_energy - b.mechanical_energy)
+        // Energy the system lost beyond friction: -(change of mechanical energy - work done
+        // on it - work of the normal contact forces + frictional dissipation).
+        let residual = -((e.mechanical_energy - b.mechanical_energy)
             - (e.external_work - b.external_work)
             - (e.normal_work - b.normal_work)
-            + d_friction;
+            + d_friction);
+        let initial_drum_energy = 0.5 * inertia * b.omega * b.omega;
         lost = Some(drum_lost);
         friction = Some(d_friction);
-        balance = (drum_lost.abs() > 0.0).then(|| residual.abs() / drum_lost.abs());
+        residual_j = Some(residual);
+        balance = (drum_lost.abs() > 1e-6 * initial_drum_energy)
+            .then(|| residual.abs() / drum_lost.abs());
     }
     let max_hourglass_ratio = (!dynamic.is_empty()).then(|| {
         dynamic
@@ -210,6 +220,7 @@ pub fn summarize(
         drum_energy_lost_j: lost,
         friction_work_j: friction,
         energy_balance_error: balance,
+        energy_balance_residual_j: residual_j,
         max_hourglass_ratio,
         max_gap_violation_m: samples
             .iter()

@@ -81,6 +81,13 @@ fn without_friction_the_drum_keeps_its_speed() {
     let (s, dir) = run(&["contact.mu=0", "steps[1].duration=0.01"]);
     assert_eq!(s.status, "completed", "{:?}", s.error);
     assert_eq!(s.t_stop, None);
+    // Nothing to lose: the balance is judged in joules, against the drum's 315 J.
+    assert_eq!(s.energy_balance_error, None);
+    let residual = s.energy_balance_residual_j.expect("residual");
+    assert!(
+        residual.abs() < 1e-3 * 315.0,
+        "energy residual {residual} J"
+    );
     let history = std::fs::read_to_string(dir.path().join("history.csv")).expect("history");
     let header: Vec<&str> = history.lines().next().expect("header").split(',').collect();
     let col = header
