@@ -19,7 +19,7 @@ use std::time::{Duration, Instant};
 
 use nalgebra::{DVector, Vector2};
 
-use crate::assembly::{Assembler, external_forces};
+use crate::assembly::{Assembler, InternalState, external_forces};
 use crate::coupling::{ContactRows, contact_rows, solve_contact_forces};
 use crate::dof::EquationKind;
 use crate::error::IncrementFailure;
@@ -189,9 +189,15 @@ pub fn solve_increment<const D: usize>(
             if force_residual <= newton.force_tolerance
                 && contact_residual <= newton.contact_tolerance
             {
-                let state = finish(
-                    model, start, kind, x, v, a, net, f_ext, &internal, &rows, r, shift,
-                );
+                let iterate = Iterate {
+                    x,
+                    v,
+                    a,
+                    net,
+                    f_ext,
+                    internal,
+                };
+                let state = finish(model, start, kind, iterate, &rows, r, shift);
                 return Ok((state, counters));
             }
             if iteration == newton.max_iterations {
@@ -267,22 +273,35 @@ fn scaled_force_residual<const D: usize>(
     if scale > 0.0 { worst / scale } else { worst }
 }
 
+/// The converged iterate: unknowns, their rates, and the forces evaluated there.
+struct Iterate {
+    x: DVector<f64>,
+    v: DVector<f64>,
+    a: DVector<f64>,
+    /// `f_int - f_ext`.
+    net: DVector<f64>,
+    f_ext: DVector<f64>,
+    internal: InternalState,
+}
+
 /// Builds the converged state and updates the energy ledger.
-#[allow(clippy::too_many_arguments)]
 fn finish<const D: usize>(
     model: &Model<D>,
     start: &State,
     kind: IncrementKind,
-    x: DVector<f64>,
-    v: DVector<f64>,
-    a: DVector<f64>,
-    net: DVector<f64>,
-    f_ext: DVector<f64>,
-    internal: &crate::assembly::InternalState,
+    iterate: Iterate,
     rows: &ContactRows,
     r: &DVector<f64>,
     shift: Vec<f64>,
 ) -> State {
+    let Iterate {
+        x,
+        v,
+        a,
+        net,
+        f_ext,
+        internal,
+    } = iterate;
     let d = rows.components;
     let mut contacts = Vec::with_capacity(rows.len());
     let mut friction = 0.0;
