@@ -28,6 +28,8 @@ use crate::schema::{Case, ContactFormulation, DrumSurfaceSpec, MaterialSpec, Ste
 pub const DRUM: usize = 0;
 /// Index of the back plate among the model's rigid bodies.
 pub const BACK_PLATE: usize = 1;
+/// Names of the rigid bodies, by index (as case files name them in a step's `hold`).
+pub const BODY_NAMES: [&str; 2] = ["drum", "back_plate"];
 
 /// A built scene: model, steps and solver settings.
 #[derive(Debug)]
@@ -84,7 +86,7 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
         .ok_or("pad mesh has no surface 'ymax'")?;
 
     let drum = RigidBody::<D> {
-        name: "drum".into(),
+        name: BODY_NAMES[DRUM].into(),
         reference_point: SVector::zeros(),
         mass: case.drum.mass,
         rotary_inertia: case.drum.rotary_inertia,
@@ -98,7 +100,7 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
     let mut free = [false; D];
     free[1] = true;
     let plate = RigidBody::<D> {
-        name: "back_plate".into(),
+        name: BODY_NAMES[BACK_PLATE].into(),
         reference_point: plate_point,
         mass: case.back_plate.mass,
         rotary_inertia: 0.0,
@@ -142,7 +144,16 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
     )
     .map_err(|e| e.to_string())?;
 
-    let body_index = |name: &str| if name == "drum" { DRUM } else { BACK_PLATE };
+    let held = |hold: &[String]| -> Result<Vec<usize>, String> {
+        hold.iter()
+            .map(|h| {
+                BODY_NAMES
+                    .iter()
+                    .position(|b| b == h)
+                    .ok_or_else(|| format!("no rigid body named '{h}' to hold"))
+            })
+            .collect()
+    };
     let steps = case
         .steps
         .iter()
@@ -152,31 +163,31 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
                 increments,
                 hold,
                 regularization_time,
-            } => Step {
+            } => Ok(Step {
                 name: name.clone(),
                 kind: StepKind::Static {
                     increments: *increments,
                     regularization_time: *regularization_time,
                 },
-                held_bodies: hold.iter().map(|h| body_index(h)).collect(),
-            },
+                held_bodies: held(hold)?,
+            }),
             StepSpec::Dynamic {
                 name,
                 duration,
                 dt,
                 alpha,
                 hold,
-            } => Step {
+            } => Ok(Step {
                 name: name.clone(),
                 kind: StepKind::Dynamic {
                     duration: *duration,
                     dt: *dt,
                     alpha: *alpha,
                 },
-                held_bodies: hold.iter().map(|h| body_index(h)).collect(),
-            },
+                held_bodies: held(hold)?,
+            }),
         })
-        .collect();
+        .collect::<Result<Vec<_>, String>>()?;
     let s = &case.solver;
     let settings = Settings {
         newton: NewtonSettings {

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 use thiserror::Error;
 
+use crate::drum::BODY_NAMES;
 use crate::schema::{
     Case, ContactFormulation, DrumSurfaceSpec, FacetElement, MaterialSpec, StepSpec,
 };
@@ -331,16 +332,12 @@ pub fn validate(case: &Case) -> Result<(), Problem> {
                 if dt > duration {
                     return Err((f("dt"), format!("expected dt <= duration ({duration})")));
                 }
-                if !(alpha.is_finite() && (-1.0 / 3.0 - 1e-12..=0.0).contains(alpha)) {
-                    return Err((
-                        f("alpha"),
-                        format!("expected a value in [-1/3, 0], got {alpha}"),
-                    ));
-                }
+                // The integrator owns the admissible range; its message names it.
+                skid_integrator::hht::Hht::new(*alpha).map_err(|message| (f("alpha"), message))?;
                 hold
             }
         };
-        if let Some(h) = hold.iter().find(|h| *h != "drum" && *h != "back_plate") {
+        if let Some(h) = hold.iter().find(|h| !BODY_NAMES.contains(&h.as_str())) {
             return Err((
                 f("hold"),
                 format!("expected \"drum\" or \"back_plate\", got \"{h}\""),

@@ -35,7 +35,7 @@ impl Hht {
     /// A message if `alpha` is outside [-1/3, 0].
     pub fn new(alpha: f64) -> Result<Self, String> {
         if !(alpha.is_finite() && (-1.0 / 3.0 - 1e-12..=0.0).contains(&alpha)) {
-            return Err(format!("HHT alpha must lie in [-1/3, 0], got {alpha}"));
+            return Err(format!("expected HHT alpha in [-1/3, 0], got {alpha}"));
         }
         Ok(Self {
             alpha,
