@@ -302,6 +302,17 @@ fn finish<const D: usize>(
         f_ext,
         internal,
     } = iterate;
+    // The mean contact force over the increment and, for a dynamic increment, the velocity and
+    // smooth acceleration with the contact impulse (see `crate::hht`).
+    let (r, v, a) = match kind {
+        IncrementKind::Static { .. } => (r.clone(), v, a),
+        IncrementKind::Dynamic { hht, h } => {
+            let contact = rows.transpose_times(r, x.len()).component_div(model.mass());
+            let (v, a) = hht.split_impulse(h, &start.v, &start.a, &a, &contact);
+            (r * hht.impulse_force_factor(), v, a)
+        }
+    };
+    let r = &r;
     let d = rows.components;
     let mut contacts = Vec::with_capacity(rows.len());
     let mut friction = 0.0;
