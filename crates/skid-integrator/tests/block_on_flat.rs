@@ -221,7 +221,7 @@ fn block_slides_above_mu_n_with_friction_exactly_mu_n() {
 /// bottom nodes bounce and slide, contacts open and close many times. The contact impulses are
 /// integrated so that their work is exactly `p . du` (see `skid_integrator::hht`), so the
 /// energy ledger must close: kinetic + strain + hourglass = pressure work + normal contact work
-/// - friction dissipation, up to the trapezoidal rule's error on the nonlinear forces. A contact
+/// minus friction dissipation, up to the trapezoidal rule's error on the nonlinear forces. A contact
 /// force that kept acting after its contact opened would break this balance.
 #[test]
 fn energy_balance_closes_through_contact_chatter() {
