@@ -137,6 +137,8 @@ pub struct RunStatistics {
     pub fixed_point_iterations: usize,
     /// Failed attempts answered by a cutback.
     pub cutbacks: usize,
+    /// The failed attempts by kind of failure ([`IncrementFailure::kind`]).
+    pub cutback_causes: std::collections::BTreeMap<&'static str, usize>,
     /// Time spent in the parts of Newton (all attempts).
     pub timings: Timings,
     /// Wall time of the whole run.
@@ -202,7 +204,7 @@ pub fn initial_state<const D: usize>(
 
 /// Smooth acceleration at the start of a dynamic step, `a = -M^{-1} (f_int - f_ext)`: the
 /// contact forces act as impulses and are never part of `a` (see [`crate::hht`]). Held
-/// equations get zero.
+/// and massless equations get zero.
 fn consistent_acceleration<const D: usize>(
     model: &Model<D>,
     state: &State,
@@ -210,10 +212,11 @@ fn consistent_acceleration<const D: usize>(
 ) -> DVector<f64> {
     let n = model.dofs().len();
     DVector::from_fn(n, |i, _| {
-        if held[i] {
+        let m = model.mass()[i];
+        if held[i] || m <= 0.0 {
             0.0
         } else {
-            -state.net_force[i] / model.mass()[i]
+            -state.net_force[i] / m
         }
     })
 }
@@ -387,6 +390,7 @@ fn run_steps<const D: usize>(
                 }
                 Err(cause) => {
                     stats.cutbacks += 1;
+                    *stats.cutback_causes.entry(cause.kind()).or_default() += 1;
                     consecutive_failures += 1;
                     successes = 0;
                     if consecutive_failures > settings.cutback.max_cutbacks
