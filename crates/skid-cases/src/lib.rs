@@ -4,6 +4,8 @@
 //! - [`validate`]: reading a case with field-level error messages and overrides;
 //! - [`drum`]: building the drum scene (any idealization, 2D or 3D) as a model;
 //! - [`history`]: the per-increment history of the drum (`history.csv`);
+//! - [`newton`]: the Newton residuals of every increment (`newton.csv`);
+//! - [`csv_out`]: CSV files that appear only when complete;
 //! - [`summary`]: stop time, spin-down straightness, post-stop motion, energy balance;
 //! - [`fields`]: ParaView field output (VTU frames and a PVD collection);
 //! - [`runner`]: running one case into an output directory;
@@ -11,9 +13,11 @@
 //! - [`report`]: the validation report comparing the runs of a batch.
 
 pub mod batch;
+pub mod csv_out;
 pub mod drum;
 pub mod fields;
 pub mod history;
+pub mod newton;
 pub mod report;
 pub mod runner;
 pub mod schema;
