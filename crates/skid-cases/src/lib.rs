@@ -10,7 +10,8 @@
 //! - [`fields`]: ParaView field output (VTU frames and a PVD collection);
 //! - [`runner`]: running one case into an output directory;
 //! - [`batch`]: running many cases in parallel;
-//! - [`report`]: the validation report comparing the runs of a batch.
+//! - [`report`]: the validation report: the benchmark runs, the hard cases, the convergence
+//!   study.
 
 pub mod batch;
 pub mod csv_out;
@@ -25,7 +26,7 @@ pub mod summary;
 pub mod validate;
 
 pub use batch::{BatchEntry, BatchError, BatchStatus, collect_case_files, run_batch};
-pub use report::{ReportError, ReportOutcome, write_report};
+pub use report::{ReportError, ReportOutcome, ReportSources, write_report};
 pub use runner::{default_output_dir, run_case, run_case_file};
 pub use schema::Case;
 pub use summary::Summary;
