@@ -120,12 +120,7 @@ pub fn solve_increment<const D: usize>(
     };
     let mut x = match kind {
         IncrementKind::Static { .. } => start.x.clone(),
-        // Constant total acceleration: the smooth one plus that of the last contact forces, so
-        // that a node resting in contact is predicted to stay there.
-        IncrementKind::Dynamic { hht, h } => {
-            let a = &start.a + acceleration_of(model, &start.contact_reaction);
-            hht.predict(h, &start.x, &start.v, &a)
-        }
+        IncrementKind::Dynamic { hht, h } => hht.predict(h, &start.x, &start.v, &start.a),
     };
     for (eq, &h) in held.iter().enumerate() {
         if h {
