@@ -52,31 +52,24 @@ fn draw(
     curves: &[Curve],
     legend: SeriesLabelPosition,
 ) -> Result<(), ReportError> {
-    let error = |e: &dyn std::fmt::Display| ReportError::Plot {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    };
     let points = || curves.iter().flat_map(|c| c.points.iter());
     let x = padded_range(points().map(|p| p.0));
     let x = x.start.max(0.0)..x.end;
     let y = padded_range(points().map(|p| p.1));
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| error(&e))?;
-        let mut chart = ChartBuilder::on(&root)
+    write_svg(path, |root| {
+        let mut chart = ChartBuilder::on(root)
             .caption(title, ("sans-serif", 22))
             .margin(16)
             .x_label_area_size(48)
             .y_label_area_size(72)
             .build_cartesian_2d(x, y)
-            .map_err(|e| error(&e))?;
+            .map_err(|e| e.to_string())?;
         chart
             .configure_mesh()
             .x_desc(x_label)
             .y_desc(y_label)
             .draw()
-            .map_err(|e| error(&e))?;
+            .map_err(|e| e.to_string())?;
         let mut palette = 0;
         for curve in curves {
             let color = if curve.dashed {
@@ -92,23 +85,49 @@ fn draw(
             } else {
                 chart.draw_series(LineSeries::new(points, style))
             }
-            .map_err(|e| error(&e))?
+            .map_err(|e| e.to_string())?
             .label(curve.label.as_str())
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color));
         }
-        chart
-            .configure_series_labels()
-            .position(legend)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| error(&e))?;
-        root.present().map_err(|e| error(&e))?;
+        draw_legend(&mut chart, legend)
+    })
+}
+
+/// Renders a plot into the SVG file `path`: `body` draws on a white canvas of [`SIZE`]; the
+/// file is written only if every drawing call succeeded, and atomically.
+fn write_svg(
+    path: &Path,
+    body: impl FnOnce(&DrawingArea<SVGBackend<'_>, plotters::coord::Shift>) -> Result<(), String>,
+) -> Result<(), ReportError> {
+    let error = |message: String| ReportError::Plot {
+        path: path.to_path_buf(),
+        message,
+    };
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| error(e.to_string()))?;
+        body(&root).map_err(error)?;
+        root.present().map_err(|e| error(e.to_string()))?;
     }
     write_atomic(path, &svg).map_err(|source| ReportError::Write {
         path: path.to_path_buf(),
         source,
     })
+}
+
+/// The legend of the labelled series, boxed on a translucent white background.
+fn draw_legend<'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, SVGBackend<'a>, CT>,
+    position: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| e.to_string())
 }
 
 fn points(times: &[f64], values: &[f64]) -> Vec<(f64, f64)> {
@@ -222,10 +241,6 @@ pub fn plot_normalized_spin_down(runs: &[(&Run, f64)], path: &Path) -> Result<()
 /// # Errors
 /// [`ReportError`] if the plot cannot be drawn or written.
 pub fn plot_newton(histories: &[(String, Vec<f64>)], path: &Path) -> Result<(), ReportError> {
-    let error = |e: &dyn std::fmt::Display| ReportError::Plot {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    };
     let positive = || {
         histories
             .iter()
@@ -241,24 +256,21 @@ pub fn plot_newton(histories: &[(String, Vec<f64>)], path: &Path) -> Result<(), 
         (1e-12, 1.0)
     };
     let iterations = histories.iter().map(|(_, r)| r.len()).max().unwrap_or(1);
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| error(&e))?;
-        let mut chart = ChartBuilder::on(&root)
+    write_svg(path, |root| {
+        let mut chart = ChartBuilder::on(root)
             .caption("Newton residuals", ("sans-serif", 22))
             .margin(16)
             .x_label_area_size(48)
             .y_label_area_size(72)
             .build_cartesian_2d(0.5..iterations as f64 + 0.5, (lo..hi).log_scale())
-            .map_err(|e| error(&e))?;
+            .map_err(|e| e.to_string())?;
         chart
             .configure_mesh()
             .x_desc("Newton iteration")
             .y_desc("scaled force residual")
             .y_label_formatter(&|v| format!("{v:.0e}"))
             .draw()
-            .map_err(|e| error(&e))?;
+            .map_err(|e| e.to_string())?;
         for (k, (label, residuals)) in histories.iter().enumerate() {
             let color = Palette99::pick(k).to_rgba();
             let points = residuals
@@ -268,22 +280,11 @@ pub fn plot_newton(histories: &[(String, Vec<f64>)], path: &Path) -> Result<(), 
                 .map(|(i, r)| ((i + 1) as f64, *r));
             chart
                 .draw_series(LineSeries::new(points, color.stroke_width(2)).point_size(4))
-                .map_err(|e| error(&e))?
+                .map_err(|e| e.to_string())?
                 .label(label.as_str())
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| error(&e))?;
-        root.present().map_err(|e| error(&e))?;
-    }
-    write_atomic(path, &svg).map_err(|source| ReportError::Write {
-        path: path.to_path_buf(),
-        source,
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
     })
 }
 
