@@ -50,7 +50,8 @@ pub struct Assembler {
 }
 
 impl Assembler {
-    /// Builds the pattern from the model's connectivity and analyses it once.
+    /// Builds the pattern from the model's connectivity and analyses it once, with the contact
+    /// equations eliminated last (see [`crate::sparse`]).
     ///
     /// # Errors
     /// [`ModelError::Invalid`] if the pattern cannot be analysed.
@@ -79,7 +80,8 @@ impl Assembler {
         }
         let n = model.dofs().len();
         let diagonal = (0..n).map(|i| push(&mut builder, i, i)).collect();
-        let pattern = SparsePattern::new(n, builder).map_err(ModelError::Invalid)?;
+        let pattern = SparsePattern::new(n, builder, &model.contact_equations())
+            .map_err(ModelError::Invalid)?;
         let values = vec![0.0; pattern.slots()];
         Ok(Self {
             pattern,

@@ -9,7 +9,11 @@
 //! One Newton step solves `K_eff dx = -R + H^T r`, hence `dx = dx_0 + Z r` with
 //! `dx_0 = -K_eff^{-1} R` and `Z = K_eff^{-1} H^T`, and the local quantities become
 //! `u = W r + q` with the Delassus operator `W = H Z` and `q = u(x) + H dx_0`. The contact
-//! forces `r` then come from the exact Coulomb law in (W, q) (see `skid_contact::coulomb`).
+//! forces `r` then come from the exact Coulomb law in (W, q) (see `skid_contact::coulomb`), and
+//! the step is `dx = K_eff^{-1} (-R + H^T r)`, one more solve. `Z` itself is never formed: `W`
+//! comes from the block of `K_eff^{-1}` on the contact equations, which the factorization
+//! eliminates last (see [`crate::sparse`]), at the cost of a dense inverse of that size rather
+//! than one sparse solve per contact row.
 
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 use skid_contact::coulomb::{CoulombSettings, CoulombSolution, FrictionProblem, solve_coulomb};
@@ -69,26 +73,48 @@ impl ContactRows {
         )
     }
 
-    /// `Z = K^{-1} H^T` and the Delassus operator `W = H Z` (symmetrised).
-    pub fn delassus(&self, factor: &Factorization, n: usize) -> (DMatrix<f64>, DMatrix<f64>) {
-        let m = self.rows.len();
-        let mut ht = DMatrix::zeros(n, m);
-        for (k, row) in self.rows.iter().enumerate() {
-            for &(eq, c) in row {
-                ht[(eq, k)] += c;
+    /// The Delassus operator `W = H K^{-1} H^T`.
+    ///
+    /// `H` only involves the contact equations `C`, which the factorization eliminates last, so
+    /// `W = H_C (K^{-1})_CC H_C^T` with the dense block `(K^{-1})_CC` of the size of `C` (see
+    /// [`Factorization::trailing_inverse`]).
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] if a row involves an equation outside the trailing set
+    /// (the assembler was built for another model).
+    pub fn delassus(&self, factor: &Factorization) -> Result<DMatrix<f64>, IncrementFailure> {
+        let mut position = std::collections::HashMap::new();
+        for (k, &eq) in factor.trailing().iter().enumerate() {
+            position.insert(eq, k);
+        }
+        let local: Vec<Vec<(usize, f64)>> = self
+            .rows
+            .iter()
+            .map(|row| {
+                row.iter()
+                    .map(|&(eq, c)| position.get(&eq).map(|&k| (k, c)))
+                    .collect::<Option<Vec<_>>>()
+            })
+            .collect::<Option<_>>()
+            .ok_or_else(|| {
+                IncrementFailure::LinearSolve(
+                    "a contact row involves an equation outside the contact equations".into(),
+                )
+            })?;
+        let inverse = factor.trailing_inverse();
+        let m = local.len();
+        // G = (K^-1)_CC H_C^T, column by column
+        let mut g = DMatrix::zeros(inverse.nrows(), m);
+        for (j, row) in local.iter().enumerate() {
+            for &(k, c) in row {
+                g.column_mut(j).axpy(c, &inverse.column(k), 1.0);
             }
         }
-        let z = factor.solve_many(&ht);
-        let mut w = DMatrix::zeros(m, m);
-        for (i, row) in self.rows.iter().enumerate() {
-            for &(eq, c) in row {
-                for j in 0..m {
-                    w[(i, j)] += c * z[(eq, j)];
-                }
-            }
-        }
-        let w = (&w + w.transpose()) * 0.5;
-        (z, w)
+        // W = H_C G
+        let w = DMatrix::from_fn(m, m, |i, j| {
+            local[i].iter().map(|&(k, c)| c * g[(k, j)]).sum::<f64>()
+        });
+        Ok((&w + w.transpose()) * 0.5)
     }
 }
 
@@ -246,6 +272,7 @@ pub fn contact_rows<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::assembly::Assembler;
     use crate::model::ContactPair;
     use crate::test_support::{body, pad_block};
     use skid_contact::surface::AnalyticCylinder;
@@ -351,6 +378,45 @@ mod tests {
             full.r
         );
         assert!(screened.natural_map_error < 1e-8);
+    }
+
+    /// The Delassus operator from the trailing block of the factor equals `H K^-1 H^T` computed
+    /// column by column with full solves.
+    fn delassus_is_h_k_inverse_h_transpose<const D: usize>() {
+        let model = block_on_drum::<D>();
+        let n = model.dofs().len();
+        let mut assembler = Assembler::new(&model).expect("assembler");
+        let x = DVector::from_fn(n, |i, _| 1e-4 * (i as f64 * 1.3).sin());
+        assembler.internal(&model, &x, Some(1.0)).expect("internal");
+        // the mass term of a time step makes the free pad and drum definite
+        assembler.add_diagonal(&(model.mass() * 1e8));
+        let factor = assembler.factorize().expect("factor");
+        let held = vec![false; n];
+        let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
+        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let w = rows.delassus(&factor).expect("delassus");
+        let m = rows.rows.len();
+        let mut expected = DMatrix::zeros(m, m);
+        for k in 0..m {
+            let mut unit = DVector::zeros(m);
+            unit[k] = 1.0;
+            let z = factor.solve(&rows.transpose_times(&unit, n));
+            expected.set_column(k, &rows.times(&z));
+        }
+        assert!(
+            (&w - &expected).amax() < 1e-10 * expected.amax(),
+            "{D}D: {w} vs {expected}"
+        );
+    }
+
+    #[test]
+    fn delassus_is_h_k_inverse_h_transpose_2d() {
+        delassus_is_h_k_inverse_h_transpose::<2>();
+    }
+
+    #[test]
+    fn delassus_is_h_k_inverse_h_transpose_3d() {
+        delassus_is_h_k_inverse_h_transpose::<3>();
     }
 
     #[test]

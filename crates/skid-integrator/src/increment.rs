@@ -217,7 +217,7 @@ pub fn solve_increment<const D: usize>(
             last = Some((DVector::zeros(0), DVector::zeros(0)));
             dx0
         } else {
-            let (z, w) = rows.delassus(&factor, n);
+            let w = rows.delassus(&factor)?;
             let q = &rows.u + rows.times(&dx0);
             timings.linear_solve += clock.elapsed();
             let clock = Instant::now();
@@ -227,7 +227,7 @@ pub fn solve_increment<const D: usize>(
             let solution = solution.map_err(|e| IncrementFailure::Contact(e.to_string()))?;
             counters.contact_solves += solution.conic_solves;
             counters.fixed_point_iterations += solution.fixed_point_iterations;
-            let dx = dx0 + &z * &solution.r;
+            let dx = dx0 + factor.solve(&rows.transpose_times(&solution.r, n));
             shift = solution.shift;
             last = Some((solution.r, solution.u));
             dx
