@@ -126,7 +126,8 @@ impl ContactRows {
 /// on the candidates with `q_N <= 0`; any excluded candidate that the resulting forces would
 /// push into penetration is added and the reduced problem solved again. The result solves the
 /// full problem exactly; the far ends of a pad, standing millimetres off the drum, never enter
-/// a conic solve. `shift` warm-starts the De Saxce shifts (one per candidate).
+/// a conic solve. `warm` (one force per row, e.g. the forces of the last solve) warm-starts the
+/// solve of each reduced problem (see [`solve_coulomb`]).
 ///
 /// # Errors
 /// The conic solver's failure.
@@ -134,13 +135,13 @@ pub fn solve_contact_forces(
     rows: &ContactRows,
     w: &DMatrix<f64>,
     q: &DVector<f64>,
-    shift: &[f64],
+    warm: &DVector<f64>,
     settings: &CoulombSettings,
 ) -> Result<CoulombSolution, ContactError> {
     let d = rows.components;
     let nc = rows.len();
     let mut active: Vec<bool> = (0..nc).map(|c| q[c * d] <= 0.0).collect();
-    let (mut conic_solves, mut fixed_point_iterations) = (0, 0);
+    let (mut conic_solves, mut fixed_point_iterations, mut newton_steps) = (0, 0, 0);
     loop {
         let members: Vec<usize> = (0..nc).filter(|&c| active[c]).collect();
         let index: Vec<usize> = members
@@ -152,10 +153,10 @@ pub fn solve_contact_forces(
             let w_sub = w.select_rows(&index).select_columns(&index);
             let q_sub = q.select_rows(&index);
             let mu: Vec<f64> = members.iter().map(|&c| rows.mu[c]).collect();
-            let warm: Vec<f64> = members
-                .iter()
-                .map(|&c| shift.get(c).copied().unwrap_or(0.0))
-                .collect();
+            let warm = DVector::from_iterator(
+                index.len(),
+                index.iter().map(|&k| warm.get(k).copied().unwrap_or(0.0)),
+            );
             let problem = FrictionProblem {
                 dim: d,
                 w: &w_sub,
@@ -165,6 +166,7 @@ pub fn solve_contact_forces(
             let solution = solve_coulomb(&problem, settings, Some(&warm))?;
             conic_solves += solution.conic_solves;
             fixed_point_iterations += solution.fixed_point_iterations;
+            newton_steps += solution.newton_steps;
             for (k, &i) in index.iter().enumerate() {
                 r[i] = solution.r[k];
             }
@@ -197,6 +199,7 @@ pub fn solve_contact_forces(
                 shift,
                 fixed_point_iterations,
                 conic_solves,
+                newton_steps,
                 natural_map_error,
             });
         }
@@ -354,7 +357,7 @@ mod tests {
             mu: vec![0.3; nc],
         };
         let settings = CoulombSettings::default();
-        let screened = solve_contact_forces(&rows, &w, &q, &[0.0; 3], &settings).expect("screened");
+        let screened = solve_contact_forces(&rows, &w, &q, &DVector::zeros(d * nc), &settings).expect("screened");
         let full = solve_coulomb(
             &FrictionProblem {
                 dim: d,

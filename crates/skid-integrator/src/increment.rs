@@ -89,6 +89,8 @@ pub struct IncrementCounters {
     pub contact_solves: usize,
     /// De Saxce fixed-point iterations.
     pub fixed_point_iterations: usize,
+    /// Semismooth Newton steps of the contact solves.
+    pub contact_newton_steps: usize,
     /// Scaled (force, contact) residuals at each convergence check.
     pub residuals: Vec<(f64, f64)>,
 }
@@ -133,7 +135,7 @@ pub fn solve_increment<const D: usize>(
         }
     }
     let mut counters = IncrementCounters::default();
-    let mut shift = start.shift.clone();
+    let mut warm = start.warm_forces.clone();
     // Contact forces and linearised kinematics of the last conic solve.
     let mut last: Option<(DVector<f64>, DVector<f64>)> = None;
 
@@ -202,7 +204,7 @@ pub fn solve_increment<const D: usize>(
                     f_ext,
                     internal,
                 };
-                let state = finish(model, start, kind, iterate, &rows, r, shift);
+                let state = finish(model, start, kind, iterate, &rows, r, warm);
                 return Ok((state, counters));
             }
             if iteration == newton.max_iterations {
@@ -226,14 +228,15 @@ pub fn solve_increment<const D: usize>(
             let q = &rows.u + rows.times(&dx0);
             timings.linear_solve += clock.elapsed();
             let clock = Instant::now();
-            let solution = solve_contact_forces(&rows, &w, &q, &shift, &settings.coulomb);
+            let solution = solve_contact_forces(&rows, &w, &q, &warm, &settings.coulomb);
             // Failed solves cost time too: count it before reporting the failure.
             timings.contact_solve += clock.elapsed();
             let solution = solution.map_err(|e| IncrementFailure::Contact(e.to_string()))?;
             counters.contact_solves += solution.conic_solves;
             counters.fixed_point_iterations += solution.fixed_point_iterations;
+            counters.contact_newton_steps += solution.newton_steps;
             let dx = dx0 + factor.solve(&rows.transpose_times(&solution.r, n));
-            shift = solution.shift;
+            warm.clone_from(&solution.r);
             last = Some((solution.r, solution.u));
             dx
         };
@@ -302,7 +305,7 @@ fn finish<const D: usize>(
     iterate: Iterate,
     rows: &ContactRows,
     r: &DVector<f64>,
-    shift: Vec<f64>,
+    warm_forces: DVector<f64>,
 ) -> State {
     let Iterate {
         x,
@@ -373,7 +376,7 @@ fn finish<const D: usize>(
         net_force: net,
         external_force: f_ext,
         contacts,
-        shift,
+        warm_forces,
         energy,
     }
 }

@@ -389,7 +389,7 @@ fn non_convergence_is_reported_as_cutback_error() {
         conic_max_iterations: 1,
         ..tight()
     };
-    match solve_coulomb(&problem, &settings, None) {
+    match solve_fixed_point(&problem, &settings, None, true) {
         Err(ContactError::ConicSolveFailed {
             status,
             fixed_point_iteration: 1,
@@ -404,7 +404,10 @@ fn invalid_inputs_are_rejected_without_panic() {
     let q = DVector::from_vec(vec![-0.01, 0.05]);
     let settings = tight();
     let check = |problem: FrictionProblem, shift: Option<&[f64]>, settings: &CoulombSettings| {
-        let result = solve_coulomb(&problem, settings, shift);
+        let result = match shift {
+            Some(shift) => solve_fixed_point(&problem, settings, Some(shift), true),
+            None => solve_coulomb(&problem, settings, None),
+        };
         assert!(
             matches!(result, Err(ContactError::InvalidProblem(_))),
             "{result:?}"
@@ -469,6 +472,13 @@ fn invalid_inputs_are_rejected_without_panic() {
     );
     check(good, Some(&[0.1, 0.2]), &settings);
     check(good, Some(&[-0.1]), &settings);
+    for forces in [vec![0.1], vec![0.1, f64::INFINITY]] {
+        let result = solve_coulomb(&good, &settings, Some(&DVector::from_vec(forces)));
+        assert!(
+            matches!(result, Err(ContactError::InvalidProblem(_))),
+            "{result:?}"
+        );
+    }
     let zero_tolerance = CoulombSettings {
         tolerance: 0.0,
         ..tight()
