@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 use nalgebra::{DVector, Vector2};
 
 use crate::assembly::{Assembler, InternalState, external_forces};
-use crate::coupling::{ContactRows, contact_rows, solve_contact_forces};
+use crate::coupling::{ContactRows, contact_rows, contact_step};
 use crate::dof::EquationKind;
 use crate::error::IncrementFailure;
 use crate::hht::Hht;
@@ -216,26 +216,25 @@ pub fn solve_increment<const D: usize>(
             }
         }
 
-        let clock = Instant::now();
-        let factor = assembler.factorize()?;
-        let dx0 = factor.solve(&(-&residual));
         let dx = if rows.is_empty() {
+            let clock = Instant::now();
+            let dx = assembler.factorize()?.solve(&(-&residual));
             timings.linear_solve += clock.elapsed();
             last = Some((DVector::zeros(0), DVector::zeros(0)));
-            dx0
+            dx
         } else {
-            let w = rows.delassus(&factor)?;
-            let q = &rows.u + rows.times(&dx0);
-            timings.linear_solve += clock.elapsed();
-            let clock = Instant::now();
-            let solution = solve_contact_forces(&rows, &w, &q, &warm, &settings.coulomb);
-            // Failed solves cost time too: count it before reporting the failure.
-            timings.contact_solve += clock.elapsed();
-            let solution = solution.map_err(|e| IncrementFailure::Contact(e.to_string()))?;
+            let (dx, solution) = contact_step(
+                assembler,
+                &rows,
+                &residual,
+                &warm,
+                length,
+                &settings.coulomb,
+                timings,
+            )?;
             counters.contact_solves += solution.conic_solves;
             counters.fixed_point_iterations += solution.fixed_point_iterations;
             counters.contact_newton_steps += solution.newton_steps;
-            let dx = dx0 + factor.solve(&rows.transpose_times(&solution.r, n));
             warm.clone_from(&solution.r);
             last = Some((solution.r, solution.u));
             dx

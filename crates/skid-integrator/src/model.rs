@@ -287,24 +287,6 @@ impl<const D: usize> Model<D> {
         self.bodies.iter().position(|b| b.name == name)
     }
 
-    /// The equations that contact rows can involve, sorted: the components of every contact
-    /// candidate node and the motions of the bodies carrying the master surfaces.
-    pub fn contact_equations(&self) -> Vec<usize> {
-        let mut eqs: Vec<usize> = self
-            .contacts
-            .iter()
-            .flat_map(|pair| {
-                pair.nodes
-                    .iter()
-                    .flat_map(|&node| self.dofs.node(node).iter().flatten().copied())
-                    .chain(self.dofs.body_equations(pair.body))
-            })
-            .collect();
-        eqs.sort_unstable();
-        eqs.dedup();
-        eqs
-    }
-
     /// Current position of a node embedded in 3D (z = 0 in 2D).
     pub fn node_position(&self, x: &DVector<f64>, node: usize) -> Vector3<f64> {
         embed(&(self.part.mesh.nodes[node] + self.dofs.node_displacement(x, node)))

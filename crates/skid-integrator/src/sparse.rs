@@ -67,27 +67,33 @@ impl SparsePattern {
     pub fn new(n: usize, builder: PatternBuilder, trailing: &[usize]) -> Result<Self, String> {
         let (symbolic, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &builder.pairs)
             .map_err(|e| format!("sparsity pattern: {e:?}"))?;
-        let (forward, inverse) = trailing_last_ordering(n, symbolic.as_ref(), trailing)?;
-        let permutation = faer::perm::PermRef::new_checked(&forward, &inverse, n);
-        let params = CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-            ..Default::default()
-        };
-        let analysis = factorize_symbolic_cholesky(
-            symbolic.as_ref(),
-            Side::Lower,
-            SymmetricOrdering::Custom(permutation),
-            params,
-        )
-        .map_err(|e| format!("symbolic factorization: {e:?}"))?;
+        let analysis = analyse(n, &symbolic, trailing)?;
         Ok(Self {
             n,
             symbolic,
             argsort,
             slots: builder.pairs.len(),
-            analysis: Arc::new(analysis),
+            analysis,
             trailing: trailing.into(),
         })
+    }
+
+    /// The equations eliminated last.
+    pub fn trailing(&self) -> &[usize] {
+        &self.trailing
+    }
+
+    /// Analyses the pattern again with the equations `trailing` eliminated last (nothing to do
+    /// if they already are, in that order).
+    ///
+    /// # Errors
+    /// A message if `trailing` is not a set of distinct equations `< n`.
+    pub fn eliminate_last(&mut self, trailing: &[usize]) -> Result<(), String> {
+        if *self.trailing != *trailing {
+            self.analysis = analyse(self.n, &self.symbolic, trailing)?;
+            self.trailing = trailing.into();
+        }
+        Ok(())
     }
 
     /// Number of value slots (registered entries, duplicates counted).
@@ -141,6 +147,28 @@ impl SparsePattern {
             n: self.n,
         })
     }
+}
+
+/// The supernodal symbolic Cholesky analysis of `symbolic` with `trailing` eliminated last.
+fn analyse(
+    n: usize,
+    symbolic: &SymbolicSparseColMat<usize>,
+    trailing: &[usize],
+) -> Result<Arc<SymbolicCholesky<usize>>, String> {
+    let (forward, inverse) = trailing_last_ordering(n, symbolic.as_ref(), trailing)?;
+    let permutation = faer::perm::PermRef::new_checked(&forward, &inverse, n);
+    let params = CholeskySymbolicParams {
+        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+        ..Default::default()
+    };
+    factorize_symbolic_cholesky(
+        symbolic.as_ref(),
+        Side::Lower,
+        SymmetricOrdering::Custom(permutation),
+        params,
+    )
+    .map(Arc::new)
+    .map_err(|e| format!("symbolic factorization: {e:?}"))
 }
 
 /// Elimination order (`forward[new] = old`, `inverse[old] = new`): the approximate minimum degree

@@ -42,7 +42,10 @@ enum Branch {
     /// Closed with a zero friction radius (`mu = 0`): `Phi_T = r_T`.
     Frictionless,
     /// Sliding: unit direction `d` of `v_T`, and the factor `mu tau / ||v||`.
-    Slide { direction: [f64; 2], factor: f64 },
+    Slide {
+        direction: [f64; 2],
+        factor: f64,
+    },
 }
 
 /// The Alart–Curnier function `Phi` at `(r, u)` and the branch of every contact.
@@ -73,7 +76,8 @@ fn evaluate(
             let norm = v.iter().map(|c| c * c).sum::<f64>().sqrt();
             let radius = mu * tau;
             if radius == 0.0 {
-                phi.rows_mut(k + 1, dim - 1).copy_from(&r.rows(k + 1, dim - 1));
+                phi.rows_mut(k + 1, dim - 1)
+                    .copy_from(&r.rows(k + 1, dim - 1));
                 Branch::Frictionless
             } else if norm <= radius {
                 for t in 1..dim {
@@ -175,7 +179,8 @@ fn newton_step(
     let mut step = DVector::zeros(r.len());
     for (i, branch) in branches.iter().enumerate() {
         if matches!(branch, Branch::Open) {
-            step.rows_mut(dim * i, dim).copy_from(&(-r.rows(dim * i, dim)));
+            step.rows_mut(dim * i, dim)
+                .copy_from(&(-r.rows(dim * i, dim)));
         }
     }
     let (transposed, rows) = closed_jacobian_transposed(problem, w, rho, branches);
@@ -187,7 +192,9 @@ fn newton_step(
     // the closed block of J^T; J dr = rhs is solved as a transposed system
     let block = Mat::<f64>::from_fn(n, n, |a, b| transposed[(rows[a], b)]);
     let mut rhs = Mat::<f64>::from_fn(n, 1, |a, _| -phi[rows[a]] - coupling[a]);
-    block.partial_piv_lu().solve_transpose_in_place(rhs.as_mut());
+    block
+        .partial_piv_lu()
+        .solve_transpose_in_place(rhs.as_mut());
     for (a, &row) in rows.iter().enumerate() {
         step[row] = rhs[(a, 0)];
     }
@@ -283,7 +290,9 @@ mod tests {
             q: &q,
             mu: &mu,
         };
-        let rho: Vec<f64> = (0..n).map(|i| inverse_mean_compliance(&problem, i)).collect();
+        let rho: Vec<f64> = (0..n)
+            .map(|i| inverse_mean_compliance(&problem, i))
+            .collect();
         let (_, branches) = evaluate(&problem, &rho, &r, &u);
         let kinds: Vec<&str> = branches
             .iter()
