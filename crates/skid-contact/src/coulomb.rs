@@ -144,7 +144,7 @@ pub fn solve_coulomb(
     if problem.q.iter().step_by(dim).all(|&q_n| q_n >= 0.0) {
         return solve_fixed_point(problem, settings, None, true);
     }
-    let w = (problem.w + problem.w.transpose()) * 0.5;
+    let w = symmetric_part(problem.w);
     let start = initial_forces.map_or_else(|| DVector::zeros(problem.q.len()), Clone::clone);
     let (candidate, newton_steps) = newton(
         problem,
@@ -199,7 +199,7 @@ fn solve_fixed_point(
         });
     }
 
-    let w = (problem.w + problem.w.transpose()) * 0.5;
+    let w = symmetric_part(problem.w);
     // positive: some q_N < 0, and the diagonal of W was checked positive
     let length_scale = q.amax();
     let compliance_scale = w.diagonal().mean();
@@ -327,6 +327,19 @@ fn inverse_mean_compliance(problem: &FrictionProblem, i: usize) -> f64 {
         / (dim * i..dim * (i + 1))
             .map(|k| problem.w[(k, k)])
             .sum::<f64>()
+}
+
+/// The symmetric part `(W + W^T) / 2`.
+fn symmetric_part(w: &DMatrix<f64>) -> DMatrix<f64> {
+    let mut symmetric = w.clone();
+    for j in 0..w.ncols() {
+        for i in j + 1..w.nrows() {
+            let mean = 0.5 * (w[(i, j)] + w[(j, i)]);
+            symmetric[(i, j)] = mean;
+            symmetric[(j, i)] = mean;
+        }
+    }
+    symmetric
 }
 
 /// Shift `s_i = mu_i ||u_T,i||` of each contact.

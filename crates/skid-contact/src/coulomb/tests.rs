@@ -574,6 +574,51 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 64,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x0a1a_c0de),
+        ..ProptestConfig::default()
+    })]
+
+    /// Semismooth Newton (from `r = 0`) and the conic fixed point find the same forces on random
+    /// coupled instances, both satisfying the exact law; warm-started with the solution, Newton
+    /// confirms it without a conic solve in at most one step.
+    #[test]
+    fn newton_and_conic_fixed_point_agree(
+        seed in any::<u64>(),
+        n in 1usize..12,
+        three_d in any::<bool>(),
+        mu_max in 0.0f64..0.3,
+        w_shift in 0.1f64..1.0,
+    ) {
+        let dim = if three_d { 3 } else { 2 };
+        let mut rng = Rng(seed);
+        let w = random_delassus(&mut rng, dim * n, w_shift) * 1e-6;
+        let q = DVector::from_fn(dim * n, |k, _| {
+            1e-3 * if k % dim == 0 { rng.uniform(-1.0, 0.5) } else { rng.uniform(-2.0, 2.0) }
+        });
+        let mu: Vec<f64> = (0..n).map(|_| rng.uniform(0.0, mu_max)).collect();
+        let problem = FrictionProblem { dim, w: &w, q: &q, mu: &mu };
+        let newton = solve_coulomb(&problem, &tight(), None);
+        let conic = solve_fixed_point(&problem, &tight(), None, true);
+        prop_assert!(newton.is_ok() && conic.is_ok(), "{:?} {:?}", newton, conic);
+        let (Ok(newton), Ok(conic)) = (newton, conic) else { return Ok(()) };
+        check_coulomb_law(dim, &mu, &newton, 1e3, 1e-3);
+        check_coulomb_law(dim, &mu, &conic, 1e3, 1e-3);
+        let scale = conic.r.amax().max(1e-3);
+        prop_assert!(
+            (&newton.r - &conic.r).amax() <= 1e-6 * scale,
+            "{} vs {}", newton.r, conic.r
+        );
+        let warm = solve_coulomb(&problem, &tight(), Some(&conic.r));
+        prop_assert!(warm.is_ok(), "{:?}", warm);
+        let Ok(warm) = warm else { return Ok(()) };
+        prop_assert_eq!(warm.conic_solves, 0);
+        prop_assert!(warm.newton_steps <= 1);
+    }
+}
+
 /// A contact whose slip the forces cannot change (zero tangential compliance, as for a node
 /// on a facet vertex) still obeys the law: it slides with the given slip and friction mu r_N.
 #[test]
