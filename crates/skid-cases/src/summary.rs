@@ -44,6 +44,8 @@ pub struct Summary {
     pub contact_solves: usize,
     /// De Saxce fixed-point iterations.
     pub fixed_point_iterations: usize,
+    /// Semismooth Newton steps of the contact solves.
+    pub contact_newton_steps: usize,
     /// Failed attempts answered by a cutback.
     pub cutbacks: usize,
     /// The failed attempts by cause (e.g. "newton not converged": 3).
@@ -214,6 +216,7 @@ pub fn summarize(
         newton_iterations: stats.newton_iterations,
         contact_solves: stats.contact_solves,
         fixed_point_iterations: stats.fixed_point_iterations,
+        contact_newton_steps: stats.contact_newton_steps,
         cutbacks: stats.cutbacks,
         cutback_causes: stats
             .cutback_causes

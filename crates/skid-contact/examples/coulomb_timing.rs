@@ -43,7 +43,7 @@ fn time_case(dim: usize, n_contacts: usize, repetitions: usize) {
         mu: &mu,
     };
     let settings = CoulombSettings::default();
-    let mut shift = None;
+    let mut forces = None;
     for warm in [false, true] {
         let start = Instant::now();
         let mut last = None;
@@ -51,7 +51,7 @@ fn time_case(dim: usize, n_contacts: usize, repetitions: usize) {
             match solve_coulomb(
                 &problem,
                 &settings,
-                if warm { shift.as_deref() } else { None },
+                if warm { forces.as_ref() } else { None },
             ) {
                 Ok(solution) => last = Some(solution),
                 Err(e) => {
@@ -64,13 +64,14 @@ fn time_case(dim: usize, n_contacts: usize, repetitions: usize) {
         if let Some(solution) = last {
             println!(
                 "{dim}D, {n_contacts:2} contacts ({m:2} unknowns), {}: {:.3} ms per solve, \
-                 {} conic solve(s), natural-map error {:.1e}",
-                if warm { "warm shift" } else { "cold      " },
+                 {} conic solve(s), {} Newton step(s), natural-map error {:.1e}",
+                if warm { "warm forces" } else { "cold       " },
                 per_solve * 1e3,
                 solution.conic_solves,
+                solution.newton_steps,
                 solution.natural_map_error
             );
-            shift = Some(solution.shift);
+            forces = Some(solution.r);
         }
     }
 }

@@ -50,7 +50,8 @@ pub struct Assembler {
 }
 
 impl Assembler {
-    /// Builds the pattern from the model's connectivity and analyses it once.
+    /// Builds the pattern from the model's connectivity and analyses it once (no equations
+    /// eliminated last until [`Self::eliminate_last`] asks for them).
     ///
     /// # Errors
     /// [`ModelError::Invalid`] if the pattern cannot be analysed.
@@ -79,7 +80,7 @@ impl Assembler {
         }
         let n = model.dofs().len();
         let diagonal = (0..n).map(|i| push(&mut builder, i, i)).collect();
-        let pattern = SparsePattern::new(n, builder).map_err(ModelError::Invalid)?;
+        let pattern = SparsePattern::new(n, builder, &[]).map_err(ModelError::Invalid)?;
         let values = vec![0.0; pattern.slots()];
         Ok(Self {
             pattern,
@@ -174,6 +175,22 @@ impl Assembler {
                 self.values[slot] = 1.0;
             }
         }
+    }
+
+    /// The equations the factorization eliminates last.
+    pub fn trailing(&self) -> &[usize] {
+        self.pattern.trailing()
+    }
+
+    /// Has the factorization eliminate the equations `trailing` last (see [`crate::sparse`]);
+    /// analyses the pattern again if they change.
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] if they are not distinct equations of the model.
+    pub fn eliminate_last(&mut self, trailing: &[usize]) -> Result<(), IncrementFailure> {
+        self.pattern
+            .eliminate_last(trailing)
+            .map_err(IncrementFailure::LinearSolve)
     }
 
     /// Factorizes the current effective tangent.

@@ -9,7 +9,17 @@
 //! One Newton step solves `K_eff dx = -R + H^T r`, hence `dx = dx_0 + Z r` with
 //! `dx_0 = -K_eff^{-1} R` and `Z = K_eff^{-1} H^T`, and the local quantities become
 //! `u = W r + q` with the Delassus operator `W = H Z` and `q = u(x) + H dx_0`. The contact
-//! forces `r` then come from the exact Coulomb law in (W, q) (see `skid_contact::coulomb`).
+//! forces `r` then come from the exact Coulomb law in (W, q) (see `skid_contact::coulomb`), and
+//! the step is `dx = K_eff^{-1} (-R + H^T r)`, one more solve. `Z` itself is never formed: `W`
+//! comes from the block of `K_eff^{-1}` on the contact equations, which the factorization
+//! eliminates last (see [`crate::sparse`]), at the cost of a dense inverse of that size rather
+//! than one sparse solve per contact row.
+//!
+//! That dense block costs the cube of its size, so only the candidates *near* contact enter
+//! it (see [`contact_step`]): those with a gap below a fraction of the model size or carrying
+//! force at the warm start. The others get `r = 0`, which is exact as long as the step leaves
+//! them open; one that the step would push into the surface joins the near set and the step is
+//! repeated.
 
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 use skid_contact::coulomb::{CoulombSettings, CoulombSolution, FrictionProblem, solve_coulomb};
@@ -19,6 +29,10 @@ use skid_contact::kinematics::{RotatingFrame, evaluate, slip_increment};
 use crate::error::IncrementFailure;
 use skid_fem::cell::embed;
 
+use std::time::Instant;
+
+use crate::assembly::Assembler;
+use crate::increment::Timings;
 use crate::model::Model;
 use crate::sparse::Factorization;
 
@@ -69,52 +83,209 @@ impl ContactRows {
         )
     }
 
-    /// `Z = K^{-1} H^T` and the Delassus operator `W = H Z` (symmetrised).
-    pub fn delassus(&self, factor: &Factorization, n: usize) -> (DMatrix<f64>, DMatrix<f64>) {
-        let m = self.rows.len();
-        let mut ht = DMatrix::zeros(n, m);
-        for (k, row) in self.rows.iter().enumerate() {
-            for &(eq, c) in row {
-                ht[(eq, k)] += c;
+    /// Indices of the rows of the given candidates, `components` per candidate.
+    fn row_indices(&self, candidates: &[usize]) -> Vec<usize> {
+        let d = self.components;
+        candidates
+            .iter()
+            .flat_map(|&c| (c * d)..(c + 1) * d)
+            .collect()
+    }
+
+    /// The equations the rows of the given candidates involve, sorted.
+    pub fn equations(&self, candidates: &[usize]) -> Vec<usize> {
+        let mut eqs: Vec<usize> = self
+            .row_indices(candidates)
+            .into_iter()
+            .flat_map(|k| self.rows[k].iter().map(|&(eq, _)| eq))
+            .collect();
+        eqs.sort_unstable();
+        eqs.dedup();
+        eqs
+    }
+
+    /// The Delassus operator `W = H_S K^{-1} H_S^T` of the rows `H_S` of the given candidates.
+    ///
+    /// `H_S` only involves equations `C` that the factorization eliminates last, so
+    /// `W = H_S (K^{-1})_CC H_S^T` with the dense block `(K^{-1})_CC` of the size of `C` (see
+    /// [`Factorization::trailing_inverse`]).
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] if a row involves an equation outside the trailing set.
+    pub fn delassus(
+        &self,
+        factor: &Factorization,
+        candidates: &[usize],
+    ) -> Result<DMatrix<f64>, IncrementFailure> {
+        let mut position = std::collections::HashMap::new();
+        for (k, &eq) in factor.trailing().iter().enumerate() {
+            position.insert(eq, k);
+        }
+        let local: Vec<Vec<(usize, f64)>> = self
+            .row_indices(candidates)
+            .into_iter()
+            .map(|k| &self.rows[k])
+            .map(|row| {
+                row.iter()
+                    .map(|&(eq, c)| position.get(&eq).map(|&k| (k, c)))
+                    .collect::<Option<Vec<_>>>()
+            })
+            .collect::<Option<_>>()
+            .ok_or_else(|| {
+                IncrementFailure::LinearSolve(
+                    "a contact row involves an equation the factorization does not eliminate last"
+                        .into(),
+                )
+            })?;
+        let inverse = factor.trailing_inverse();
+        let m = local.len();
+        // G = (K^-1)_CC H_C^T, column by column
+        let mut g = DMatrix::zeros(inverse.nrows(), m);
+        for (j, row) in local.iter().enumerate() {
+            for &(k, c) in row {
+                g.column_mut(j).axpy(c, &inverse.column(k), 1.0);
             }
         }
-        let z = factor.solve_many(&ht);
-        let mut w = DMatrix::zeros(m, m);
-        for (i, row) in self.rows.iter().enumerate() {
-            for &(eq, c) in row {
-                for j in 0..m {
-                    w[(i, j)] += c * z[(eq, j)];
-                }
-            }
-        }
-        let w = (&w + w.transpose()) * 0.5;
-        (z, w)
+        // W = H_C G
+        let w = DMatrix::from_fn(m, m, |i, j| {
+            local[i].iter().map(|&(k, c)| c * g[(k, j)]).sum::<f64>()
+        });
+        Ok((&w + w.transpose()) * 0.5)
     }
 }
 
-/// Solves the exact Coulomb law for all candidates of `rows` in `u = W r + q`, handing the
-/// conic solver only the candidates that can carry force.
+/// Gap below which a candidate is near contact, as a fraction of the model size.
+const NEAR_GAP_FRACTION: f64 = 0.001;
+
+/// One contact-coupled Newton step `dx = K^{-1} (-R + H^T r)` with the forces `r` of the exact
+/// Coulomb law in `u = W r + q` (see the module documentation), and the Coulomb solution with
+/// `r` and the linearised `u = u(x) + H dx` over all candidates.
 ///
-/// A candidate that is open (`q_N > 0`) and stays open under the forces of the others
-/// (`u_N = q_N + (W r)_N >= 0`) satisfies the law with `r = 0`. So the problem is first solved
-/// on the candidates with `q_N <= 0`; any excluded candidate that the resulting forces would
-/// push into penetration is added and the reduced problem solved again. The result solves the
-/// full problem exactly; the far ends of a pad, standing millimetres off the drum, never enter
-/// a conic solve. `shift` warm-starts the De Saxce shifts (one per candidate).
+/// Only the candidates near contact (gap `u_N < NEAR_GAP_FRACTION * length`, or a normal force
+/// in `warm`) enter `W`, whose equations the assembler is asked to eliminate last (the set only
+/// grows, so the pattern is analysed again rarely). A far candidate that the step would push
+/// into the surface (`u_N < 0`) joins them and the step is repeated; the result then solves the
+/// Coulomb law for all candidates. `warm` (one force per row) warm-starts the solve.
 ///
 /// # Errors
-/// The conic solver's failure.
-pub fn solve_contact_forces(
+/// The failures of the factorization and of the Coulomb solve.
+pub fn contact_step(
+    assembler: &mut Assembler,
     rows: &ContactRows,
-    w: &DMatrix<f64>,
-    q: &DVector<f64>,
-    shift: &[f64],
+    residual: &DVector<f64>,
+    warm: &DVector<f64>,
+    length: f64,
     settings: &CoulombSettings,
-) -> Result<CoulombSolution, ContactError> {
+    timings: &mut Timings,
+) -> Result<(DVector<f64>, CoulombSolution), IncrementFailure> {
     let d = rows.components;
     let nc = rows.len();
+    let n = residual.len();
+    let mut near: Vec<bool> = (0..nc)
+        .map(|c| {
+            rows.u[c * d] < NEAR_GAP_FRACTION * length || warm.get(c * d).is_some_and(|&f| f != 0.0)
+        })
+        .collect();
+    let (mut conic_solves, mut fixed_point_iterations, mut newton_steps) = (0, 0, 0);
+    let mut current = None;
+    loop {
+        let clock = Instant::now();
+        let candidates: Vec<usize> = (0..nc).filter(|&c| near[c]).collect();
+        let needed = rows.equations(&candidates);
+        let trailing = assembler.trailing();
+        if needed.iter().any(|eq| trailing.binary_search(eq).is_err()) {
+            let mut grown = [trailing, &needed].concat();
+            grown.sort_unstable();
+            grown.dedup();
+            assembler.eliminate_last(&grown)?;
+            current = None;
+        }
+        let (factor, dx0) = match current.take() {
+            Some(current) => current,
+            None => {
+                let f = assembler.factorize()?;
+                let dx0 = f.solve(&(-residual));
+                (f, dx0)
+            }
+        };
+        let index = rows.row_indices(&candidates);
+        let w = rows.delassus(&factor, &candidates)?;
+        let q = (&rows.u + rows.times(&dx0)).select_rows(&index);
+        timings.linear_solve += clock.elapsed();
+        let clock = Instant::now();
+        let mu: Vec<f64> = candidates.iter().map(|&c| rows.mu[c]).collect();
+        let warm_near = DVector::from_iterator(
+            index.len(),
+            index.iter().map(|&k| warm.get(k).copied().unwrap_or(0.0)),
+        );
+        let problem = FrictionProblem {
+            dim: d,
+            w: &w,
+            q: &q,
+            mu: &mu,
+        };
+        let solution = solve_contact_forces(&problem, &warm_near, settings);
+        // Failed solves cost time too: count it before reporting the failure.
+        timings.contact_solve += clock.elapsed();
+        let solution = solution.map_err(|e| IncrementFailure::Contact(e.to_string()))?;
+        conic_solves += solution.conic_solves;
+        fixed_point_iterations += solution.fixed_point_iterations;
+        newton_steps += solution.newton_steps;
+        let clock = Instant::now();
+        let mut r = DVector::zeros(rows.rows.len());
+        for (k, &i) in index.iter().enumerate() {
+            r[i] = solution.r[k];
+        }
+        let dx = &dx0 + factor.solve(&rows.transpose_times(&r, n));
+        let u = &rows.u + rows.times(&dx);
+        timings.linear_solve += clock.elapsed();
+        let mut grew = false;
+        for c in 0..nc {
+            if !near[c] && u[c * d] < 0.0 {
+                near[c] = true;
+                grew = true;
+            }
+        }
+        if !grew {
+            let shift = (0..nc)
+                .map(|c| rows.mu[c] * u.rows(c * d + 1, d - 1).norm())
+                .collect();
+            let solution = CoulombSolution {
+                r,
+                u,
+                shift,
+                fixed_point_iterations,
+                conic_solves,
+                newton_steps,
+                natural_map_error: solution.natural_map_error,
+            };
+            return Ok((dx, solution));
+        }
+        current = Some((factor, dx0));
+    }
+}
+
+/// Solves the exact Coulomb law `problem` for all its contacts, handing the solver only the
+/// contacts that can carry force.
+///
+/// A contact that is open (`q_N > 0`) and stays open under the forces of the others
+/// (`u_N = q_N + (W r)_N >= 0`) satisfies the law with `r = 0`. So the problem is first solved
+/// on the contacts with `q_N <= 0`; any excluded contact that the resulting forces would
+/// push into penetration is added and the reduced problem solved again. The result solves the
+/// full problem exactly. `warm` (one force per row, e.g. the forces of the last solve)
+/// warm-starts the solve of each reduced problem (see [`solve_coulomb`]).
+///
+/// # Errors
+/// The Coulomb solver's failure.
+pub fn solve_contact_forces(
+    problem: &FrictionProblem,
+    warm: &DVector<f64>,
+    settings: &CoulombSettings,
+) -> Result<CoulombSolution, ContactError> {
+    let &FrictionProblem { dim: d, w, q, mu } = problem;
+    let nc = mu.len();
     let mut active: Vec<bool> = (0..nc).map(|c| q[c * d] <= 0.0).collect();
-    let (mut conic_solves, mut fixed_point_iterations) = (0, 0);
+    let (mut conic_solves, mut fixed_point_iterations, mut newton_steps) = (0, 0, 0);
     loop {
         let members: Vec<usize> = (0..nc).filter(|&c| active[c]).collect();
         let index: Vec<usize> = members
@@ -125,20 +296,21 @@ pub fn solve_contact_forces(
         if !members.is_empty() {
             let w_sub = w.select_rows(&index).select_columns(&index);
             let q_sub = q.select_rows(&index);
-            let mu: Vec<f64> = members.iter().map(|&c| rows.mu[c]).collect();
-            let warm: Vec<f64> = members
-                .iter()
-                .map(|&c| shift.get(c).copied().unwrap_or(0.0))
-                .collect();
-            let problem = FrictionProblem {
+            let mu_sub: Vec<f64> = members.iter().map(|&c| mu[c]).collect();
+            let warm = DVector::from_iterator(
+                index.len(),
+                index.iter().map(|&k| warm.get(k).copied().unwrap_or(0.0)),
+            );
+            let reduced = FrictionProblem {
                 dim: d,
                 w: &w_sub,
                 q: &q_sub,
-                mu: &mu,
+                mu: &mu_sub,
             };
-            let solution = solve_coulomb(&problem, settings, Some(&warm))?;
+            let solution = solve_coulomb(&reduced, settings, Some(&warm))?;
             conic_solves += solution.conic_solves;
             fixed_point_iterations += solution.fixed_point_iterations;
+            newton_steps += solution.newton_steps;
             for (k, &i) in index.iter().enumerate() {
                 r[i] = solution.r[k];
             }
@@ -153,24 +325,16 @@ pub fn solve_contact_forces(
         }
         if !grew {
             let shift = (0..nc)
-                .map(|c| rows.mu[c] * u.rows(c * d + 1, d - 1).norm())
+                .map(|c| mu[c] * u.rows(c * d + 1, d - 1).norm())
                 .collect();
-            let natural_map_error = skid_contact::coulomb::natural_map_error(
-                &FrictionProblem {
-                    dim: d,
-                    w,
-                    q,
-                    mu: &rows.mu,
-                },
-                &r,
-                &u,
-            );
+            let natural_map_error = skid_contact::coulomb::natural_map_error(problem, &r, &u);
             return Ok(CoulombSolution {
                 r,
                 u,
                 shift,
                 fixed_point_iterations,
                 conic_solves,
+                newton_steps,
                 natural_map_error,
             });
         }
@@ -246,6 +410,7 @@ pub fn contact_rows<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::assembly::Assembler;
     use crate::model::ContactPair;
     use crate::test_support::{body, pad_block};
     use skid_contact::surface::AnalyticCylinder;
@@ -319,26 +484,16 @@ mod tests {
         w[(1, 3)] = 0.2e-6;
         w[(3, 1)] = 0.2e-6;
         let q = DVector::from_vec(vec![-1e-3, 2e-3, 1e-4, 1.5e-3, 5e-3, 1e-3]);
-        let rows = ContactRows {
-            components: d,
-            rows: vec![Vec::new(); d * nc],
-            u: DVector::zeros(d * nc),
-            coords: vec![Vector2::zeros(); nc],
-            mu: vec![0.3; nc],
+        let problem = FrictionProblem {
+            dim: d,
+            w: &w,
+            q: &q,
+            mu: &[0.3; 3],
         };
         let settings = CoulombSettings::default();
-        let screened = solve_contact_forces(&rows, &w, &q, &[0.0; 3], &settings).expect("screened");
-        let full = solve_coulomb(
-            &FrictionProblem {
-                dim: d,
-                w: &w,
-                q: &q,
-                mu: &rows.mu,
-            },
-            &settings,
-            None,
-        )
-        .expect("full");
+        let screened =
+            solve_contact_forces(&problem, &DVector::zeros(d * nc), &settings).expect("screened");
+        let full = solve_coulomb(&problem, &settings, None).expect("full");
         assert!(
             screened.r[2] > 0.0,
             "contact 1 was pulled into contact and carries force"
@@ -351,6 +506,125 @@ mod tests {
             full.r
         );
         assert!(screened.natural_map_error < 1e-8);
+    }
+
+    /// The block-on-drum model with its effective tangent assembled at `x` (with the mass term
+    /// of a time step, which makes the free pad and drum definite).
+    fn assembled<const D: usize>(x: &DVector<f64>) -> (Model<D>, Assembler) {
+        let model = block_on_drum::<D>();
+        let mut assembler = Assembler::new(&model).expect("assembler");
+        assembler.internal(&model, x, Some(1.0)).expect("internal");
+        assembler.add_diagonal(&(model.mass() * 1e8));
+        (model, assembler)
+    }
+
+    /// The Delassus operator of a subset of the candidates, from the trailing block of the
+    /// factor, equals `H_S K^-1 H_S^T` computed column by column with full solves; a candidate
+    /// whose equations are not eliminated last is reported, not mishandled.
+    fn delassus_is_h_k_inverse_h_transpose<const D: usize>() {
+        let n = block_on_drum::<D>().dofs().len();
+        let x = DVector::from_fn(n, |i, _| 1e-4 * (i as f64 * 1.3).sin());
+        let (model, mut assembler) = assembled::<D>(&x);
+        let held = vec![false; n];
+        let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
+        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let subset: Vec<usize> = (0..rows.len()).step_by(2).collect();
+        assembler
+            .eliminate_last(&rows.equations(&subset))
+            .expect("trailing");
+        let factor = assembler.factorize().expect("factor");
+        let w = rows.delassus(&factor, &subset).expect("delassus");
+        let index = rows.row_indices(&subset);
+        let mut expected = DMatrix::zeros(index.len(), index.len());
+        for (a, &k) in index.iter().enumerate() {
+            let mut unit = DVector::zeros(rows.rows.len());
+            unit[k] = 1.0;
+            let z = factor.solve(&rows.transpose_times(&unit, n));
+            expected.set_column(a, &rows.times(&z).select_rows(&index));
+        }
+        assert!(
+            (&w - &expected).amax() < 1e-10 * expected.amax(),
+            "{D}D: {w} vs {expected}"
+        );
+        let all: Vec<usize> = (0..rows.len()).collect();
+        assert!(matches!(
+            rows.delassus(&factor, &all),
+            Err(IncrementFailure::LinearSolve(_))
+        ));
+    }
+
+    /// A step that pushes the whole pad into the drum: starting from the one candidate row
+    /// touching the drum, the far candidates that the step pushes in join, and the step equals
+    /// the one with every candidate in the Delassus operator from the start.
+    fn far_candidates_pushed_in_join_the_contact_step<const D: usize>() {
+        let n = block_on_drum::<D>().dofs().len();
+        let x = DVector::zeros(n);
+        let (model, mut assembler) = assembled::<D>(&x);
+        let held = vec![false; n];
+        let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
+        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        // the drum is held by its mass term; every pad node is pushed down by 1 cm
+        let mut residual = DVector::zeros(n);
+        for node in 0..model.part().mesh.nodes.len() {
+            if let Some(eq) = model.dofs().node(node)[1] {
+                residual[eq] = 1e-2 * model.mass()[eq] * 1e8;
+            }
+        }
+        let warm = DVector::zeros(rows.rows.len());
+        let settings = CoulombSettings::default();
+        let mut timings = Timings::default();
+        let touching = (0..rows.len()).filter(|&c| rows.u[c * D] < 1e-12).count();
+        assert!(touching > 0 && touching < rows.len());
+        // a tiny model length: only the touching candidates are near at first
+        let (dx, local) = contact_step(
+            &mut assembler,
+            &rows,
+            &residual,
+            &warm,
+            1e-9,
+            &settings,
+            &mut timings,
+        )
+        .expect("local");
+        // a huge one: every candidate is near
+        let (dx_all, all) = contact_step(
+            &mut assembler,
+            &rows,
+            &residual,
+            &warm,
+            1e3,
+            &settings,
+            &mut timings,
+        )
+        .expect("all");
+        let carrying = (0..rows.len()).filter(|&c| local.r[c * D] > 0.0).count();
+        assert!(carrying > touching, "{D}D: {carrying} carry force");
+        assert!(
+            (&dx - &dx_all).amax() < 1e-8 * dx_all.amax(),
+            "{D}D: {dx} vs {dx_all}"
+        );
+        assert!((&local.r - &all.r).amax() < 1e-6 * all.r.amax());
+        assert!(local.u.iter().step_by(D).all(|&g| g > -1e-9));
+    }
+
+    #[test]
+    fn far_candidates_pushed_in_join_the_contact_step_2d() {
+        far_candidates_pushed_in_join_the_contact_step::<2>();
+    }
+
+    #[test]
+    fn far_candidates_pushed_in_join_the_contact_step_3d() {
+        far_candidates_pushed_in_join_the_contact_step::<3>();
+    }
+
+    #[test]
+    fn delassus_is_h_k_inverse_h_transpose_2d() {
+        delassus_is_h_k_inverse_h_transpose::<2>();
+    }
+
+    #[test]
+    fn delassus_is_h_k_inverse_h_transpose_3d() {
+        delassus_is_h_k_inverse_h_transpose::<3>();
     }
 
     #[test]

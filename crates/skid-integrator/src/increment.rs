@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 use nalgebra::{DVector, Vector2};
 
 use crate::assembly::{Assembler, InternalState, external_forces};
-use crate::coupling::{ContactRows, contact_rows, solve_contact_forces};
+use crate::coupling::{ContactRows, contact_rows, contact_step};
 use crate::dof::EquationKind;
 use crate::error::IncrementFailure;
 use crate::hht::Hht;
@@ -89,6 +89,8 @@ pub struct IncrementCounters {
     pub contact_solves: usize,
     /// De Saxce fixed-point iterations.
     pub fixed_point_iterations: usize,
+    /// Semismooth Newton steps of the contact solves.
+    pub contact_newton_steps: usize,
     /// Scaled (force, contact) residuals at each convergence check.
     pub residuals: Vec<(f64, f64)>,
 }
@@ -128,7 +130,7 @@ pub fn solve_increment<const D: usize>(
         }
     }
     let mut counters = IncrementCounters::default();
-    let mut shift = start.shift.clone();
+    let mut warm = start.warm_forces.clone();
     // Contact forces and linearised kinematics of the last conic solve.
     let mut last: Option<(DVector<f64>, DVector<f64>)> = None;
 
@@ -197,7 +199,7 @@ pub fn solve_increment<const D: usize>(
                     f_ext,
                     internal,
                 };
-                let state = finish(model, start, kind, iterate, &rows, r, shift);
+                let state = finish(model, start, kind, iterate, &rows, r, warm);
                 return Ok((state, counters));
             }
             if iteration == newton.max_iterations {
@@ -209,26 +211,26 @@ pub fn solve_increment<const D: usize>(
             }
         }
 
-        let clock = Instant::now();
-        let factor = assembler.factorize()?;
-        let dx0 = factor.solve(&(-&residual));
         let dx = if rows.is_empty() {
+            let clock = Instant::now();
+            let dx = assembler.factorize()?.solve(&(-&residual));
             timings.linear_solve += clock.elapsed();
             last = Some((DVector::zeros(0), DVector::zeros(0)));
-            dx0
+            dx
         } else {
-            let (z, w) = rows.delassus(&factor, n);
-            let q = &rows.u + rows.times(&dx0);
-            timings.linear_solve += clock.elapsed();
-            let clock = Instant::now();
-            let solution = solve_contact_forces(&rows, &w, &q, &shift, &settings.coulomb);
-            // Failed solves cost time too: count it before reporting the failure.
-            timings.contact_solve += clock.elapsed();
-            let solution = solution.map_err(|e| IncrementFailure::Contact(e.to_string()))?;
+            let (dx, solution) = contact_step(
+                assembler,
+                &rows,
+                &residual,
+                &warm,
+                length,
+                &settings.coulomb,
+                timings,
+            )?;
             counters.contact_solves += solution.conic_solves;
             counters.fixed_point_iterations += solution.fixed_point_iterations;
-            let dx = dx0 + &z * &solution.r;
-            shift = solution.shift;
+            counters.contact_newton_steps += solution.newton_steps;
+            warm.clone_from(&solution.r);
             last = Some((solution.r, solution.u));
             dx
         };
@@ -297,7 +299,7 @@ fn finish<const D: usize>(
     iterate: Iterate,
     rows: &ContactRows,
     r: &DVector<f64>,
-    shift: Vec<f64>,
+    warm_forces: DVector<f64>,
 ) -> State {
     let Iterate {
         x,
@@ -368,7 +370,7 @@ fn finish<const D: usize>(
         net_force: net,
         external_force: f_ext,
         contacts,
-        shift,
+        warm_forces,
         energy,
     }
 }

@@ -4,11 +4,26 @@
 //! entry per equation; contact never enters it (friction is handled by the cone problem in the
 //! contact forces). So the symbolic analysis (ordering, elimination tree) is computed once per
 //! run and every Newton iteration only refactors numerically.
+//!
+//! Equations named as *trailing* (the contact equations) are eliminated last: the ordering is
+//! the approximate minimum degree ordering of the other equations followed by the trailing ones.
+//! With `P K P^T = L L^T` and the trailing set `C` last, the trailing diagonal block of `L` is the
+//! Cholesky factor of the Schur complement `S = K_CC - K_CI K_II^{-1} K_IC`, and by the block
+//! inverse formula `(K^{-1})_CC = S^{-1} = L_CC^{-T} L_CC^{-1}`: a dense inverse of the size of
+//! `C`, instead of `|C|` sparse solves with the whole factor.
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
-use faer::{Mat, Side};
+use std::sync::Arc;
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::amd;
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky,
+};
+use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat, SymbolicSparseColMatRef};
+use faer::{Conj, Mat, MatMut, Side};
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::IncrementFailure;
@@ -37,27 +52,48 @@ pub struct SparsePattern {
     symbolic: SymbolicSparseColMat<usize>,
     argsort: Argsort<usize>,
     slots: usize,
-    analysis: SymbolicLlt<usize>,
+    analysis: Arc<SymbolicCholesky<usize>>,
+    trailing: Arc<[usize]>,
 }
 
 impl SparsePattern {
     /// Builds the pattern of an `n x n` matrix from the registered entries (duplicates are
-    /// summed) and analyses it once.
+    /// summed) and analyses it once, with the equations `trailing` (distinct, `< n`) eliminated
+    /// last in the given order.
     ///
     /// # Errors
-    /// A message if faer rejects the pattern (an index out of range).
-    pub fn new(n: usize, builder: PatternBuilder) -> Result<Self, String> {
+    /// A message if faer rejects the pattern (an index out of range) or `trailing` is not a set
+    /// of distinct equations.
+    pub fn new(n: usize, builder: PatternBuilder, trailing: &[usize]) -> Result<Self, String> {
         let (symbolic, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &builder.pairs)
             .map_err(|e| format!("sparsity pattern: {e:?}"))?;
-        let analysis = SymbolicLlt::try_new(symbolic.as_ref(), Side::Lower)
-            .map_err(|e| format!("symbolic factorization: {e:?}"))?;
+        let analysis = analyse(n, &symbolic, trailing)?;
         Ok(Self {
             n,
             symbolic,
             argsort,
             slots: builder.pairs.len(),
             analysis,
+            trailing: trailing.into(),
         })
+    }
+
+    /// The equations eliminated last.
+    pub fn trailing(&self) -> &[usize] {
+        &self.trailing
+    }
+
+    /// Analyses the pattern again with the equations `trailing` eliminated last (nothing to do
+    /// if they already are, in that order).
+    ///
+    /// # Errors
+    /// A message if `trailing` is not a set of distinct equations `< n`.
+    pub fn eliminate_last(&mut self, trailing: &[usize]) -> Result<(), String> {
+        if *self.trailing != *trailing {
+            self.analysis = analyse(self.n, &self.symbolic, trailing)?;
+            self.trailing = trailing.into();
+        }
+        Ok(())
     }
 
     /// Number of value slots (registered entries, duplicates counted).
@@ -83,19 +119,106 @@ impl SparsePattern {
         }
         let matrix = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
             .map_err(|e| IncrementFailure::LinearSolve(format!("{e:?}")))?;
-        let llt = Llt::try_new_with_symbolic(self.analysis.clone(), matrix.as_ref(), Side::Lower)
+        let par = faer::get_global_parallelism();
+        let mut factor = vec![0.0; self.analysis.len_val()];
+        let mut scratch = MemBuffer::new(
+            self.analysis
+                .factorize_numeric_llt_scratch::<f64>(par, Default::default()),
+        );
+        self.analysis
+            .factorize_numeric_llt(
+                &mut factor,
+                matrix.as_ref(),
+                Side::Lower,
+                LltRegularization::default(),
+                par,
+                MemStack::new(&mut scratch),
+                Default::default(),
+            )
             .map_err(|e| {
-            IncrementFailure::LinearSolve(format!(
-                "effective tangent is not positive definite ({e:?})"
-            ))
-        })?;
-        Ok(Factorization { llt, n: self.n })
+                IncrementFailure::LinearSolve(format!(
+                    "effective tangent is not positive definite ({e:?})"
+                ))
+            })?;
+        Ok(Factorization {
+            analysis: Arc::clone(&self.analysis),
+            factor,
+            trailing: Arc::clone(&self.trailing),
+            n: self.n,
+        })
     }
+}
+
+/// The supernodal symbolic Cholesky analysis of `symbolic` with `trailing` eliminated last.
+fn analyse(
+    n: usize,
+    symbolic: &SymbolicSparseColMat<usize>,
+    trailing: &[usize],
+) -> Result<Arc<SymbolicCholesky<usize>>, String> {
+    let (forward, inverse) = trailing_last_ordering(n, symbolic.as_ref(), trailing)?;
+    let permutation = faer::perm::PermRef::new_checked(&forward, &inverse, n);
+    let params = CholeskySymbolicParams {
+        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+        ..Default::default()
+    };
+    factorize_symbolic_cholesky(
+        symbolic.as_ref(),
+        Side::Lower,
+        SymmetricOrdering::Custom(permutation),
+        params,
+    )
+    .map(Arc::new)
+    .map_err(|e| format!("symbolic factorization: {e:?}"))
+}
+
+/// Elimination order (`forward[new] = old`, `inverse[old] = new`): the approximate minimum degree
+/// ordering of the whole pattern with the `trailing` equations taken out of it and appended in the
+/// given order. (Ordering the other equations by their own graph alone ignores their coupling to
+/// the trailing block and gives more fill.)
+fn trailing_last_ordering(
+    n: usize,
+    pattern: SymbolicSparseColMatRef<'_, usize>,
+    trailing: &[usize],
+) -> Result<(Vec<usize>, Vec<usize>), String> {
+    let mut is_trailing = vec![false; n];
+    for &eq in trailing {
+        match is_trailing.get_mut(eq) {
+            Some(flag) if !*flag => *flag = true,
+            _ => return Err(format!("trailing equation {eq} repeated or out of range")),
+        }
+    }
+    let mut order = vec![0usize; n];
+    let mut order_inverse = vec![0usize; n];
+    let mut scratch = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<usize>(
+        n,
+        pattern.compute_nnz(),
+    ))
+    .map_err(|e| format!("ordering: {e:?}"))?;
+    amd::order_maybe_unsorted(
+        &mut order,
+        &mut order_inverse,
+        pattern,
+        amd::Control::default(),
+        MemStack::new(&mut scratch),
+    )
+    .map_err(|e| format!("ordering: {e:?}"))?;
+    let forward: Vec<usize> = order
+        .into_iter()
+        .filter(|&eq| !is_trailing[eq])
+        .chain(trailing.iter().copied())
+        .collect();
+    let mut inverse = vec![0; n];
+    for (new, &old) in forward.iter().enumerate() {
+        inverse[old] = new;
+    }
+    Ok((forward, inverse))
 }
 
 /// A numeric Cholesky factorization.
 pub struct Factorization {
-    llt: Llt<usize, f64>,
+    analysis: Arc<SymbolicCholesky<usize>>,
+    factor: Vec<f64>,
+    trailing: Arc<[usize]>,
     n: usize,
 }
 
@@ -103,15 +226,79 @@ impl Factorization {
     /// Solves `K x = b`.
     pub fn solve(&self, b: &DVector<f64>) -> DVector<f64> {
         let mut rhs = Mat::<f64>::from_fn(self.n, 1, |i, _| b[i]);
-        self.llt.solve_in_place(rhs.as_mut());
+        self.solve_in_place(rhs.as_mut());
         DVector::from_fn(self.n, |i, _| rhs[(i, 0)])
     }
 
-    /// Solves `K X = B` for several right-hand sides at once.
-    pub fn solve_many(&self, b: &DMatrix<f64>) -> DMatrix<f64> {
-        let mut rhs = Mat::<f64>::from_fn(self.n, b.ncols(), |i, j| b[(i, j)]);
-        self.llt.solve_in_place(rhs.as_mut());
-        DMatrix::from_fn(self.n, b.ncols(), |i, j| rhs[(i, j)])
+    fn solve_in_place(&self, rhs: MatMut<'_, f64>) {
+        let par = faer::get_global_parallelism();
+        let mut scratch = MemBuffer::new(
+            self.analysis
+                .solve_in_place_scratch::<f64>(rhs.ncols(), par),
+        );
+        LltRef::new(&self.analysis, &self.factor).solve_in_place_with_conj(
+            Conj::No,
+            rhs,
+            par,
+            MemStack::new(&mut scratch),
+        );
+    }
+
+    /// The equations eliminated last, in the order of [`Self::trailing_inverse`].
+    pub fn trailing(&self) -> &[usize] {
+        &self.trailing
+    }
+
+    /// `(K^{-1})_CC`, the block of the inverse on the trailing equations `C` (in the order of
+    /// [`Self::trailing`]): `S^{-1} = L_CC^{-T} L_CC^{-1}` from the trailing diagonal block of the
+    /// factor (see the module documentation).
+    pub fn trailing_inverse(&self) -> DMatrix<f64> {
+        let c = self.trailing.len();
+        let first = self.n - c;
+        let mut l_cc = Mat::<f64>::zeros(c, c);
+        let SymbolicCholeskyRaw::Supernodal(symbolic) = self.analysis.raw() else {
+            unreachable!("the analysis is forced supernodal")
+        };
+        let factor = faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef::new(
+            symbolic,
+            &self.factor,
+        );
+        for s in 0..symbolic.n_supernodes() {
+            let node = factor.supernode(s);
+            let (start, values) = (node.start(), node.val());
+            let width = values.ncols();
+            if start + width <= first {
+                continue;
+            }
+            // rows: the diagonal block start..start+width, then the pattern
+            let rows = (start..start + width).chain(node.pattern().iter().copied());
+            for (local_row, row) in rows.enumerate() {
+                for local_col in 0..width.min(local_row + 1) {
+                    let col = start + local_col;
+                    if col >= first {
+                        l_cc[(row - first, col - first)] = values[(local_row, local_col)];
+                    }
+                }
+            }
+        }
+        let par = faer::get_global_parallelism();
+        let mut inverse = Mat::<f64>::zeros(c, c);
+        let mut scratch =
+            MemBuffer::new(faer::linalg::cholesky::llt::inverse::inverse_scratch::<f64>(c, par));
+        faer::linalg::cholesky::llt::inverse::inverse(
+            inverse.as_mut(),
+            l_cc.as_ref(),
+            par,
+            MemStack::new(&mut scratch),
+        );
+        // only the lower triangle is written
+        DMatrix::from_fn(c, c, |i, j| {
+            if i >= j {
+                inverse[(i, j)]
+            } else {
+                inverse[(j, i)]
+            }
+        })
     }
 }
 
@@ -135,7 +322,7 @@ mod tests {
             ]);
         }
         let diag: Vec<usize> = (0..n).map(|i| builder.push(i, i)).collect();
-        let pattern = SparsePattern::new(n, builder).expect("pattern");
+        let pattern = SparsePattern::new(n, builder, &[]).expect("pattern");
         for k in [1.0, 7.5] {
             let mut values = vec![0.0; pattern.slots()];
             for s in &element_slots {
@@ -158,9 +345,52 @@ mod tests {
             }
             let x = f.solve(&b);
             assert!((x - &x_true).amax() < 1e-10);
-            let many = f.solve_many(&DMatrix::from_columns(&[b.clone(), b * 2.0]));
-            assert!((many.column(1) - x_true * 2.0).amax() < 1e-10);
         }
+    }
+
+    /// The block of the inverse on the trailing equations, read off the trailing block of the
+    /// factor, is the block of the dense inverse: a 2D grid Laplacian plus a diagonal, with an
+    /// edge of the grid and a scattered equation eliminated last.
+    #[test]
+    fn trailing_inverse_is_the_block_of_the_inverse() {
+        let side = 9;
+        let n = side * side;
+        let mut builder = PatternBuilder::default();
+        let mut entries = Vec::new();
+        for i in 0..n {
+            entries.push((builder.push(i, i), i, i, 4.5 + (i as f64 * 0.7).sin()));
+            for j in [i + 1, i + side] {
+                let neighbour = (j < n) && (j != i + 1 || j % side != 0);
+                if neighbour {
+                    entries.push((builder.push(j, i), j, i, -1.0));
+                }
+            }
+        }
+        let trailing: Vec<usize> = (0..side).map(|k| k * side).chain([40, 3]).collect();
+        let pattern = SparsePattern::new(n, builder, &trailing).expect("pattern");
+        let mut values = vec![0.0; pattern.slots()];
+        let mut dense = DMatrix::<f64>::zeros(n, n);
+        for &(slot, i, j, v) in &entries {
+            values[slot] = v;
+            dense[(i, j)] = v;
+            dense[(j, i)] = v;
+        }
+        let factor = pattern.factorize(&values).expect("spd");
+        assert_eq!(factor.trailing(), trailing.as_slice());
+        let block = factor.trailing_inverse();
+        let inverse = dense.try_inverse().expect("invertible");
+        let expected = DMatrix::from_fn(trailing.len(), trailing.len(), |a, b| {
+            inverse[(trailing[a], trailing[b])]
+        });
+        assert!(
+            (&block - &expected).amax() < 1e-12 * expected.amax(),
+            "{block} vs {expected}"
+        );
+        // the solve is unaffected by the ordering
+        let b = DVector::from_fn(n, |i, _| (i as f64).cos());
+        assert!((factor.solve(&b) - &inverse * &b).amax() < 1e-12);
+        // a repeated trailing equation is rejected
+        assert!(SparsePattern::new(n, PatternBuilder::default(), &[1, 1]).is_err());
     }
 
     #[test]
@@ -168,7 +398,7 @@ mod tests {
         let mut builder = PatternBuilder::default();
         let a = builder.push(0, 0);
         let b = builder.push(1, 1);
-        let pattern = SparsePattern::new(2, builder).expect("pattern");
+        let pattern = SparsePattern::new(2, builder, &[]).expect("pattern");
         let mut values = vec![0.0; pattern.slots()];
         values[a] = 1.0;
         values[b] = -1.0;

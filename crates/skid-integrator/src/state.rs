@@ -67,8 +67,9 @@ pub struct State {
     pub contact_reaction: DVector<f64>,
     /// Contact candidates, pair by pair, node by node.
     pub contacts: Vec<ContactPointState>,
-    /// De Saxce shifts of the last contact solve (warm start of the next).
-    pub shift: Vec<f64>,
+    /// Contact forces `r` of the last contact solve, one per contact row (`[r_N, r_T..]` per
+    /// candidate): the warm start of the next.
+    pub warm_forces: DVector<f64>,
     /// Energy bookkeeping.
     pub energy: EnergyLedger,
 }

@@ -135,6 +135,8 @@ pub struct RunStatistics {
     pub contact_solves: usize,
     /// De Saxce fixed-point iterations of converged increments.
     pub fixed_point_iterations: usize,
+    /// Semismooth Newton steps of the contact solves of converged increments.
+    pub contact_newton_steps: usize,
     /// Failed attempts answered by a cutback.
     pub cutbacks: usize,
     /// The failed attempts by kind of failure ([`IncrementFailure::kind`]).
@@ -196,7 +198,7 @@ pub fn initial_state<const D: usize>(
         net_force: -&f_ext,
         contact_reaction: DVector::zeros(n),
         external_force: f_ext,
-        shift: vec![0.0; contacts.len()],
+        warm_forces: DVector::zeros(contacts.len() * D),
         contacts,
         energy,
     })
@@ -370,6 +372,7 @@ fn run_steps<const D: usize>(
                     stats.newton_iterations += counters.newton_iterations;
                     stats.contact_solves += counters.contact_solves;
                     stats.fixed_point_iterations += counters.fixed_point_iterations;
+                    stats.contact_newton_steps += counters.contact_newton_steps;
                     observer.on_increment(
                         model,
                         &IncrementReport {

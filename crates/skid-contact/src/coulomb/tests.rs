@@ -389,7 +389,7 @@ fn non_convergence_is_reported_as_cutback_error() {
         conic_max_iterations: 1,
         ..tight()
     };
-    match solve_coulomb(&problem, &settings, None) {
+    match solve_fixed_point(&problem, &settings, None, true) {
         Err(ContactError::ConicSolveFailed {
             status,
             fixed_point_iteration: 1,
@@ -404,7 +404,10 @@ fn invalid_inputs_are_rejected_without_panic() {
     let q = DVector::from_vec(vec![-0.01, 0.05]);
     let settings = tight();
     let check = |problem: FrictionProblem, shift: Option<&[f64]>, settings: &CoulombSettings| {
-        let result = solve_coulomb(&problem, settings, shift);
+        let result = match shift {
+            Some(shift) => solve_fixed_point(&problem, settings, Some(shift), true),
+            None => solve_coulomb(&problem, settings, None),
+        };
         assert!(
             matches!(result, Err(ContactError::InvalidProblem(_))),
             "{result:?}"
@@ -469,6 +472,13 @@ fn invalid_inputs_are_rejected_without_panic() {
     );
     check(good, Some(&[0.1, 0.2]), &settings);
     check(good, Some(&[-0.1]), &settings);
+    for forces in [vec![0.1], vec![0.1, f64::INFINITY]] {
+        let result = solve_coulomb(&good, &settings, Some(&DVector::from_vec(forces)));
+        assert!(
+            matches!(result, Err(ContactError::InvalidProblem(_))),
+            "{result:?}"
+        );
+    }
     let zero_tolerance = CoulombSettings {
         tolerance: 0.0,
         ..tight()
@@ -561,6 +571,51 @@ proptest! {
                 prop_assert!(natural_map_error(&scaled, &relaxed, &u_relaxed) > 1e-8);
             }
         }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 64,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x0a1a_c0de),
+        ..ProptestConfig::default()
+    })]
+
+    /// Semismooth Newton (from `r = 0`) and the conic fixed point find the same forces on random
+    /// coupled instances, both satisfying the exact law; warm-started with the solution, Newton
+    /// confirms it without a conic solve in at most one step.
+    #[test]
+    fn newton_and_conic_fixed_point_agree(
+        seed in any::<u64>(),
+        n in 1usize..12,
+        three_d in any::<bool>(),
+        mu_max in 0.0f64..0.3,
+        w_shift in 0.1f64..1.0,
+    ) {
+        let dim = if three_d { 3 } else { 2 };
+        let mut rng = Rng(seed);
+        let w = random_delassus(&mut rng, dim * n, w_shift) * 1e-6;
+        let q = DVector::from_fn(dim * n, |k, _| {
+            1e-3 * if k % dim == 0 { rng.uniform(-1.0, 0.5) } else { rng.uniform(-2.0, 2.0) }
+        });
+        let mu: Vec<f64> = (0..n).map(|_| rng.uniform(0.0, mu_max)).collect();
+        let problem = FrictionProblem { dim, w: &w, q: &q, mu: &mu };
+        let newton = solve_coulomb(&problem, &tight(), None);
+        let conic = solve_fixed_point(&problem, &tight(), None, true);
+        prop_assert!(newton.is_ok() && conic.is_ok(), "{:?} {:?}", newton, conic);
+        let (Ok(newton), Ok(conic)) = (newton, conic) else { return Ok(()) };
+        check_coulomb_law(dim, &mu, &newton, 1e3, 1e-3);
+        check_coulomb_law(dim, &mu, &conic, 1e3, 1e-3);
+        let scale = conic.r.amax().max(1e-3);
+        prop_assert!(
+            (&newton.r - &conic.r).amax() <= 1e-6 * scale,
+            "{} vs {}", newton.r, conic.r
+        );
+        let warm = solve_coulomb(&problem, &tight(), Some(&conic.r));
+        prop_assert!(warm.is_ok(), "{:?}", warm);
+        let Ok(warm) = warm else { return Ok(()) };
+        prop_assert_eq!(warm.conic_solves, 0);
+        prop_assert!(warm.newton_steps <= 1);
     }
 }
 

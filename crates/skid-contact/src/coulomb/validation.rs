@@ -1,6 +1,6 @@
 //! Input checks for the friction problem, done before any data reaches clarabel (which asserts).
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 use super::{CoulombSettings, FrictionProblem};
 use crate::error::ContactError;
@@ -65,7 +65,9 @@ fn check_delassus(w: &DMatrix<f64>, dim: usize) -> Result<(), ContactError> {
         ))?;
     }
     let magnitude = w.amax();
-    let asymmetry = (w - w.transpose()).amax();
+    let asymmetry = (0..w.ncols())
+        .flat_map(|j| (j + 1..w.nrows()).map(move |i| (w[(i, j)] - w[(j, i)]).abs()))
+        .fold(0.0, f64::max);
     if asymmetry > SYMMETRY_TOLERANCE * magnitude {
         invalid(format!(
             "W is not symmetric: max |W - W^T| = {asymmetry:e} against max |W| = {magnitude:e}"
@@ -104,6 +106,20 @@ pub(crate) fn check_shift(shift: &[f64], n_contacts: usize) -> Result<(), Contac
     }
     if !shift.iter().all(|s| s.is_finite() && *s >= 0.0) {
         invalid("initial shift entries must be finite and >= 0".into())?;
+    }
+    Ok(())
+}
+
+/// Check warm-start forces: one finite entry per unknown.
+pub(crate) fn check_forces(forces: &DVector<f64>, unknowns: usize) -> Result<(), ContactError> {
+    if forces.len() != unknowns {
+        invalid(format!(
+            "initial forces have length {} but there are {unknowns} unknowns",
+            forces.len()
+        ))?;
+    }
+    if !forces.iter().all(|f| f.is_finite()) {
+        invalid("initial forces must be finite".into())?;
     }
     Ok(())
 }
