@@ -13,7 +13,7 @@ use skid_fem::solid::ElementResponse;
 
 use crate::error::{IncrementFailure, ModelError};
 use crate::model::Model;
-use crate::sparse::{Factorization, PatternBuilder, SparsePattern};
+use crate::sparse::{Factorization, NON_FINITE_TANGENT, PatternBuilder, SparsePattern};
 
 /// Below this many elements the element loop runs sequentially (threads cost more than they
 /// save on tiny meshes).
@@ -183,7 +183,53 @@ impl Assembler {
     pub fn factorize(&self) -> Result<Factorization, IncrementFailure> {
         self.pattern.factorize(&self.values)
     }
+
+    /// Factorizes `K + c_k M` (the current values hold `K + c_0 M`, held equations already
+    /// replaced by identity rows), with the first `c_k = c_0 10^k`, `k = 0, 1, ...,`
+    /// [`MAX_SHIFT_DECADES`], for which it is positive definite; returns the factor and `c_k`.
+    ///
+    /// This is the pseudo-transient continuation of a static Newton step: the mass term is not
+    /// in the residual, so the converged state does not depend on it; a larger `c` only turns
+    /// Newton's step into a damped, shorter one. It is needed where the tangent of the solid
+    /// *without its contacts* is indefinite although the contact-constrained problem is stable:
+    /// a pad pressed harder than its shear modulus by a load balanced only by contact forces
+    /// (its free front face may shear and tilt at negative stiffness, `tau : Omega^T Omega < 0`
+    /// for a compressive Kirchhoff stress), which the Cholesky-based contact reduction cannot
+    /// factor. A `c_0` of zero is not escalated.
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] if even `c_0 10^MAX_SHIFT_DECADES` leaves the matrix
+    /// indefinite, or for non-finite entries.
+    pub fn factorize_shifted(
+        &mut self,
+        mass: &DVector<f64>,
+        c0: f64,
+        held: &[bool],
+    ) -> Result<(Factorization, f64), IncrementFailure> {
+        let mut c = c0;
+        let mut decades = 0;
+        loop {
+            match self.factorize() {
+                Ok(factor) => return Ok((factor, c)),
+                Err(IncrementFailure::LinearSolve(message))
+                    if decades < MAX_SHIFT_DECADES
+                        && c > 0.0
+                        && !message.starts_with(NON_FINITE_TANGENT) =>
+                {
+                    self.add_diagonal(&(mass * (9.0 * c)));
+                    self.hold(held);
+                    c *= 10.0;
+                    decades += 1;
+                }
+                Err(e) => return Err(e),
+            }
+        }
+    }
 }
+
+/// How many tenfold increases of the static step's mass shift [`Assembler::factorize_shifted`]
+/// tries before it reports the tangent as indefinite.
+pub const MAX_SHIFT_DECADES: usize = 8;
 
 /// External nodal forces of the pressure loads at load factor `lambda`, on the current
 /// geometry (follower pressure), per equation.

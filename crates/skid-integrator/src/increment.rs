@@ -12,8 +12,10 @@
 //! Dynamic residual (HHT): `R = M a + (1 + alpha) F(x) - alpha F_n`; tangent
 //! `M/(beta h^2) + (1 + alpha) K_T`. Static residual: `R = F(x)` with `F = f_int - lambda f_ext`;
 //! tangent `K_T + M/h_s^2`. The mass term of the static tangent only regularises the Newton
-//! step (it keeps a pad that is not yet held by contact from being singular); it is not in the
-//! residual, so the converged state is exactly static.
+//! step (it keeps a pad that is not yet held by contact from being singular, and it grows
+//! tenfold at a time where the tangent without contact is indefinite, see
+//! [`Assembler::factorize_shifted`]); it is not in the residual, so the converged state is
+//! exactly static.
 
 use std::time::{Duration, Instant};
 
@@ -210,7 +212,12 @@ pub fn solve_increment<const D: usize>(
         }
 
         let clock = Instant::now();
-        let factor = assembler.factorize()?;
+        let factor = match kind {
+            IncrementKind::Static { regularization, .. } => {
+                assembler.factorize_shifted(mass, regularization, held)?.0
+            }
+            IncrementKind::Dynamic { .. } => assembler.factorize()?,
+        };
         let dx0 = factor.solve(&(-&residual));
         let dx = if rows.is_empty() {
             timings.linear_solve += clock.elapsed();
