@@ -9,9 +9,10 @@ use nalgebra::{DVector, SVector};
 use rayon::prelude::*;
 use skid_fem::error::FemError;
 use skid_fem::pressure::pressure_face_forces;
-use skid_fem::solid::ElementResponse;
+use skid_fem::solid::{ElementResponse, Tangent};
 
 use crate::error::{IncrementFailure, ModelError};
+use crate::mixed::MixedPressures;
 use crate::model::Model;
 use crate::sparse::{Factorization, NON_FINITE_TANGENT, PatternBuilder, SparsePattern};
 
@@ -47,6 +48,8 @@ pub struct Assembler {
     diagonal: Vec<usize>,
     slot_position: Vec<(usize, usize)>,
     values: Vec<f64>,
+    /// Element pressures of the mixed tangent between Newton iterates.
+    mixed: MixedPressures,
 }
 
 impl Assembler {
@@ -87,6 +90,7 @@ impl Assembler {
             diagonal,
             slot_position,
             values,
+            mixed: MixedPressures::new(model.elements().len()),
         })
     }
 
@@ -102,13 +106,19 @@ impl Assembler {
         tangent_factor: Option<f64>,
     ) -> Result<InternalState, IncrementFailure> {
         let part = model.part();
+        let mixed = &self.mixed;
         let evaluate = |e: usize| -> Result<ElementResponse, IncrementFailure> {
             let u: Vec<SVector<f64, D>> = part.mesh.elements[e]
                 .iter()
                 .map(|&n| model.dofs().node_displacement(x, n))
                 .collect();
+            let tangent = if tangent_factor.is_some() {
+                mixed.tangent(e)
+            } else {
+                Tangent::None
+            };
             model.elements()[e]
-                .evaluate(part.material.as_ref(), &u, tangent_factor.is_some())
+                .respond(part.material.as_ref(), &u, tangent)
                 .map_err(|err| match err {
                     FemError::InvertedElement { det_f } => {
                         IncrementFailure::InvertedElement { element: e, det_f }
@@ -129,6 +139,7 @@ impl Assembler {
             (0..n_el).map(evaluate).collect::<Result<_, _>>()?
         };
 
+        self.mixed.record(model, x, &responses);
         let mut state = InternalState {
             force: DVector::zeros(model.dofs().len()),
             strain_energy: 0.0,
@@ -152,6 +163,30 @@ impl Assembler {
             }
         }
         Ok(state)
+    }
+
+    /// At the start of an increment from the converged configuration `start`: the first
+    /// tangent takes the element pressures `U'(J)` there (evaluated again unless the last
+    /// [`Self::internal`] call was at `start`); see [`crate::mixed`].
+    ///
+    /// # Errors
+    /// As [`Self::internal`].
+    pub fn start_mixed_pressures<const D: usize>(
+        &mut self,
+        model: &Model<D>,
+        start: &DVector<f64>,
+    ) -> Result<(), IncrementFailure> {
+        if !self.mixed.recorded_at(start) {
+            self.internal(model, start, None)?;
+        }
+        self.mixed.hold();
+        Ok(())
+    }
+
+    /// After the Newton step `dx` from the configuration of the last [`Self::internal`] call,
+    /// predicts the element pressures the next tangent uses; see [`crate::mixed`].
+    pub fn advance_mixed_pressures<const D: usize>(&mut self, model: &Model<D>, dx: &DVector<f64>) {
+        self.mixed.advance(model, dx);
     }
 
     /// Adds `d_i` to each diagonal entry of the effective tangent (mass terms).

@@ -129,6 +129,7 @@ pub fn solve_increment<const D: usize>(
             x[eq] = start.x[eq];
         }
     }
+    assembler.start_mixed_pressures(model, &start.x)?;
     let mut counters = IncrementCounters::default();
     let mut shift = start.shift.clone();
     // Contact forces and linearised kinematics of the last conic solve.
@@ -243,6 +244,7 @@ pub fn solve_increment<const D: usize>(
         if dx.iter().any(|v| !v.is_finite()) {
             return Err(IncrementFailure::NonFinite { iteration });
         }
+        assembler.advance_mixed_pressures(model, &dx);
         x += dx;
     }
     // The loop returns from inside: either converged or at the last convergence check.
