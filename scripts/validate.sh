@@ -1,16 +1,26 @@
 #!/usr/bin/env bash
-# The drum validation: builds skid (release), runs every drum idealization of cases/drum in
-# parallel, writes the comparison report validation/report.md (with its plots), and checks the
-# 2D benchmark's convergence in time step and insensitivity to the pad density. Results go to
-# out/. Exit status 0 only if every run completed and every check passed.
+# The drum validation: builds skid (release); runs every drum idealization of cases/drum and
+# every hard case of cases/hard in parallel, and the convergence study (scripts/convergence.sh);
+# writes the report validation/report.md (benchmark, hard cases, convergence) with its plots;
+# and checks the 2D benchmark's convergence in time step and insensitivity to the pad density.
+# Results go to out/. Exit status 0 only if every run completed and every check passed.
+#
+# HARD_CASES: the hard case files or directories to run instead of cases/hard (words, globs
+# allowed), e.g. HARD_CASES='cases/hard/2d-*.json'.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release -p skid-cli
-skid=target/release/skid
+skid=${CARGO_TARGET_DIR:-target}/release/skid
 
 status=0
 "$skid" batch cases/drum --out out/drum || status=1
-"$skid" report --runs out/drum --out validation/report.md || status=1
+# shellcheck disable=SC2206 # split into words and expand globs on purpose
+hard=(${HARD_CASES:-cases/hard})
+rm -rf out/hard # runs of cases left out must not stay in the report
+"$skid" batch "${hard[@]}" --out out/hard || status=1
+SKID="$skid" scripts/convergence.sh out/convergence || status=1
+"$skid" report --runs out/drum --hard out/hard --convergence out/convergence \
+    --out validation/report.md || status=1
 
 out=out/validation
 mkdir -p "$out"

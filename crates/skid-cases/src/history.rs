@@ -3,15 +3,15 @@
 //!
 //! The CSV is written to `history.csv.partial` and renamed to `history.csv` only when the run
 //! has ended (completed, or stopped with an error that the summary reports), so an interrupted
-//! process never leaves a file that looks complete.
+//! process never leaves a file that looks complete ([`PartialCsv`]).
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::io::Write;
+use std::path::Path;
 
 use skid_integrator::Model;
 use skid_integrator::stepper::{IncrementReport, Observer};
 
+use crate::csv_out::PartialCsv;
 use crate::drum::{BACK_PLATE, DRUM};
 
 /// Column names of `history.csv`.
@@ -73,9 +73,7 @@ pub struct Sample {
 
 /// Observer writing `history.csv` and keeping the samples.
 pub struct DrumRecorder {
-    writer: BufWriter<File>,
-    partial: PathBuf,
-    final_path: PathBuf,
+    csv: PartialCsv,
     /// Samples of all converged increments (and the initial state).
     pub samples: Vec<Sample>,
 }
@@ -86,14 +84,8 @@ impl DrumRecorder {
     /// # Errors
     /// I/O errors.
     pub fn create(dir: &Path) -> std::io::Result<Self> {
-        let final_path = dir.join("history.csv");
-        let partial = dir.join("history.csv.partial");
-        let mut writer = BufWriter::new(File::create(&partial)?);
-        writeln!(writer, "{}", COLUMNS.join(","))?;
         Ok(Self {
-            writer,
-            partial,
-            final_path,
+            csv: PartialCsv::create(&dir.join("history.csv"), &COLUMNS)?,
             samples: Vec::new(),
         })
     }
@@ -102,10 +94,8 @@ impl DrumRecorder {
     ///
     /// # Errors
     /// I/O errors.
-    pub fn finish(mut self) -> std::io::Result<Vec<Sample>> {
-        self.writer.flush()?;
-        self.writer.get_ref().sync_all()?;
-        std::fs::rename(&self.partial, &self.final_path)?;
+    pub fn finish(self) -> std::io::Result<Vec<Sample>> {
+        self.csv.finish()?;
         Ok(self.samples)
     }
 }
@@ -145,7 +135,7 @@ impl<const D: usize> Observer<D> for DrumRecorder {
         }
         let e = &s.energy;
         writeln!(
-            self.writer,
+            self.csv.rows(),
             "{:.9e},{},{},{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{},{},{},{},{:.3e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e}",
             s.time,
             report.step,

@@ -4,16 +4,21 @@
 //! - [`validate`]: reading a case with field-level error messages and overrides;
 //! - [`drum`]: building the drum scene (any idealization, 2D or 3D) as a model;
 //! - [`history`]: the per-increment history of the drum (`history.csv`);
+//! - [`newton`]: the Newton residuals of every increment (`newton.csv`);
+//! - [`csv_out`]: CSV files that appear only when complete;
 //! - [`summary`]: stop time, spin-down straightness, post-stop motion, energy balance;
 //! - [`fields`]: ParaView field output (VTU frames and a PVD collection);
 //! - [`runner`]: running one case into an output directory;
 //! - [`batch`]: running many cases in parallel;
-//! - [`report`]: the validation report comparing the runs of a batch.
+//! - [`report`]: the validation report: the benchmark runs, the hard cases, the convergence
+//!   study.
 
 pub mod batch;
+pub mod csv_out;
 pub mod drum;
 pub mod fields;
 pub mod history;
+pub mod newton;
 pub mod report;
 pub mod runner;
 pub mod schema;
@@ -21,7 +26,7 @@ pub mod summary;
 pub mod validate;
 
 pub use batch::{BatchEntry, BatchError, BatchStatus, collect_case_files, run_batch};
-pub use report::{ReportError, ReportOutcome, write_report};
+pub use report::{ReportError, ReportOutcome, ReportSources, write_report};
 pub use runner::{default_output_dir, run_case, run_case_file};
 pub use schema::Case;
 pub use summary::Summary;

@@ -1,19 +1,31 @@
-//! The validation report: reads the runs of a batch (`<runs>/*/summary.json` and
-//! `history.csv`), compares every run's drum spin-down with a reference run (DRUM.md section 3)
-//! and writes a markdown report with two SVG plots next to it.
+//! The validation report: reads runs (`<dir>/*/summary.json`, `history.csv`, `case.json`) and
+//! writes a markdown report with SVG plots next to it. Its sections, each from its own
+//! directory of runs:
 //!
-//! - this module: reading runs, and the comparison math (interpolation, `e_slide`);
-//! - [`plot`]: the SVG plots;
-//! - [`markdown`]: the report text, its table and acceptance checks.
+//! - the benchmark ([`markdown`]): every run's drum spin-down against a reference run
+//!   (DRUM.md section 3), with [`plot`]'s omega plots;
+//! - the hard cases ([`hard`]): checks derived from each run's case;
+//! - the convergence study ([`convergence`]): t_stop and e_slide against mesh and time-step
+//!   refinement with observed orders, and Newton residual histories.
+//!
+//! This module: reading runs, and the comparison math (interpolation, `e_slide`); [`format`]:
+//! number formatting and check lists shared by the sections.
 
+pub mod convergence;
+pub mod format;
+pub mod hard;
 pub mod markdown;
 pub mod plot;
 
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use crate::runner::write_atomic;
+use format::Counts;
+
+use crate::runner::{CASE_JSON, write_atomic};
+use crate::schema::Case;
 
 /// The run used as reference when none is requested.
 pub const DEFAULT_REFERENCE: &str = "3d-analytic-fine";
@@ -70,10 +82,15 @@ pub struct RunSummary {
     pub dimension: usize,
     /// `"completed"` or `"failed"`.
     pub status: String,
+    /// Why the run stopped early, if it did.
+    #[serde(default)]
+    pub error: Option<String>,
     /// Stop time from the start of the dynamic step, s.
     pub t_stop: Option<f64>,
     /// Initial angular velocity, rad/s.
     pub omega0: f64,
+    /// Least-squares deceleration over `[0.1, 0.9] t_stop`, rad/s^2.
+    pub deceleration: Option<f64>,
     /// Deceleration of the analytic estimate, rad/s^2.
     pub deceleration_analytic: f64,
     /// Largest `|omega|` after the stop, rad/s.
@@ -82,12 +99,20 @@ pub struct RunSummary {
     pub post_stop_max_angle_change: Option<f64>,
     /// Relative energy balance error.
     pub energy_balance_error: Option<f64>,
+    /// Energy balance residual, J.
+    pub energy_balance_residual_j: Option<f64>,
+    /// Deepest penetration over the run, m.
+    pub max_gap_violation_m: f64,
+    /// Largest gap at a contact carrying force while sliding, m.
+    pub max_sliding_separation_m: f64,
     /// Converged increments.
     pub increments: usize,
     /// Newton iterations.
     pub newton_iterations: usize,
     /// Conic solves.
     pub contact_solves: usize,
+    /// Failed attempts answered by a cutback.
+    pub cutbacks: usize,
     /// Wall time of the run, s.
     pub wall_time_s: f64,
 }
@@ -99,6 +124,8 @@ pub struct History {
     pub time: Vec<f64>,
     /// Drum angular velocity, rad/s.
     pub omega: Vec<f64>,
+    /// Non-finite numbers (NaN, infinity) anywhere in the file's rows.
+    pub non_finite: usize,
 }
 
 /// One run of a batch.
@@ -110,6 +137,8 @@ pub struct Run {
     pub summary: RunSummary,
     /// Its dynamic history.
     pub history: History,
+    /// The case as run (`case.json`), if the run directory has it.
+    pub case: Option<Case>,
 }
 
 /// Keeps the dynamic part of a history: the last row before time first advances (the state the
@@ -137,7 +166,8 @@ pub fn dynamic_part(time: &[f64], omega: &[f64]) -> History {
 }
 
 /// Reads `history.csv` text (columns found by name: `time`, `drum_omega`) and keeps its
-/// dynamic part ([`dynamic_part`]); `path` is only used in messages.
+/// dynamic part ([`dynamic_part`]), counting the non-finite numbers in every column; `path` is
+/// only used in messages.
 ///
 /// # Errors
 /// [`ReportError::Parse`] naming the line and column at fault.
@@ -160,8 +190,14 @@ pub fn parse_history(text: &str, path: &Path) -> Result<History, ReportError> {
     };
     let (it, iw) = (column("time")?, column("drum_omega")?);
     let (mut time, mut omega) = (Vec::new(), Vec::new());
+    let mut non_finite = 0;
     for (k, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let fields: Vec<&str> = line.split(',').collect();
+        non_finite += fields
+            .iter()
+            .filter_map(|f| f.trim().parse::<f64>().ok())
+            .filter(|v| !v.is_finite())
+            .count();
         let value = |i: usize, name: &str| {
             fields
                 .get(i)
@@ -173,7 +209,10 @@ pub fn parse_history(text: &str, path: &Path) -> Result<History, ReportError> {
         time.push(value(it, "time")?);
         omega.push(value(iw, "drum_omega")?);
     }
-    Ok(dynamic_part(&time, &omega))
+    Ok(History {
+        non_finite,
+        ..dynamic_part(&time, &omega)
+    })
 }
 
 /// Linear interpolation of `values(times)` at `t`; `None` outside `[times[0], times[last]]`
@@ -240,6 +279,16 @@ pub fn load_run(dir: &Path) -> Result<Run, ReportError> {
         })?;
     let history_path = dir.join("history.csv");
     let history = parse_history(&read(&history_path)?, &history_path)?;
+    let case_path = dir.join(CASE_JSON);
+    let case = if case_path.is_file() {
+        let case = serde_json::from_str(&read(&case_path)?).map_err(|e| ReportError::Parse {
+            path: case_path.clone(),
+            message: format!("expected the case as run (written by skid run): {e}"),
+        })?;
+        Some(case)
+    } else {
+        None
+    };
     let name = dir
         .file_name()
         .map_or_else(|| summary.case.clone(), |n| n.to_string_lossy().into());
@@ -247,6 +296,7 @@ pub fn load_run(dir: &Path) -> Result<Run, ReportError> {
         name,
         summary,
         history,
+        case,
     })
 }
 
@@ -298,29 +348,60 @@ pub fn choose_reference(runs: &[Run], requested: Option<&str>) -> Result<usize, 
     })
 }
 
+/// Where the report's sections come from; a section is written when its directory is given.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ReportSources<'a> {
+    /// Benchmark runs, one subdirectory per run, compared with a reference run.
+    pub runs: Option<&'a Path>,
+    /// The reference run among `runs` (see [`choose_reference`]).
+    pub reference: Option<&'a str>,
+    /// Hard-case runs, one subdirectory per run, each with its `case.json`.
+    pub hard: Option<&'a Path>,
+    /// The convergence study: one subdirectory per series, holding one per level.
+    pub convergence: Option<&'a Path>,
+}
+
 /// What [`write_report`] wrote and found.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReportOutcome {
-    /// The reference run's name.
-    pub reference: String,
+    /// The reference run's name, if the benchmark section was written.
+    pub reference: Option<String>,
     /// Files written: the markdown report and the plots.
     pub files: Vec<PathBuf>,
-    /// Acceptance checks passed, failed and skipped.
-    pub counts: markdown::Counts,
+    /// Acceptance checks passed, failed and skipped, over all sections.
+    pub counts: Counts,
 }
 
-/// Reads the runs in `runs`, and writes the report `out` with `omega.svg` and
-/// `omega-difference.svg` beside it.
+/// The shell commands that regenerate a report from `sources` into `out`.
+fn regenerate(sources: &ReportSources<'_>, out: &Path) -> String {
+    let mut commands = Vec::new();
+    let mut report = String::from("skid report");
+    if let Some(runs) = sources.runs {
+        commands.push(format!("skid batch cases/drum --out {}", runs.display()));
+        let _ = write!(report, " --runs {}", runs.display());
+        if let Some(reference) = sources.reference {
+            let _ = write!(report, " --reference {reference}");
+        }
+    }
+    if let Some(hard) = sources.hard {
+        commands.push(format!("skid batch cases/hard --out {}", hard.display()));
+        let _ = write!(report, " --hard {}", hard.display());
+    }
+    if let Some(convergence) = sources.convergence {
+        commands.push(format!("scripts/convergence.sh {}", convergence.display()));
+        let _ = write!(report, " --convergence {}", convergence.display());
+    }
+    let _ = write!(report, " --out {}", out.display());
+    commands.push(report);
+    commands.join("\n")
+}
+
+/// Reads the runs named by `sources` and writes the report `out`, its plots beside it.
 ///
 /// # Errors
-/// [`ReportError`] for unreadable runs, an absent reference, or outputs that cannot be written.
-pub fn write_report(
-    runs_dir: &Path,
-    reference: Option<&str>,
-    out: &Path,
-) -> Result<ReportOutcome, ReportError> {
-    let runs = load_runs(runs_dir)?;
-    let r = choose_reference(&runs, reference)?;
+/// [`ReportError`] for unreadable runs, an absent reference, a malformed convergence study, or
+/// outputs that cannot be written.
+pub fn write_report(sources: &ReportSources<'_>, out: &Path) -> Result<ReportOutcome, ReportError> {
     let dir = out
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -329,20 +410,97 @@ pub fn write_report(
         path: dir.to_path_buf(),
         source,
     })?;
-    let omega_svg = dir.join(plot::OMEGA_SVG);
-    let difference_svg = dir.join(plot::DIFFERENCE_SVG);
-    plot::plot_omega(&runs, &runs[r], &omega_svg)?;
-    plot::plot_difference(&runs, &runs[r], &difference_svg)?;
-    let (text, counts) = markdown::render(runs_dir, &runs, r);
+    let mut text = format!(
+        "# Braking-drum validation report\n\n\
+         Written by `skid report`. To regenerate (all of it: `scripts/validate.sh`):\n\n\
+         ```sh\n{}\n```\n\n",
+        regenerate(sources, out)
+    );
+    let mut files = vec![out.to_path_buf()];
+    let mut counts = Counts::default();
+    let mut reference = None;
+    if let Some(runs_dir) = sources.runs {
+        let runs = load_runs(runs_dir)?;
+        let r = choose_reference(&runs, sources.reference)?;
+        let omega_svg = dir.join(plot::OMEGA_SVG);
+        let difference_svg = dir.join(plot::DIFFERENCE_SVG);
+        plot::plot_omega(&runs, &runs[r], &omega_svg)?;
+        plot::plot_difference(&runs, &runs[r], &difference_svg)?;
+        files.extend([omega_svg, difference_svg]);
+        let (section, n) = markdown::render(runs_dir, &runs, r);
+        text.push_str(&section);
+        counts += n;
+        reference = Some(runs[r].name.clone());
+    }
+    if let Some(hard_dir) = sources.hard {
+        let runs = load_runs(hard_dir)?;
+        let (section, n, plots) = hard::section(hard_dir, &runs, dir)?;
+        text.push('\n');
+        text.push_str(&section);
+        files.extend(plots);
+        counts += n;
+    }
+    if let Some(study_dir) = sources.convergence {
+        let study = convergence::load_study(study_dir)?;
+        let (section, plots) = convergence::section(study_dir, &study, dir)?;
+        text.push('\n');
+        text.push_str(&section);
+        files.extend(plots);
+    }
+    let _ = write!(text, "\n## All checks\n\n{}\n", counts.line());
     write_atomic(out, &text).map_err(|source| ReportError::Write {
         path: out.to_path_buf(),
         source,
     })?;
     Ok(ReportOutcome {
-        reference: runs[r].name.clone(),
-        files: vec![out.to_path_buf(), omega_svg, difference_svg],
+        reference,
+        files,
         counts,
     })
+}
+
+/// Synthetic runs for the report's unit tests.
+#[cfg(test)]
+pub(crate) mod test_runs {
+    use super::{History, Run, RunSummary};
+
+    /// A completed 3D run whose drum decelerates from 60 rad/s at `decel` rad/s^2, sampled
+    /// every millisecond to 0.15 s and held at zero after the stop, with a summary that says
+    /// so (post-stop motion 2 rad/s and 0.01 rad, energy error 0.1 %, no case).
+    pub(crate) fn spin_down(name: &str, decel: f64) -> Run {
+        let time: Vec<f64> = (0..=150).map(|k| k as f64 * 1e-3).collect();
+        let omega = time.iter().map(|t| (60.0 - decel * t).max(0.0)).collect();
+        Run {
+            name: name.into(),
+            summary: RunSummary {
+                case: name.into(),
+                dimension: 3,
+                status: "completed".into(),
+                error: None,
+                t_stop: (decel > 0.0).then(|| 60.0 / decel),
+                omega0: 60.0,
+                deceleration: Some(decel),
+                deceleration_analytic: 600.0,
+                post_stop_max_abs_omega: Some(2.0),
+                post_stop_max_angle_change: Some(0.01),
+                energy_balance_error: Some(1e-3),
+                energy_balance_residual_j: Some(0.3),
+                max_gap_violation_m: 1e-12,
+                max_sliding_separation_m: 1e-12,
+                increments: 1500,
+                newton_iterations: 3000,
+                contact_solves: 3000,
+                cutbacks: 0,
+                wall_time_s: 1.5,
+            },
+            history: History {
+                time,
+                omega,
+                non_finite: 0,
+            },
+            case: None,
+        }
+    }
 }
 
 #[cfg(test)]
@@ -352,7 +510,11 @@ mod tests {
     fn linear(omega0: f64, decel: f64, dt: f64, n: usize) -> History {
         let time: Vec<f64> = (0..=n).map(|k| k as f64 * dt).collect();
         let omega = time.iter().map(|t| omega0 - decel * t).collect();
-        History { time, omega }
+        History {
+            time,
+            omega,
+            non_finite: 0,
+        }
     }
 
     #[test]
@@ -360,6 +522,7 @@ mod tests {
         let h = History {
             time: vec![0.0, 1.0, 3.0],
             omega: vec![10.0, 8.0, 0.0],
+            non_finite: 0,
         };
         assert_eq!(interpolate(&h.time, &h.omega, 0.0), Some(10.0));
         assert_eq!(interpolate(&h.time, &h.omega, 0.5), Some(9.0));
@@ -432,25 +595,7 @@ mod tests {
     }
 
     fn run(name: &str) -> Run {
-        Run {
-            name: name.into(),
-            summary: RunSummary {
-                case: name.into(),
-                dimension: 3,
-                status: "completed".into(),
-                t_stop: Some(0.1),
-                omega0: 60.0,
-                deceleration_analytic: 600.0,
-                post_stop_max_abs_omega: None,
-                post_stop_max_angle_change: None,
-                energy_balance_error: None,
-                increments: 0,
-                newton_iterations: 0,
-                contact_solves: 0,
-                wall_time_s: 0.0,
-            },
-            history: History::default(),
-        }
+        test_runs::spin_down(name, 600.0)
     }
 
     #[test]

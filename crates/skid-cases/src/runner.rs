@@ -1,5 +1,6 @@
-//! Runs one case: builds the scene, integrates it, writes `history.csv`, `summary.json` and,
-//! if the case asks for it, the ParaView field output in `fields/`.
+//! Runs one case: builds the scene, integrates it, writes `case.json` (the case as run, overrides
+//! applied), `history.csv`, `newton.csv`, `summary.json` and, if the case asks for it, the
+//! ParaView field output in `fields/`.
 
 use std::path::{Path, PathBuf};
 
@@ -9,9 +10,13 @@ use skid_integrator::stepper::{IncrementReport, Observer, run};
 use crate::drum::build;
 use crate::fields::{self, DrumOutline, FieldWriter};
 use crate::history::DrumRecorder;
+use crate::newton::{NEWTON_CSV, NewtonRecorder};
 use crate::schema::Case;
 use crate::summary::{Summary, summarize};
 use crate::validate::{CaseError, load_case};
+
+/// The case as run (overrides applied), written into the output directory.
+pub const CASE_JSON: &str = "case.json";
 
 /// Default output directory of a case: `out/<case name>`.
 pub fn default_output_dir(case: &Case) -> PathBuf {
@@ -57,15 +62,21 @@ fn run_in<const D: usize>(case: &Case, source: &Path, dir: &Path) -> Result<Summ
     let output = |path: PathBuf| move |source| CaseError::Output { path, source };
     std::fs::create_dir_all(dir).map_err(output(dir.to_path_buf()))?;
     // Stale results of an earlier run must not survive next to a new, possibly interrupted one.
-    for stale in ["history.csv", "summary.json"] {
+    for stale in ["history.csv", NEWTON_CSV, "summary.json", CASE_JSON] {
         let p = dir.join(stale);
         if p.exists() {
             std::fs::remove_file(&p).map_err(output(p.clone()))?;
         }
     }
+    write_atomic(
+        &dir.join(CASE_JSON),
+        &serde_json::to_string_pretty(case).unwrap_or_default(),
+    )
+    .map_err(output(dir.join(CASE_JSON)))?;
     let fields_dir = dir.join(fields::FIELDS_DIR);
     fields::clear(dir).map_err(output(fields_dir.clone()))?;
     let mut recorder = DrumRecorder::create(dir).map_err(output(dir.join("history.csv")))?;
+    let mut newton = NewtonRecorder::create(dir).map_err(output(dir.join(NEWTON_CSV)))?;
     let mut field_writer = case
         .output
         .field_interval
@@ -80,10 +91,12 @@ fn run_in<const D: usize>(case: &Case, source: &Path, dir: &Path) -> Result<Summ
         .map_err(output(fields_dir.clone()))?;
     let mut observers = Observers {
         history: &mut recorder,
+        newton: &mut newton,
         fields: field_writer.as_mut(),
     };
     let (stats, result) = run(&scene.model, &scene.steps, &scene.settings, &mut observers);
     let samples = recorder.finish().map_err(output(dir.join("history.csv")))?;
+    newton.finish().map_err(output(dir.join(NEWTON_CSV)))?;
     if let Some(writer) = field_writer {
         writer
             .finish(&scene.model)
@@ -99,9 +112,10 @@ fn run_in<const D: usize>(case: &Case, source: &Path, dir: &Path) -> Result<Summ
     Ok(summary)
 }
 
-/// The observers of a run: the history and, optionally, the field output.
+/// The observers of a run: the history, the Newton residuals and, optionally, the field output.
 struct Observers<'a> {
     history: &'a mut DrumRecorder,
+    newton: &'a mut NewtonRecorder,
     fields: Option<&'a mut FieldWriter>,
 }
 
@@ -112,6 +126,7 @@ impl<const D: usize> Observer<D> for Observers<'_> {
         report: &IncrementReport<'_>,
     ) -> std::io::Result<()> {
         self.history.on_increment(model, report)?;
+        self.newton.on_increment(model, report)?;
         if let Some(fields) = self.fields.as_deref_mut() {
             fields.on_increment(model, report)?;
         }

@@ -37,6 +37,10 @@ pub struct Case {
     /// Field output (optional; none by default).
     #[serde(default)]
     pub output: OutputSpec,
+    /// What a run of the case is expected to show (optional; read by `skid report`'s hard-case
+    /// checks, ignored by the solver).
+    #[serde(default)]
+    pub expect: ExpectSpec,
 }
 
 /// The rigid drum: its inertia sits at the reference node on the axis.
@@ -289,4 +293,17 @@ pub struct OutputSpec {
     /// [`crate::fields`]); frames are also written for the initial state, at the end of every
     /// static step and at the end of the run. `None`: no field output.
     pub field_interval: Option<f64>,
+}
+
+/// Expectations on a run, for the checks of `skid report --hard`; every field is optional.
+/// The checks themselves are derived from the case (see `skid_cases::report::hard`); this only
+/// adjusts them where a case's physics departs from the assumptions of the defaults.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct ExpectSpec {
+    /// Relative tolerance of the stop time against the estimate `I omega0 / (mu p A R)`;
+    /// `None`: the report's default.
+    pub t_stop_estimate_tolerance: Option<f64>,
+    /// Why the case departs from the defaults (shown in the report).
+    pub note: String,
 }

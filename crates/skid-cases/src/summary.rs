@@ -46,6 +46,8 @@ pub struct Summary {
     pub fixed_point_iterations: usize,
     /// Failed attempts answered by a cutback.
     pub cutbacks: usize,
+    /// The failed attempts by cause (e.g. "newton not converged": 3).
+    pub cutback_causes: std::collections::BTreeMap<String, usize>,
     /// Wall time of the run, s.
     pub wall_time_s: f64,
     /// Of which: element loop, loads and contact kinematics, s.
@@ -213,6 +215,11 @@ pub fn summarize(
         contact_solves: stats.contact_solves,
         fixed_point_iterations: stats.fixed_point_iterations,
         cutbacks: stats.cutbacks,
+        cutback_causes: stats
+            .cutback_causes
+            .iter()
+            .map(|(&k, &n)| (k.to_string(), n))
+            .collect(),
         wall_time_s: stats.wall_time.as_secs_f64(),
         assembly_s: stats.timings.assembly.as_secs_f64(),
         linear_solve_s: stats.timings.linear_solve.as_secs_f64(),

@@ -369,5 +369,8 @@ pub fn validate(case: &Case) -> Result<(), Problem> {
     if let Some(interval) = case.output.field_interval {
         positive("output.field_interval", interval)?;
     }
+    if let Some(tolerance) = case.expect.t_stop_estimate_tolerance {
+        positive("expect.t_stop_estimate_tolerance", tolerance)?;
+    }
     Ok(())
 }

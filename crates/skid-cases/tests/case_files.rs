@@ -160,3 +160,28 @@ fn overrides_set_nested_fields_and_reject_bad_paths() {
     assert_eq!(field, "pad.densty");
     assert!(message.contains("unknown field"));
 }
+
+#[test]
+fn shipped_cases_are_valid_described_and_named_after_their_files() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../cases");
+    let mut seen = 0;
+    for dir in ["drum", "hard"] {
+        for entry in std::fs::read_dir(root.join(dir)).expect("cases directory") {
+            let path = entry.expect("entry").path();
+            if path.extension().is_none_or(|e| e != "json") {
+                continue;
+            }
+            let case = load_case(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
+            let stem = path.file_stem().expect("stem").to_string_lossy();
+            assert_eq!(case.name, stem, "{}", path.display());
+            assert!(!case.description.is_empty(), "{}", path.display());
+            assert!(
+                stem.starts_with(&format!("{}d-", case.dimension)),
+                "{}: the prefix names the dimension",
+                path.display()
+            );
+            seen += 1;
+        }
+    }
+    assert!(seen >= 27, "{seen} shipped cases");
+}

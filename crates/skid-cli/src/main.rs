@@ -10,6 +10,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use skid_cases::ReportSources;
 
 #[derive(Parser)]
 #[command(
@@ -48,14 +49,24 @@ enum Command {
         #[arg(long)]
         jobs: Option<usize>,
     },
-    /// Compare the runs of a batch with a reference run: a markdown report and two SVG plots.
+    /// The validation report (markdown with SVG plots): the benchmark runs against a reference
+    /// run, the hard-case checks, the convergence study; each section from its own directory.
+    /// With none of --runs, --hard, --convergence: the benchmark section of `out`.
     Report {
-        /// Directory holding one subdirectory per run (summary.json, history.csv).
-        #[arg(long, default_value = "out")]
-        runs: PathBuf,
-        /// Reference run [default: 3d-analytic-fine, else the first 3d-analytic* run].
+        /// Benchmark runs: one subdirectory per run (summary.json, history.csv).
+        #[arg(long)]
+        runs: Option<PathBuf>,
+        /// Reference run among --runs [default: 3d-analytic-fine, else the first 3d-analytic*].
         #[arg(long)]
         reference: Option<String>,
+        /// Hard-case runs (`skid batch cases/hard`): one subdirectory per run with its
+        /// case.json.
+        #[arg(long)]
+        hard: Option<PathBuf>,
+        /// Convergence study (`scripts/convergence.sh`): one subdirectory per series, holding
+        /// one run per level.
+        #[arg(long)]
+        convergence: Option<PathBuf>,
         /// The markdown report; the plots are written beside it.
         #[arg(long, default_value = "validation/report.md")]
         out: PathBuf,
@@ -71,8 +82,22 @@ fn main() -> ExitCode {
         Command::Report {
             runs,
             reference,
+            hard,
+            convergence,
             out,
-        } => report::run(&runs, reference.as_deref(), &out),
+        } => {
+            let runs = match (&runs, &hard, &convergence) {
+                (None, None, None) => Some(PathBuf::from("out")),
+                _ => runs,
+            };
+            let sources = ReportSources {
+                runs: runs.as_deref(),
+                reference: reference.as_deref(),
+                hard: hard.as_deref(),
+                convergence: convergence.as_deref(),
+            };
+            report::run(&sources, &out)
+        }
         Command::Run {
             case,
             out,

@@ -62,6 +62,35 @@ fn run_writes_history_and_summary_and_prints_one_json_line() {
         );
     }
     assert!(dir.path().join("summary.json").exists());
+
+    // newton.csv: one row per Newton iteration of every converged increment, the residuals
+    // of the last one of each increment within the tolerances.
+    let newton = std::fs::read_to_string(dir.path().join("newton.csv")).expect("newton.csv");
+    let rows: Vec<Vec<&str>> = newton
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(
+        Some(rows.len() as u64),
+        summary["newton_iterations"].as_u64()
+    );
+    for (k, row) in rows.iter().enumerate() {
+        let last_of_increment = rows.get(k + 1).is_none_or(|next| next[4] == "1");
+        let force: f64 = row[5].parse().expect("force residual");
+        let contact: f64 = row[6].parse().expect("contact residual");
+        assert!(force.is_finite() && contact.is_finite(), "{row:?}");
+        if last_of_increment {
+            assert!(force <= 1e-6 && contact <= 1e-9, "not converged: {row:?}");
+        }
+    }
+    // case.json: the case as run, overrides applied.
+    let case: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("case.json")).expect("case.json"),
+    )
+    .expect("json");
+    assert_eq!(case["steps"][1]["duration"].as_f64(), Some(0.005));
+    assert_eq!(case["name"], "2d-analytic");
 }
 
 #[test]

@@ -78,6 +78,22 @@ pub enum IncrementFailure {
     },
 }
 
+impl IncrementFailure {
+    /// A short name of the kind of failure, for counting cutbacks by cause.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::NewtonNotConverged { .. } => "newton not converged",
+            Self::NonFinite { .. } => "non-finite values",
+            Self::InvertedElement { .. } => "inverted element",
+            Self::Element { .. } => "element evaluation",
+            Self::Load(_) => "load evaluation",
+            Self::LinearSolve(_) => "tangent not positive definite",
+            Self::Contact(_) => "contact solve",
+            Self::NoProjection { .. } => "no contact projection",
+        }
+    }
+}
+
 /// A run that could not be completed.
 #[derive(Debug, Error)]
 #[non_exhaustive]

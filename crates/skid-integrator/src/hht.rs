@@ -1,19 +1,37 @@
-//! HHT-alpha time integration (Hilber, Hughes & Taylor 1977), Abaqus sign convention.
+//! HHT-alpha time integration (Hilber, Hughes & Taylor 1977), Abaqus sign convention, with
+//! the contact forces integrated as impulses.
 //!
-//! With `alpha` in [-1/3, 0], `beta = (1 - alpha)^2 / 4` and `gamma = 1/2 - alpha`, the
-//! equations of motion are imposed as
+//! With `alpha` in [-1/3, 0], `beta = (1 - alpha)^2 / 4` and `gamma = 1/2 - alpha`, the smooth
+//! forces obey the HHT equation
 //!
-//! `M a_{n+1} + (1 + alpha) F(x_{n+1}) - alpha F(x_n) - H^T r = 0`,  `F = f_int - f_ext`,
+//! `M a_{n+1} + (1 + alpha) F(x_{n+1}) - alpha F(x_n) = 0`,  `F = f_int - f_ext`,
 //!
-//! with the Newmark relations
+//! where `a` is the *smooth* acceleration: it never contains a contact force. The contact
+//! forces act through their mean value `p` over the increment, an impulse `h p` that changes the
+//! velocity at the end of the increment and moves the positions by the trapezoidal rule
+//! (half the velocity jump over the increment):
 //!
-//! `a_{n+1} = (x_{n+1} - x_n - h v_n) / (beta h^2) - (1/(2 beta) - 1) a_n`,
-//! `v_{n+1} = v_n + h [(1 - gamma) a_n + gamma a_{n+1}]`.
+//! `x_{n+1} = x_n + h v_n + h^2 [(1/2 - beta) a_n + beta a_{n+1}] + (h^2/2) M^{-1} H^T p`,
+//! `v_{n+1} = v_n + h [(1 - gamma) a_n + gamma a_{n+1}] + h M^{-1} H^T p`.
 //!
-//! The scheme is second-order accurate and unconditionally stable for linear problems; its
-//! spectral radius at infinite frequency is `(1 + alpha)/(1 - alpha)`. The contact forces `r`
-//! are unknowns of the increment (their cone constraint holds for the value the increment
-//! applies), so they carry no history term.
+//! Eliminating `a_{n+1}` gives the increment's equation in the unknown positions,
+//!
+//! `M (x_{n+1} - x_n - h v_n - h^2 (1/2 - beta) a_n) / (beta h^2) + (1 + alpha) F(x_{n+1})
+//!  - alpha F(x_n) - H^T r = 0`,  with `r = p / (2 beta)`,
+//!
+//! which is the plain HHT equation with `r` in the place of the contact force. The friction cone
+//! is invariant under positive scaling, so the exact Coulomb law in `r` is the law in `p`.
+//!
+//! Why impulses: with the contact force inside `a_n` (plain HHT), the force of a contact that
+//! opens during an increment keeps acting through `a_n` and does work `p_n dg / 2 > 0` on the
+//! separating pad. Friction chatter (contacts opening and closing every few increments) then
+//! pumps energy into the pad faster than light numerical damping removes it. With impulses a
+//! contact never acts once it is open, and because the impulse moves the positions by half its
+//! velocity jump, its work on the kinetic energy is exactly `p . H dx`: the normal part
+//! `p_N dg <= 0` (a closing contact can only absorb energy), the tangential part the frictional
+//! dissipation `-p_T . ds >= 0`. Smooth forces keep the second-order accuracy and
+//! unconditional linear stability of HHT, whose spectral radius at infinite frequency is
+//! `(1 + alpha)/(1 - alpha)`; a node resting in contact keeps a zero velocity.
 
 use nalgebra::DVector;
 
@@ -65,6 +83,32 @@ impl Hht {
         x + v * h + a * (0.5 * h * h)
     }
 
+    /// Factor `2 beta` that turns the increment's contact unknown `r` into the mean contact
+    /// force `p` over the increment.
+    pub fn impulse_force_factor(&self) -> f64 {
+        2.0 * self.beta
+    }
+
+    /// End-of-increment smooth acceleration and velocity when the contact forces act as an
+    /// impulse. `a_total` is the Newmark acceleration of the converged positions (which contains
+    /// the contact term) and `contact = M^{-1} H^T r` the acceleration the contact unknown gives:
+    /// `a_{n+1} = a_total - contact`,
+    /// `v_{n+1} = v_n + h [(1 - gamma) a_n + gamma a_{n+1}] + 2 beta h contact`.
+    pub fn split_impulse(
+        &self,
+        h: f64,
+        v_n: &DVector<f64>,
+        a_n: &DVector<f64>,
+        a_total: &DVector<f64>,
+        contact: &DVector<f64>,
+    ) -> (DVector<f64>, DVector<f64>) {
+        let a = a_total - contact;
+        let v = v_n
+            + (a_n * (1.0 - self.gamma) + &a * self.gamma) * h
+            + contact * (h * self.impulse_force_factor());
+        (v, a)
+    }
+
     /// Velocity and acceleration at the end of the increment from the Newmark relations.
     pub fn velocity_and_acceleration(
         &self,
@@ -94,6 +138,38 @@ mod tests {
         let x1 = -r0 / (hht.mass_factor(h) + 1.0 + hht.alpha);
         let (v1, a1) = hht.velocity_and_acceleration(h, &one(x), &one(v), &one(a), &one(x1));
         (x1, v1[0], a1[0])
+    }
+
+    /// A free mass (no smooth force) given a contact unknown `r`: the velocity jumps by the
+    /// impulse `h p / m` with `p = 2 beta r`, and the position moves by the trapezoidal rule,
+    /// `x_{n+1} - x_n = h (v_n + v_{n+1}) / 2`, so the impulse's work `p (x_{n+1} - x_n)` equals
+    /// the kinetic energy change.
+    #[test]
+    fn contact_impulse_moves_by_the_trapezoidal_rule() {
+        let one = |z: f64| DVector::from_element(1, z);
+        let (h, m, r, v0) = (1e-3, 2.0, 50.0, -3.0);
+        for alpha in [0.0, -0.05, -0.3] {
+            let hht = Hht::new(alpha).expect("alpha");
+            // The increment's equation m (x1 - x0 - h v0) / (beta h^2) - r = 0.
+            let x1 = h * v0 + r * hht.beta * h * h / m;
+            let (_, a_total) =
+                hht.velocity_and_acceleration(h, &one(0.0), &one(v0), &one(0.0), &one(x1));
+            let (v1, a1) = hht.split_impulse(h, &one(v0), &one(0.0), &a_total, &one(r / m));
+            let p = hht.impulse_force_factor() * r;
+            assert!(
+                a1[0].abs() < 1e-9,
+                "no smooth force, no smooth acceleration: {}",
+                a1[0]
+            );
+            assert!((v1[0] - (v0 + h * p / m)).abs() < 1e-12);
+            assert!((x1 - h * (v0 + v1[0]) / 2.0).abs() < 1e-15);
+            let work = p * x1;
+            let kinetic = 0.5 * m * (v1[0] * v1[0] - v0 * v0);
+            assert!(
+                (work - kinetic).abs() < 1e-12 * kinetic.abs(),
+                "{work} vs {kinetic}"
+            );
+        }
     }
 
     fn oscillate(alpha: f64, h: f64, steps: usize) -> Vec<(f64, f64)> {

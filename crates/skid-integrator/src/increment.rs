@@ -122,7 +122,12 @@ pub fn solve_increment<const D: usize>(
     };
     let mut x = match kind {
         IncrementKind::Static { .. } => start.x.clone(),
-        IncrementKind::Dynamic { hht, h } => hht.predict(h, &start.x, &start.v, &start.a),
+        // Constant total acceleration: the smooth one plus that of the last contact forces, so
+        // that a node resting in contact is predicted to stay there.
+        IncrementKind::Dynamic { hht, h } => {
+            let a = &start.a + acceleration_of(model, &start.contact_reaction);
+            hht.predict(h, &start.x, &start.v, &a)
+        }
     };
     for (eq, &h) in held.iter().enumerate() {
         if h {
@@ -282,6 +287,11 @@ fn scaled_force_residual<const D: usize>(
     if scale > 0.0 { worst / scale } else { worst }
 }
 
+/// `M^{-1} f` for the lumped mass matrix; equations without mass (which carry no force) get 0.
+fn acceleration_of<const D: usize>(model: &Model<D>, f: &DVector<f64>) -> DVector<f64> {
+    f.zip_map(model.mass(), |f, m| if m > 0.0 { f / m } else { 0.0 })
+}
+
 /// The converged iterate: unknowns, their rates, and the forces evaluated there.
 struct Iterate {
     x: DVector<f64>,
@@ -311,6 +321,17 @@ fn finish<const D: usize>(
         f_ext,
         internal,
     } = iterate;
+    // The mean contact force over the increment and, for a dynamic increment, the velocity and
+    // smooth acceleration with the contact impulse (see `crate::hht`).
+    let (r, v, a) = match kind {
+        IncrementKind::Static { .. } => (r.clone(), v, a),
+        IncrementKind::Dynamic { hht, h } => {
+            let contact = acceleration_of(model, &rows.transpose_times(r, x.len()));
+            let (v, a) = hht.split_impulse(h, &start.v, &start.a, &a, &contact);
+            (r * hht.impulse_force_factor(), v, a)
+        }
+    };
+    let r = &r;
     let d = rows.components;
     let mut contacts = Vec::with_capacity(rows.len());
     let mut friction = 0.0;

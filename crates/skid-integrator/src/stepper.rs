@@ -137,6 +137,8 @@ pub struct RunStatistics {
     pub fixed_point_iterations: usize,
     /// Failed attempts answered by a cutback.
     pub cutbacks: usize,
+    /// The failed attempts by kind of failure ([`IncrementFailure::kind`]).
+    pub cutback_causes: std::collections::BTreeMap<&'static str, usize>,
     /// Time spent in the parts of Newton (all attempts).
     pub timings: Timings,
     /// Wall time of the whole run.
@@ -200,33 +202,23 @@ pub fn initial_state<const D: usize>(
     })
 }
 
-/// Acceleration in equilibrium with the current forces, `a = M^{-1}(f_ext - f_int + H^T r)`,
-/// used at the start of a dynamic step (zero after a converged static step, except for bodies
-/// released from a hold).
+/// Smooth acceleration at the start of a dynamic step, `a = -M^{-1} (f_int - f_ext)`: the
+/// contact forces act as impulses and are never part of `a` (see [`crate::hht`]). Held
+/// and massless equations get zero.
 fn consistent_acceleration<const D: usize>(
     model: &Model<D>,
     state: &State,
     held: &[bool],
-) -> Result<DVector<f64>, IncrementFailure> {
+) -> DVector<f64> {
     let n = model.dofs().len();
-    let previous: Vec<_> = state.contacts.iter().map(|c| c.coords).collect();
-    let rows = contact_rows(model, &state.x, &previous, held)?;
-    let d = rows.components;
-    let mut r = DVector::zeros(rows.rows.len());
-    for (k, c) in state.contacts.iter().enumerate() {
-        r[k * d] = c.normal_force;
-        for t in 1..d {
-            r[k * d + t] = c.tangential_force[t - 1];
-        }
-    }
-    let force = rows.transpose_times(&r, n) - &state.net_force;
-    Ok(DVector::from_fn(n, |i, _| {
-        if held[i] {
+    DVector::from_fn(n, |i, _| {
+        let m = model.mass()[i];
+        if held[i] || m <= 0.0 {
             0.0
         } else {
-            force[i] / model.mass()[i]
+            -state.net_force[i] / m
         }
-    }))
+    })
 }
 
 fn validate_steps<const D: usize>(model: &Model<D>, steps: &[Step]) -> Result<(), RunError> {
@@ -333,16 +325,7 @@ fn run_steps<const D: usize>(
         let (nominal, span) = match step.kind {
             StepKind::Static { increments, .. } => (1.0 / increments as f64, 1.0),
             StepKind::Dynamic { duration, dt, .. } => {
-                state.a = consistent_acceleration(model, &state, &held).map_err(|cause| {
-                    RunError::StepFailed {
-                        step: step.name.clone(),
-                        increment: 0,
-                        time: state.time,
-                        size: dt,
-                        cutbacks: 0,
-                        cause,
-                    }
-                })?;
+                state.a = consistent_acceleration(model, &state, &held);
                 (dt / duration, duration)
             }
         };
@@ -407,6 +390,7 @@ fn run_steps<const D: usize>(
                 }
                 Err(cause) => {
                     stats.cutbacks += 1;
+                    *stats.cutback_causes.entry(cause.kind()).or_default() += 1;
                     consecutive_failures += 1;
                     successes = 0;
                     if consecutive_failures > settings.cutback.max_cutbacks

@@ -87,15 +87,16 @@ fn block(side_force: f64) -> (Model<2>, f64) {
     (model, mass)
 }
 
-/// Runs a static preload ramping both loads (if `preload`), then 2 ms of dynamics.
-fn simulate(side_force: f64, preload: bool) -> (Model<2>, f64, Vec<State>) {
+/// Runs a static preload ramping both loads (if `preload`), then 2 ms of dynamics with HHT
+/// parameter `alpha`.
+fn simulate(side_force: f64, preload: bool, alpha: f64) -> (Model<2>, f64, Vec<State>) {
     let (model, mass) = block(side_force);
     let mut steps = vec![Step {
         name: "push".into(),
         kind: StepKind::Dynamic {
             duration: 2e-3,
             dt: 2e-5,
-            alpha: -1.0 / 3.0,
+            alpha,
         },
         held_bodies: vec![],
     }];
@@ -124,7 +125,7 @@ fn block_sticks_below_mu_n() {
     // Both loads ramp together in the static preload, so the push stays at half the friction
     // limit throughout; the dynamic step that follows must keep the block stuck.
     // (During the preload itself the bottom corners may slip outward as the block bulges.)
-    let (_, _, states) = simulate(0.5 * MU * normal, true);
+    let (_, _, states) = simulate(0.5 * MU * normal, true, -1.0 / 3.0);
     let states: Vec<State> = states.into_iter().filter(|s| s.time > 0.0).collect();
     assert_eq!(states.len(), 100);
     for s in &states {
@@ -167,7 +168,7 @@ fn block_slides_above_mu_n_with_friction_exactly_mu_n() {
     let normal = P_TOP * WIDTH * THICKNESS;
     let push = 2.0 * MU * normal;
     // Loads applied suddenly: the block is pressed down and pushed at once.
-    let (model, mass, states) = simulate(push, false);
+    let (model, mass, states) = simulate(push, false, -1.0 / 3.0);
     let slider_x = model.dofs().body_translation(1)[0].expect("slider x is free");
     let mut sliding_seen = 0;
     for s in &states[1..] {
@@ -213,5 +214,43 @@ fn block_slides_above_mu_n_with_friction_exactly_mu_n() {
         (t + MU * n).abs() < 1e-7 * MU * n,
         "friction {t} = -mu N {}",
         MU * n
+    );
+}
+
+/// Loads applied suddenly with the trapezoidal rule (alpha = 0, no numerical dissipation): the
+/// bottom nodes bounce and slide, contacts open and close many times. The contact impulses are
+/// integrated so that their work is exactly `p . du` (see `skid_integrator::hht`), so the
+/// energy ledger must close: kinetic + strain + hourglass = pressure work + normal contact work
+/// minus friction dissipation, up to the trapezoidal rule's error on the nonlinear forces. A contact
+/// force that kept acting after its contact opened would break this balance.
+#[test]
+fn energy_balance_closes_through_contact_chatter() {
+    let normal = P_TOP * WIDTH * THICKNESS;
+    let (_, _, states) = simulate(2.0 * MU * normal, false, 0.0);
+    let mut switches = 0;
+    for w in states.windows(2) {
+        for (a, b) in w[0].contacts.iter().zip(&w[1].contacts) {
+            if a.is_closed() != b.is_closed() {
+                switches += 1;
+            }
+        }
+    }
+    assert!(
+        switches >= 5,
+        "contacts open and close: {switches} switches"
+    );
+    let last = states.last().expect("states");
+    assert!(last.energy.friction_dissipation > 0.0, "the block slides");
+    let mut worst: f64 = 0.0;
+    for s in &states {
+        let e = &s.energy;
+        let residual = e.kinetic + e.strain + e.hourglass - e.external_work - e.normal_work
+            + e.friction_dissipation;
+        worst = worst.max(residual.abs());
+    }
+    let scale = last.energy.external_work;
+    assert!(
+        worst <= 1e-4 * scale,
+        "energy balance residual {worst:e} J vs pressure work {scale:e} J ({switches} switches)"
     );
 }

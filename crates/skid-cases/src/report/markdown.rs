@@ -1,10 +1,11 @@
-//! The report text: how to regenerate it, the reference, the plots, a table of the runs and the
+//! The benchmark section of the report: the reference, the plots, a table of the runs and the
 //! acceptance checks of DRUM.md section 3. The text holds no date, so the same runs give the
 //! same report.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
+use super::format::{Counts, Sig, percent, show};
 use super::plot::{DIFFERENCE_SVG, OMEGA_SVG};
 use super::{Run, e_slide};
 
@@ -32,17 +33,6 @@ const BENCHMARK: [&str; 9] = [
     "3d-c3d4",
     "3d-analytic-fine",
 ];
-
-/// How many acceptance checks passed, failed and were skipped.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Counts {
-    /// Passed.
-    pub passed: usize,
-    /// Failed.
-    pub failed: usize,
-    /// Skipped because a run is absent.
-    pub skipped: usize,
-}
 
 /// The acceptance list being written.
 struct Checks {
@@ -82,34 +72,6 @@ impl Checks {
         self.counts.skipped += 1;
         let _ = writeln!(self.text, "- SKIPPED {label}: {why}");
     }
-}
-
-/// A number to 4 significant digits, plainly or in exponent form.
-struct Sig(f64);
-
-impl std::fmt::Display for Sig {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let v = self.0;
-        if v == 0.0 || (1e-3..1e5).contains(&v.abs()) {
-            let magnitude = if v == 0.0 {
-                0
-            } else {
-                v.abs().log10().floor() as i32
-            };
-            let digits = (3 - magnitude).clamp(0, 7) as usize;
-            write!(f, "{v:.digits$}")
-        } else {
-            write!(f, "{v:.3e}")
-        }
-    }
-}
-
-fn show(v: Option<f64>) -> String {
-    v.map_or_else(|| "n/a".into(), |v| Sig(v).to_string())
-}
-
-fn percent(v: Option<f64>) -> String {
-    show(v.map(|v| 100.0 * v))
 }
 
 /// `|a - b| / min(|a|, |b|)`: the relative difference, symmetric and the stricter of the two.
@@ -266,25 +228,24 @@ fn acceptance(runs: &[Run], measures: &[Measures], reference: usize) -> Checks {
     c
 }
 
-/// The markdown report of `runs` (read from `runs_dir`) against `runs[reference]`, with the
-/// counts of its acceptance checks.
+/// The benchmark section of the report for `runs` (read from `runs_dir`) against
+/// `runs[reference]`, with the counts of its acceptance checks.
 pub fn render(runs_dir: &Path, runs: &[Run], reference: usize) -> (String, Counts) {
     let reference_run = &runs[reference];
     let measures: Vec<Measures> = runs.iter().map(|r| measure(r, reference_run)).collect();
     let mut out = String::new();
     let _ = write!(
         out,
-        "# Braking-drum validation report\n\n\
-         Written by `skid report` from the runs in `{dir}`. To regenerate:\n\n\
-         ```sh\nskid batch cases/drum && skid report\n```\n\n\
+        "## Benchmark: the drum idealizations\n\n\
+         Runs in `{dir}` (`skid batch cases/drum`). \
          Reference: **{reference}**. omega_ref(t) is its drum angular velocity, linearly \
          interpolated at each run's times; times count from the start of the dynamic step. \
          e_slide = max |omega - omega_ref| / omega0 over t <= 0.9 t_stop of the run \
          (DRUM.md section 3).\n\n\
-         ## Drum angular velocity\n\n\
+         ### Drum angular velocity\n\n\
          ![omega(t) of every run and the analytic line]({OMEGA_SVG})\n\n\
          ![omega(t) - omega_ref(t)]({DIFFERENCE_SVG})\n\n\
-         ## Runs\n\n",
+         ### Runs\n\n",
         dir = runs_dir.display(),
         reference = reference_run.name,
     );
@@ -293,52 +254,25 @@ pub fn render(runs_dir: &Path, runs: &[Run], reference: usize) -> (String, Count
     let n = checks.counts;
     let _ = write!(
         out,
-        "\n## Acceptance\n\n\
+        "\n### Acceptance\n\n\
          t_stop within 1 % of the reference and of every other run; e_slide < 0.5 % for \
          analytic drums, < 1 % for faceted ones; general contact vs contact pair within \
          0.1 %; after the stop |omega| < 5 rad/s and the angle within 0.03 rad. t_stop \
          differences are relative: to the reference's t_stop for the reference check, to the \
-         smaller of the two for the others.\n\n{}\n{} passed, {} failed, {} skipped\n",
-        checks.text, n.passed, n.failed, n.skipped,
+         smaller of the two for the others.\n\n{}\n{}\n",
+        checks.text,
+        n.line(),
     );
     (out, n)
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::{History, RunSummary};
+    use super::super::test_runs::spin_down;
     use super::*;
 
     fn run(name: &str, decel: f64) -> Run {
-        let time: Vec<f64> = (0..=150).map(|k| k as f64 * 1e-3).collect();
-        let omega = time.iter().map(|t| (60.0 - decel * t).max(0.0)).collect();
-        Run {
-            name: name.into(),
-            summary: RunSummary {
-                case: name.into(),
-                dimension: 3,
-                status: "completed".into(),
-                t_stop: Some(60.0 / decel),
-                omega0: 60.0,
-                deceleration_analytic: 600.0,
-                post_stop_max_abs_omega: Some(2.0),
-                post_stop_max_angle_change: Some(0.01),
-                energy_balance_error: Some(1e-3),
-                increments: 1500,
-                newton_iterations: 3000,
-                contact_solves: 3000,
-                wall_time_s: 1.5,
-            },
-            history: History { time, omega },
-        }
-    }
-
-    #[test]
-    fn sig_shows_four_significant_digits() {
-        assert_eq!(Sig(0.100738).to_string(), "0.1007");
-        assert_eq!(Sig(60.0).to_string(), "60.00");
-        assert_eq!(Sig(0.0).to_string(), "0.000");
-        assert_eq!(Sig(2.5e-5).to_string(), "2.500e-5");
+        spin_down(name, decel)
     }
 
     #[test]
@@ -351,7 +285,7 @@ mod tests {
         ];
         let (text, counts) = render(Path::new("out"), &runs, 0);
         assert!(text.contains("Reference: **3d-analytic**"));
-        assert!(text.contains("skid batch cases/drum && skid report"));
+        assert!(text.contains("Runs in `out` (`skid batch cases/drum`)"));
         for run in &runs {
             assert!(text.contains(&format!("| {} | 3D |", run.name)), "{text}");
         }

@@ -12,6 +12,13 @@ use crate::runner::write_atomic;
 pub const OMEGA_SVG: &str = "omega.svg";
 /// File name of the omega(t) - omega_ref(t) plot.
 pub const DIFFERENCE_SVG: &str = "omega-difference.svg";
+/// File name of the hard cases' normalized spin-down plot.
+pub const HARD_OMEGA_SVG: &str = "hard-omega.svg";
+/// File name of the Newton residual plot of the convergence study.
+pub const NEWTON_SVG: &str = "newton.svg";
+
+/// The time axis of the benchmark plots.
+const TIME_AXIS: &str = "t [s] (from the start of the dynamic step)";
 
 const SIZE: (u32, u32) = (960, 600);
 
@@ -41,7 +48,7 @@ fn padded_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 fn draw(
     path: &Path,
     title: &str,
-    y_label: &str,
+    (x_label, y_label): (&str, &str),
     curves: &[Curve],
     legend: SeriesLabelPosition,
 ) -> Result<(), ReportError> {
@@ -66,7 +73,7 @@ fn draw(
             .map_err(|e| error(&e))?;
         chart
             .configure_mesh()
-            .x_desc("t [s] (from the start of the dynamic step)")
+            .x_desc(x_label)
             .y_desc(y_label)
             .draw()
             .map_err(|e| error(&e))?;
@@ -136,7 +143,7 @@ pub fn plot_omega(runs: &[Run], reference: &Run, path: &Path) -> Result<(), Repo
     draw(
         path,
         "Drum angular velocity",
-        "omega [rad/s]",
+        (TIME_AXIS, "omega [rad/s]"),
         &curves,
         SeriesLabelPosition::UpperRight,
     )
@@ -161,10 +168,123 @@ pub fn plot_difference(runs: &[Run], reference: &Run, path: &Path) -> Result<(),
     draw(
         path,
         &title,
-        "omega - omega_ref [rad/s]",
+        (TIME_AXIS, "omega - omega_ref [rad/s]"),
         &curves,
         SeriesLabelPosition::LowerLeft,
     )
+}
+
+/// Where the normalized spin-down plot ends, in `t / t_est`.
+const NORMALIZED_TIME_LIMIT: f64 = 1.5;
+
+/// `hard-omega.svg`: `omega / omega0` against `t / t_est` (up to 1.5) of every `(run, t_est)`,
+/// and the estimate's line `1 - t / t_est`: runs that brake as estimated fall on it whatever
+/// their omega0, mu or pressure.
+///
+/// # Errors
+/// [`ReportError`] if the plot cannot be drawn or written.
+pub fn plot_normalized_spin_down(runs: &[(&Run, f64)], path: &Path) -> Result<(), ReportError> {
+    let mut curves: Vec<Curve> = runs
+        .iter()
+        .map(|(r, t_est)| {
+            let w0 = r.summary.omega0;
+            Curve {
+                label: r.name.clone(),
+                points: r
+                    .history
+                    .time
+                    .iter()
+                    .zip(&r.history.omega)
+                    .map(|(t, w)| (t / t_est, w / w0))
+                    .take_while(|&(x, _)| x <= NORMALIZED_TIME_LIMIT)
+                    .collect(),
+                dashed: false,
+            }
+        })
+        .collect();
+    curves.push(Curve {
+        label: "estimate 1 - t / t_est".into(),
+        points: vec![(0.0, 1.0), (1.0, 0.0)],
+        dashed: true,
+    });
+    draw(
+        path,
+        "Hard cases: normalized spin-down",
+        ("t / t_est, t_est = I omega0 / (mu p A R)", "omega / omega0"),
+        &curves,
+        SeriesLabelPosition::UpperRight,
+    )
+}
+
+/// `newton.svg`: the force residual after each Newton iteration, on a log scale, of every
+/// `(label, residuals)` (non-positive residuals are left out).
+///
+/// # Errors
+/// [`ReportError`] if the plot cannot be drawn or written.
+pub fn plot_newton(histories: &[(String, Vec<f64>)], path: &Path) -> Result<(), ReportError> {
+    let error = |e: &dyn std::fmt::Display| ReportError::Plot {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let positive = || {
+        histories
+            .iter()
+            .flat_map(|(_, r)| r.iter().copied())
+            .filter(|r| r.is_finite() && *r > 0.0)
+    };
+    let (lo, hi) = positive().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
+        (lo.min(r), hi.max(r))
+    });
+    let (lo, hi) = if lo <= hi {
+        (lo / 3.0, hi * 3.0)
+    } else {
+        (1e-12, 1.0)
+    };
+    let iterations = histories.iter().map(|(_, r)| r.len()).max().unwrap_or(1);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| error(&e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption("Newton residuals", ("sans-serif", 22))
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(72)
+            .build_cartesian_2d(0.5..iterations as f64 + 0.5, (lo..hi).log_scale())
+            .map_err(|e| error(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("Newton iteration")
+            .y_desc("scaled force residual")
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()
+            .map_err(|e| error(&e))?;
+        for (k, (label, residuals)) in histories.iter().enumerate() {
+            let color = Palette99::pick(k).to_rgba();
+            let points = residuals
+                .iter()
+                .enumerate()
+                .filter(|(_, r)| r.is_finite() && **r > 0.0)
+                .map(|(i, r)| ((i + 1) as f64, *r));
+            chart
+                .draw_series(LineSeries::new(points, color.stroke_width(2)).point_size(4))
+                .map_err(|e| error(&e))?
+                .label(label.as_str())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| error(&e))?;
+        root.present().map_err(|e| error(&e))?;
+    }
+    write_atomic(path, &svg).map_err(|source| ReportError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 #[cfg(test)]
@@ -198,7 +318,7 @@ mod tests {
         draw(
             &path,
             "title",
-            "omega [rad/s]",
+            ("t [s]", "omega [rad/s]"),
             &curves,
             SeriesLabelPosition::UpperRight,
         )
@@ -212,5 +332,24 @@ mod tests {
             );
         }
         assert!(svg.contains("<polyline"));
+    }
+
+    #[test]
+    fn the_newton_plot_is_logarithmic_and_labels_every_history() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join(NEWTON_SVG);
+        let histories = vec![
+            ("2d".to_string(), vec![1e-2, 1e-4, 1e-8]),
+            ("3d".to_string(), vec![1e-3, 0.0, 1e-6]),
+        ];
+        plot_newton(&histories, &path).expect("draws");
+        let svg = std::fs::read_to_string(&path).expect("written");
+        for text in ["Newton residuals", "2d", "3d", "1e-8"] {
+            assert!(
+                svg.contains(&format!("\n{text}\n</text>")),
+                "no text {text}"
+            );
+        }
+        plot_newton(&[], &path).expect("an empty plot draws too");
     }
 }

@@ -1,0 +1,79 @@
+//! The Newton residual history (`newton.csv`): one row per convergence check of every converged
+//! increment, so that the convergence rate of the Newton iteration can be read off any increment.
+//!
+//! Columns: `step`, `increment`, `time` (end of the increment, s), `size` (time increment, or
+//! load-factor fraction in a static step), `iteration` (1 for the check after the first Newton
+//! update), `force_residual` (`max_i |R_i - (H^T r)_i|` scaled by the largest force in play)
+//! and `contact_residual` (largest difference between the actual and the linearised gaps and
+//! slips, over the model size): the two measures the increment's convergence test compares with
+//! its tolerances ([`skid_integrator::increment`]). Written through [`PartialCsv`].
+
+use std::io::Write;
+use std::path::Path;
+
+use skid_integrator::Model;
+use skid_integrator::stepper::{IncrementReport, Observer};
+
+use crate::csv_out::PartialCsv;
+
+/// File name of the Newton residual history.
+pub const NEWTON_CSV: &str = "newton.csv";
+
+/// Column names of `newton.csv`.
+pub const COLUMNS: [&str; 7] = [
+    "step",
+    "increment",
+    "time",
+    "size",
+    "iteration",
+    "force_residual",
+    "contact_residual",
+];
+
+/// Observer writing `newton.csv`.
+pub struct NewtonRecorder {
+    csv: PartialCsv,
+}
+
+impl NewtonRecorder {
+    /// Creates `dir/newton.csv.partial` and writes the header.
+    ///
+    /// # Errors
+    /// I/O errors.
+    pub fn create(dir: &Path) -> std::io::Result<Self> {
+        Ok(Self {
+            csv: PartialCsv::create(&dir.join(NEWTON_CSV), &COLUMNS)?,
+        })
+    }
+
+    /// Flushes and renames the file to `newton.csv`.
+    ///
+    /// # Errors
+    /// I/O errors.
+    pub fn finish(self) -> std::io::Result<()> {
+        self.csv.finish()
+    }
+}
+
+impl<const D: usize> Observer<D> for NewtonRecorder {
+    fn on_increment(
+        &mut self,
+        _model: &Model<D>,
+        report: &IncrementReport<'_>,
+    ) -> std::io::Result<()> {
+        for (k, (force, contact)) in report.counters.residuals.iter().enumerate() {
+            writeln!(
+                self.csv.rows(),
+                "{},{},{:.9e},{:.6e},{},{:.6e},{:.6e}",
+                report.step,
+                report.increment,
+                report.state.time,
+                report.size,
+                k + 1,
+                force,
+                contact,
+            )?;
+        }
+        Ok(())
+    }
+}
