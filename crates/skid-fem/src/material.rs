@@ -23,6 +23,35 @@ pub trait Hyperelastic: Send + Sync + std::fmt::Debug {
     fn initial_shear_modulus(&self) -> f64;
     /// Initial bulk modulus K0.
     fn initial_bulk_modulus(&self) -> f64;
+    /// Pressure `p = U'(J)` of the volumetric energy `U(J)` of a law whose Kirchhoff stress
+    /// splits as `tau = tau_iso + J p I`.
+    fn volumetric_pressure(&self, j: f64) -> f64;
+    /// `U''(J)`, the derivative of [`Self::volumetric_pressure`].
+    fn volumetric_stiffness(&self, j: f64) -> f64;
+
+    /// The stress-dependent terms of the tangent with a given pressure `p_m` in place of
+    /// `p = U'(J)`: returns `tau_m = tau + J (p_m - p) I` (for the geometric stiffness) and
+    /// `c_m = c^tau + J (p_m - p) (I (x) I - 2 II)`.
+    ///
+    /// This is the tangent of the one-point mixed (u-p, Q1/P0) formulation after the
+    /// element-constant pressure is condensed out: its volumetric part is
+    /// `J (p_m + J U'') I (x) I - 2 J p_m II`, the displacement formulation's with `p` replaced by
+    /// the mixed pressure. Both agree when `p_m = U'(J)`.
+    fn mixed_stress_and_tangent(
+        &self,
+        f: &Matrix3<f64>,
+        pressure: f64,
+    ) -> (Matrix3<f64>, SpatialTangent) {
+        let (tau, c) = self.stress_and_tangent(f);
+        let j = f.determinant();
+        let shift = j * (pressure - self.volumetric_pressure(j));
+        let identity = Matrix3::identity();
+        let correction = dyad(&identity, &identity) - symmetric_product(&identity) * 2.0;
+        (
+            tau + identity * shift,
+            SpatialTangent(c.0 + correction * shift),
+        )
+    }
 }
 
 /// Fourth-order spatial tangent with major and minor symmetry, stored in Voigt form, order
@@ -259,6 +288,16 @@ impl Hyperelastic for PolynomialN1 {
     fn initial_bulk_modulus(&self) -> f64 {
         2.0 / self.d1
     }
+
+    /// `p = U'(J) = 2 (J - 1) / D1`.
+    fn volumetric_pressure(&self, j: f64) -> f64 {
+        self.pressure(j)
+    }
+
+    /// `U''(J) = 2 / D1`.
+    fn volumetric_stiffness(&self, _j: f64) -> f64 {
+        2.0 / self.d1
+    }
 }
 
 #[cfg(test)]
@@ -333,6 +372,44 @@ mod tests {
                         assert!(err < 1e-6, "G = {g}: {fd} vs {analytic} (err {err})");
                     }
                 }
+            }
+        }
+        Ok(())
+    }
+
+    /// The mixed tangent is the Lie derivative of `tau_iso(F) + J(F) p_m I` at fixed `p_m`, plus
+    /// the condensed volumetric stiffness `J^2 U'' I (x) I`; at `p_m = U'(J)` it is the
+    /// consistent tangent.
+    #[test]
+    fn mixed_tangent_is_the_derivative_at_fixed_pressure() -> Result<(), FemError> {
+        let m = benchmark()?;
+        let f = general_f();
+        let j = f.determinant();
+        let (tau, c) = m.stress_and_tangent(&f);
+        let (tau_m, c_m) = m.mixed_stress_and_tangent(&f, m.volumetric_pressure(j));
+        assert!((tau_m - tau).norm() < 1e-12 * tau.norm());
+        assert!((c_m.0 - c.0).norm() < 1e-12 * c.0.norm());
+        let p_m = -3.0e6;
+        let stress_at_fixed_pressure = |f: &Matrix3<f64>| {
+            let j = f.determinant();
+            m.kirchhoff_stress(f) + Matrix3::identity() * (j * (p_m - m.volumetric_pressure(j)))
+        };
+        let (tau_m, c_m) = m.mixed_stress_and_tangent(&f, p_m);
+        assert!((stress_at_fixed_pressure(&f) - tau_m).norm() < 1e-9 * tau_m.norm());
+        let identity = Matrix3::identity();
+        let condensed = dyad(&identity, &identity) * (j * j * m.volumetric_stiffness(j));
+        let h = 1e-6;
+        for i in 0..3 {
+            for k in 0..3 {
+                let g = unit(i, k) + unit(k, (i + 2) % 3) * 0.4;
+                let plus = stress_at_fixed_pressure(&((identity + g * h) * f));
+                let minus = stress_at_fixed_pressure(&((identity - g * h) * f));
+                let fd = (plus - minus) / (2.0 * h);
+                let analytic = SpatialTangent(c_m.0 - condensed).contract(&g)
+                    + g * tau_m
+                    + tau_m * g.transpose();
+                let err = relative_error(&fd, &analytic, c_m.0.norm());
+                assert!(err < 1e-6, "G = {g}: {fd} vs {analytic} (err {err})");
             }
         }
         Ok(())

@@ -35,6 +35,24 @@ pub struct ElementResponse {
     pub cauchy_stress: Matrix3<f64>,
     /// Volume ratio `J = det F`.
     pub volume_ratio: f64,
+    /// `dJ/du`, same ordering as the force: `J g_a` for node `a` (`g_a = F^{-T} b_a`).
+    pub volume_ratio_gradient: DVector<f64>,
+}
+
+/// Which tangent stiffness an element evaluation returns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tangent {
+    /// None: forces and energies only.
+    None,
+    /// The consistent tangent `d force / d u` of the displacement formulation.
+    Consistent,
+    /// The tangent of the condensed one-point mixed (u-p) formulation at the element pressure
+    /// `pressure` (see [`Hyperelastic::mixed_stress_and_tangent`]); equal to the consistent one
+    /// when `pressure = U'(J)`. The force is the displacement formulation's in every case.
+    Mixed {
+        /// The element's mixed pressure `p_m` (Pa).
+        pressure: f64,
+    },
 }
 
 impl<const D: usize> OnePointSolid<D> {
@@ -144,7 +162,26 @@ impl<const D: usize> OnePointSolid<D> {
             })
     }
 
-    /// Internal force, optional tangent, energies and stress at displacement u (node-major
+    /// Internal force, optional consistent tangent, energies and stress at displacement u
+    /// (node-major ordering: index a*D + i); see [`Self::respond`].
+    ///
+    /// # Errors
+    /// As [`Self::respond`].
+    pub fn evaluate(
+        &self,
+        material: &dyn Hyperelastic,
+        u: &[SVector<f64, D>],
+        with_tangent: bool,
+    ) -> Result<ElementResponse, FemError> {
+        let tangent = if with_tangent {
+            Tangent::Consistent
+        } else {
+            Tangent::None
+        };
+        self.respond(material, u, tangent)
+    }
+
+    /// Internal force, the requested tangent, energies and stress at displacement u (node-major
     /// ordering: index a*D + i).
     ///
     /// With `g_a = F^{-T} b_a` (the spatial gradient of `N_a`) and the Kirchhoff stress `tau`:
@@ -155,14 +192,17 @@ impl<const D: usize> OnePointSolid<D> {
     /// `f_{iI} = k_i sum_alpha q_{i alpha} gamma_{alpha I}`, constant stiffness
     /// `k_i sum_alpha gamma_{alpha I} gamma_{alpha J}`.
     ///
+    /// With [`Tangent::Mixed`] the stress `tau` of the geometric term and the tangent `c^tau`
+    /// are those of the mixed formulation at the given pressure.
+    ///
     /// # Errors
     /// [`FemError::LengthMismatch`] if `u` does not hold one vector per node,
     /// [`FemError::InvertedElement`] if `J <= 0` or `F` is not finite.
-    pub fn evaluate(
+    pub fn respond(
         &self,
         material: &dyn Hyperelastic,
         u: &[SVector<f64, D>],
-        with_tangent: bool,
+        tangent: Tangent,
     ) -> Result<ElementResponse, FemError> {
         let n = self.node_count();
         if u.len() != n {
@@ -179,11 +219,11 @@ impl<const D: usize> OnePointSolid<D> {
             return Err(inverted);
         }
         let f_inv_t = f.try_inverse().ok_or(inverted)?.transpose();
-        let (tau, tangent) = if with_tangent {
-            let (tau, c) = material.stress_and_tangent(&f);
-            (tau, Some(c))
-        } else {
-            (material.kirchhoff_stress(&f), None)
+        let tau = material.kirchhoff_stress(&f);
+        let tangent = match tangent {
+            Tangent::None => None,
+            Tangent::Consistent => Some(material.stress_and_tangent(&f)),
+            Tangent::Mixed { pressure } => Some(material.mixed_stress_and_tangent(&f, pressure)),
         };
         let g: Vec<Vector3<f64>> = self
             .mean_gradients
@@ -212,13 +252,13 @@ impl<const D: usize> OnePointSolid<D> {
             }
         }
 
-        let stiffness = tangent.map(|c| {
+        let stiffness = tangent.map(|(tau_k, c)| {
             let b = strain_displacement::<D>(&g);
             let mut k = (b.transpose() * c.0 * &b) * self.volume;
             let hourglass = self.hourglass_vectors.tr_mul(&self.hourglass_vectors);
             for (a, g_a) in g.iter().enumerate() {
                 for (bn, g_b) in g.iter().enumerate() {
-                    let geometric = self.volume * g_a.dot(&(tau * g_b));
+                    let geometric = self.volume * g_a.dot(&(tau_k * g_b));
                     for i in 0..D {
                         k[(a * D + i, bn * D + i)] +=
                             geometric + self.hourglass_stiffness[i] * hourglass[(a, bn)];
@@ -235,6 +275,7 @@ impl<const D: usize> OnePointSolid<D> {
             hourglass_energy,
             cauchy_stress: tau / det_f,
             volume_ratio: det_f,
+            volume_ratio_gradient: DVector::from_fn(dofs, |r, _| det_f * g[r / D][r % D]),
         })
     }
 
@@ -385,6 +426,43 @@ mod tests {
     fn tangent_and_force_match_finite_differences() -> Result<(), FemError> {
         check_tangent_and_energy::<2>()?;
         check_tangent_and_energy::<3>()
+    }
+
+    /// The mixed tangent differs from the consistent one by the pressure difference times the
+    /// Hessian of the volume: `K_m - K = V0 (p_m - U'(J)) d^2 J / du^2` (the force `V0 J p g_a` at
+    /// fixed pressure), and `volume_ratio_gradient` is `dJ/du`.
+    fn check_mixed_tangent<const D: usize>() -> Result<(), FemError> {
+        let m = material()?;
+        let x = distorted::<D>();
+        let element = OnePointSolid::new(&x, 0.7, m.initial_shear_modulus(), 1.0)?;
+        let u = general_u(&x);
+        let consistent = element.respond(&m, &u, Tangent::Consistent)?;
+        let p_m = m.volumetric_pressure(consistent.volume_ratio) - 4.0e6;
+        let mixed = element.respond(&m, &u, Tangent::Mixed { pressure: p_m })?;
+        assert_eq!(mixed.force, consistent.force);
+        let missing = || FemError::InvalidMesh("no stiffness".into());
+        let k = consistent.stiffness.ok_or_else(missing)?;
+        let k_m = mixed.stiffness.ok_or_else(missing)?;
+        let shift = element.volume() * (p_m - m.volumetric_pressure(consistent.volume_ratio));
+        let h = 1e-6;
+        for dof in 0..D * element.node_count() {
+            let plus = element.evaluate(&m, &perturb(&u, dof, h), false)?;
+            let minus = element.evaluate(&m, &perturb(&u, dof, -h), false)?;
+            let dj = (plus.volume_ratio - minus.volume_ratio) / (2.0 * h);
+            assert!((dj - consistent.volume_ratio_gradient[dof]).abs() < 1e-8);
+            let hessian_column =
+                (&plus.volume_ratio_gradient - &minus.volume_ratio_gradient) / (2.0 * h);
+            let expected = k.column(dof) + hessian_column * shift;
+            let err = (expected - k_m.column(dof)).amax() / k.amax();
+            assert!(err < 1e-7, "D = {D}, dof {dof}: mixed tangent error {err}");
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn mixed_tangent_adds_pressure_times_volume_hessian() -> Result<(), FemError> {
+        check_mixed_tangent::<2>()?;
+        check_mixed_tangent::<3>()
     }
 
     /// Patch of distorted elements: affine displacement on the boundary, Newton on the interior

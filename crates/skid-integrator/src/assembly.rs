@@ -9,11 +9,12 @@ use nalgebra::{DVector, SVector};
 use rayon::prelude::*;
 use skid_fem::error::FemError;
 use skid_fem::pressure::pressure_face_forces;
-use skid_fem::solid::ElementResponse;
+use skid_fem::solid::{ElementResponse, Tangent};
 
 use crate::error::{IncrementFailure, ModelError};
+use crate::mixed::MixedPressures;
 use crate::model::Model;
-use crate::sparse::{Factorization, PatternBuilder, SparsePattern};
+use crate::sparse::{Factorization, NON_FINITE_TANGENT, PatternBuilder, SparsePattern};
 
 /// Below this many elements the element loop runs sequentially (threads cost more than they
 /// save on tiny meshes).
@@ -47,6 +48,8 @@ pub struct Assembler {
     diagonal: Vec<usize>,
     slot_position: Vec<(usize, usize)>,
     values: Vec<f64>,
+    /// Element pressures of the mixed tangent between Newton iterates.
+    mixed: MixedPressures,
 }
 
 impl Assembler {
@@ -88,6 +91,7 @@ impl Assembler {
             diagonal,
             slot_position,
             values,
+            mixed: MixedPressures::new(model.elements().len()),
         })
     }
 
@@ -103,13 +107,19 @@ impl Assembler {
         tangent_factor: Option<f64>,
     ) -> Result<InternalState, IncrementFailure> {
         let part = model.part();
+        let mixed = &self.mixed;
         let evaluate = |e: usize| -> Result<ElementResponse, IncrementFailure> {
             let u: Vec<SVector<f64, D>> = part.mesh.elements[e]
                 .iter()
                 .map(|&n| model.dofs().node_displacement(x, n))
                 .collect();
+            let tangent = if tangent_factor.is_some() {
+                mixed.tangent(e)
+            } else {
+                Tangent::None
+            };
             model.elements()[e]
-                .evaluate(part.material.as_ref(), &u, tangent_factor.is_some())
+                .respond(part.material.as_ref(), &u, tangent)
                 .map_err(|err| match err {
                     FemError::InvertedElement { det_f } => {
                         IncrementFailure::InvertedElement { element: e, det_f }
@@ -130,6 +140,7 @@ impl Assembler {
             (0..n_el).map(evaluate).collect::<Result<_, _>>()?
         };
 
+        self.mixed.record(model, x, &responses);
         let mut state = InternalState {
             force: DVector::zeros(model.dofs().len()),
             strain_energy: 0.0,
@@ -153,6 +164,30 @@ impl Assembler {
             }
         }
         Ok(state)
+    }
+
+    /// At the start of an increment from the converged configuration `start`: the first
+    /// tangent takes the element pressures `U'(J)` there (evaluated again unless the last
+    /// [`Self::internal`] call was at `start`); see [`crate::mixed`].
+    ///
+    /// # Errors
+    /// As [`Self::internal`].
+    pub fn start_mixed_pressures<const D: usize>(
+        &mut self,
+        model: &Model<D>,
+        start: &DVector<f64>,
+    ) -> Result<(), IncrementFailure> {
+        if !self.mixed.recorded_at(start) {
+            self.internal(model, start, None)?;
+        }
+        self.mixed.hold();
+        Ok(())
+    }
+
+    /// After the Newton step `dx` from the configuration of the last [`Self::internal`] call,
+    /// predicts the element pressures the next tangent uses; see [`crate::mixed`].
+    pub fn advance_mixed_pressures<const D: usize>(&mut self, model: &Model<D>, dx: &DVector<f64>) {
+        self.mixed.advance(model, dx);
     }
 
     /// Adds `d_i` to each diagonal entry of the effective tangent (mass terms).
@@ -200,7 +235,53 @@ impl Assembler {
     pub fn factorize(&self) -> Result<Factorization, IncrementFailure> {
         self.pattern.factorize(&self.values)
     }
+
+    /// Factorizes `K + c_k M` (the current values hold `K + c_0 M`, held equations already
+    /// replaced by identity rows), with the first `c_k = c_0 10^k`, `k = 0, 1, ...,`
+    /// [`MAX_SHIFT_DECADES`], for which it is positive definite; returns the factor and `c_k`.
+    ///
+    /// This is the pseudo-transient continuation of a static Newton step: the mass term is not
+    /// in the residual, so the converged state does not depend on it; a larger `c` only turns
+    /// Newton's step into a damped, shorter one. It is needed where the tangent of the solid
+    /// *without its contacts* is indefinite although the contact-constrained problem is stable:
+    /// a pad pressed harder than its shear modulus by a load balanced only by contact forces
+    /// (its free front face may shear and tilt at negative stiffness, `tau : Omega^T Omega < 0`
+    /// for a compressive Kirchhoff stress), which the Cholesky-based contact reduction cannot
+    /// factor. A `c_0` of zero is not escalated.
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] if even `c_0 10^MAX_SHIFT_DECADES` leaves the matrix
+    /// indefinite, or for non-finite entries.
+    pub fn factorize_shifted(
+        &mut self,
+        mass: &DVector<f64>,
+        c0: f64,
+        held: &[bool],
+    ) -> Result<(Factorization, f64), IncrementFailure> {
+        let mut c = c0;
+        let mut decades = 0;
+        loop {
+            match self.factorize() {
+                Ok(factor) => return Ok((factor, c)),
+                Err(IncrementFailure::LinearSolve(message))
+                    if decades < MAX_SHIFT_DECADES
+                        && c > 0.0
+                        && !message.starts_with(NON_FINITE_TANGENT) =>
+                {
+                    self.add_diagonal(&(mass * (9.0 * c)));
+                    self.hold(held);
+                    c *= 10.0;
+                    decades += 1;
+                }
+                Err(e) => return Err(e),
+            }
+        }
+    }
 }
+
+/// How many tenfold increases of the static step's mass shift [`Assembler::factorize_shifted`]
+/// tries before it reports the tangent as indefinite.
+pub const MAX_SHIFT_DECADES: usize = 8;
 
 /// External nodal forces of the pressure loads at load factor `lambda`, on the current
 /// geometry (follower pressure), per equation.

@@ -12,8 +12,10 @@
 //! Dynamic residual (HHT): `R = M a + (1 + alpha) F(x) - alpha F_n`; tangent
 //! `M/(beta h^2) + (1 + alpha) K_T`. Static residual: `R = F(x)` with `F = f_int - lambda f_ext`;
 //! tangent `K_T + M/h_s^2`. The mass term of the static tangent only regularises the Newton
-//! step (it keeps a pad that is not yet held by contact from being singular); it is not in the
-//! residual, so the converged state is exactly static.
+//! step (it keeps a pad that is not yet held by contact from being singular, and it grows
+//! tenfold at a time where the tangent without contact is indefinite, see
+//! [`Assembler::factorize_shifted`]); it is not in the residual, so the converged state is
+//! exactly static.
 
 use std::time::{Duration, Instant};
 
@@ -129,6 +131,7 @@ pub fn solve_increment<const D: usize>(
             x[eq] = start.x[eq];
         }
     }
+    assembler.start_mixed_pressures(model, &start.x)?;
     let mut counters = IncrementCounters::default();
     let mut warm = start.warm_forces.clone();
     // Contact forces and linearised kinematics of the last conic solve.
@@ -211,6 +214,11 @@ pub fn solve_increment<const D: usize>(
             }
         }
 
+        if let IncrementKind::Static { regularization, .. } = kind {
+            // Raise the static step's mass shift until `K + c M` is positive definite (see
+            // `Assembler::factorize_shifted`); the factorizations below then reuse that shift.
+            assembler.factorize_shifted(mass, regularization, held)?;
+        }
         let dx = if rows.is_empty() {
             let clock = Instant::now();
             let dx = assembler.factorize()?.solve(&(-&residual));
@@ -238,6 +246,7 @@ pub fn solve_increment<const D: usize>(
         if dx.iter().any(|v| !v.is_finite()) {
             return Err(IncrementFailure::NonFinite { iteration });
         }
+        assembler.advance_mixed_pressures(model, &dx);
         x += dx;
     }
     // The loop returns from inside: either converged or at the last convergence check.

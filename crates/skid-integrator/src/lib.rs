@@ -7,6 +7,7 @@
 //! - [`sparse`]: the fixed sparsity pattern and the Cholesky factorization whose symbolic
 //!   analysis is computed once per run and reused for every Newton iteration;
 //! - [`assembly`]: internal forces, tangent, lumped masses and follower pressure on that pattern;
+//! - [`mixed`]: the element pressures of the mixed (u-p) tangent between Newton iterates;
 //! - [`hht`]: the HHT-alpha / Newmark relations between displacement, velocity and acceleration;
 //! - [`coupling`]: the contact rows H (gap and slip linearised in the global unknowns) and the
 //!   reduction of one Newton step to the exact-Coulomb problem in the contact forces;
@@ -22,6 +23,7 @@ pub mod dof;
 pub mod error;
 pub mod hht;
 pub mod increment;
+pub mod mixed;
 pub mod model;
 pub mod sparse;
 pub mod state;

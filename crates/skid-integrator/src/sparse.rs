@@ -28,6 +28,9 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::error::IncrementFailure;
 
+/// Message of [`SparsePattern::factorize`] for a matrix with NaN or infinite entries.
+pub const NON_FINITE_TANGENT: &str = "non-finite entries in the effective tangent";
+
 /// Collects the (row, column) positions of the lower triangle in the order values will be
 /// written, and hands out the slot of each.
 #[derive(Debug, Default)]
@@ -113,9 +116,7 @@ impl SparsePattern {
     /// [`IncrementFailure::LinearSolve`] if the matrix is not positive definite or not finite.
     pub fn factorize(&self, values: &[f64]) -> Result<Factorization, IncrementFailure> {
         if values.iter().any(|v| !v.is_finite()) {
-            return Err(IncrementFailure::LinearSolve(
-                "non-finite entries in the effective tangent".into(),
-            ));
+            return Err(IncrementFailure::LinearSolve(NON_FINITE_TANGENT.into()));
         }
         let matrix = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
             .map_err(|e| IncrementFailure::LinearSolve(format!("{e:?}")))?;

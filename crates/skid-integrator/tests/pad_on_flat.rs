@@ -1,0 +1,169 @@
+//! The drum pad's material pressed onto a rigid flat under hard conditions:
+//! - by more than its shear modulus: its tangent without the contacts is indefinite (the free
+//!   front face may shear and tilt at negative stiffness under the compressive stress), yet the
+//!   pad held by the contact is in stable equilibrium. The static preload must find that
+//!   equilibrium, and the equilibrium must not depend on the Newton matrix's mass regularisation;
+//! - nearly incompressible (K/mu = 1e7): preload and dynamics must run without cutbacks.
+
+use nalgebra::{SVector, Vector3};
+use skid_contact::plane::RigidPlane;
+use skid_fem::material::PolynomialN1;
+use skid_fem::mesh::SolidMesh;
+use skid_fem::rigid::RigidBody;
+use skid_integrator::stepper::{IncrementReport, Observer, Settings, Step, StepKind, run};
+use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, State, Tie};
+
+const LENGTH: f64 = 0.1;
+const THICKNESS: f64 = 0.05;
+const WIDTH: f64 = 0.1;
+/// 2.5 times the shear modulus 1.38 MPa of the pad material.
+const HIGH_PRESSURE: f64 = 3.5e6;
+/// The drum benchmark's D1 (K/mu = 10) and its literal reading (K/mu = 1e7).
+const D1: f64 = 0.145e-6;
+const D1_LITERAL: f64 = 0.145e-12;
+
+struct Last(Option<State>);
+
+impl<const D: usize> Observer<D> for Last {
+    fn on_increment(&mut self, _: &Model<D>, r: &IncrementReport<'_>) -> std::io::Result<()> {
+        self.0 = Some(r.state.clone());
+        Ok(())
+    }
+}
+
+/// The pad (4 x 1 plane-strain elements, compressibility `d1`) on the plane y = 0, its back face
+/// tied to a plate that may only translate in y and loaded by `pressure`.
+fn pad(pressure: f64, d1: f64) -> Model<2> {
+    let mesh = SolidMesh::<2>::structured_block(
+        SVector::<f64, 2>::new(-0.5 * LENGTH, 0.0),
+        SVector::<f64, 2>::new(LENGTH, THICKNESS),
+        [4, 1],
+    )
+    .expect("mesh");
+    let front = mesh.node_sets["ymin"].clone();
+    let back = mesh.node_sets["ymax"].clone();
+    let back_faces = mesh.surfaces["ymax"].clone();
+    let part = SolidPart {
+        mesh,
+        material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, d1).expect("material")),
+        density: 1000.0,
+        thickness: WIDTH,
+        hourglass_scale: 1.0,
+    };
+    let body = |name: &str, free: [bool; 2], y: f64| RigidBody::<2> {
+        name: name.into(),
+        reference_point: SVector::<f64, 2>::new(0.0, y),
+        mass: 0.0,
+        rotary_inertia: 0.0,
+        free_translations: free,
+        rotation_axis: None,
+        initial_velocity: SVector::zeros(),
+        initial_angular_velocity: 0.0,
+    };
+    Model::new(
+        part,
+        vec![
+            body("ground", [false, false], 0.0),
+            body("plate", [false, true], THICKNESS),
+        ],
+        vec![Tie {
+            body: 1,
+            nodes: back,
+        }],
+        vec![PressureLoad {
+            faces: back_faces,
+            pressure,
+        }],
+        vec![ContactPair {
+            name: "pad-ground".into(),
+            nodes: front,
+            body: 0,
+            surface: Box::new(RigidPlane::new(Vector3::y(), Vector3::x()).expect("plane")),
+            mu: 0.15,
+        }],
+    )
+    .expect("model")
+}
+
+/// A static preload in 4 increments, then `settle` increments of 1e-4 s of HHT dynamics; the
+/// final state. Asserts that no increment needed a cutback.
+fn load(model: &Model<2>, regularization_time: f64, settle: usize) -> State {
+    let mut steps = vec![Step {
+        name: "preload".into(),
+        kind: StepKind::Static {
+            increments: 4,
+            regularization_time,
+        },
+        held_bodies: vec![],
+    }];
+    if settle > 0 {
+        steps.push(Step {
+            name: "settle".into(),
+            kind: StepKind::Dynamic {
+                duration: 1e-4 * settle as f64,
+                dt: 1e-4,
+                alpha: -0.3,
+            },
+            held_bodies: vec![],
+        });
+    }
+    let mut last = Last(None);
+    let (stats, result) = run(model, &steps, &Settings::default(), &mut last);
+    let state = result.expect("the run completes");
+    assert_eq!(stats.cutbacks, 0, "no cutbacks");
+    state
+}
+
+#[test]
+fn pad_pressed_beyond_its_shear_modulus_reaches_the_same_equilibrium() {
+    let model = pad(HIGH_PRESSURE, D1);
+    let plate = model.dofs().body_translation(1)[1].expect("plate y");
+    let a = load(&model, 1e-2, 0);
+    let b = load(&model, 1e-3, 0);
+    // Equilibrium of the plate: the contact forces carry the whole load.
+    let normal: f64 = a.contacts.iter().map(|c| c.normal_force).sum();
+    let force = HIGH_PRESSURE * LENGTH * WIDTH;
+    assert!((normal - force).abs() < 1e-6 * force, "{normal} vs {force}");
+    // Strongly compressed, and the same state whatever the regularisation.
+    assert!(a.x[plate] < -0.25 * THICKNESS, "plate {}", a.x[plate]);
+    let scale = a.x.amax();
+    assert!(
+        (&a.x - &b.x).amax() < 1e-5 * scale,
+        "{} vs {}",
+        a.x[plate],
+        b.x[plate]
+    );
+}
+
+/// K/mu = 1e7 under the drum's pressure: the Newton iterates of the displacement formulation
+/// carry pressures `U'(J)` far above the shear modulus (a volume error of 1e-6 is 14 MPa),
+/// which made the tangent indefinite; with the mixed tangent no increment fails, and the
+/// nearly incompressible pad settles to the same contact force, with J = 1 to 1e-6.
+#[test]
+fn nearly_incompressible_pad_preloads_and_settles_without_cutbacks() {
+    let pressure = 0.35e6;
+    let model = pad(pressure, D1_LITERAL);
+    let state = load(&model, 1e-2, 20);
+    let normal: f64 = state.contacts.iter().map(|c| c.normal_force).sum();
+    let force = pressure * LENGTH * WIDTH;
+    assert!((normal - force).abs() < 0.05 * force, "{normal} vs {force}");
+    let plate = model.dofs().body_translation(1)[1].expect("plate y");
+    let compressible = load(&pad(pressure, D1), 1e-2, 0);
+    // Incompressible: the pad squeezes out sideways instead of losing volume, so it gives less.
+    assert!(state.x[plate] < 0.0 && state.x[plate] > compressible.x[plate]);
+    let part = model.part();
+    for (element, nodes) in model.elements().iter().zip(&part.mesh.elements) {
+        let u: Vec<_> = nodes
+            .iter()
+            .map(|&n| model.dofs().node_displacement(&state.x, n))
+            .collect();
+        let r = element
+            .evaluate(part.material.as_ref(), &u, false)
+            .expect("element");
+        assert!(
+            (r.volume_ratio - 1.0).abs() < 1e-6,
+            "J = {}",
+            r.volume_ratio
+        );
+    }
+}
