@@ -1,11 +1,12 @@
 //! A block pressed on a rigid flat and pushed sideways: it sticks while the push is below
 //! mu N, and slides with a friction force of exactly mu N above it.
 
+mod common;
+
 use nalgebra::{SVector, Vector3};
 use skid_contact::plane::RigidPlane;
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
-use skid_fem::rigid::RigidBody;
 use skid_integrator::stepper::{IncrementReport, Observer, Settings, Step, StepKind, run};
 use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, State, Tie};
 
@@ -44,16 +45,7 @@ fn block(side_force: f64) -> (Model<2>, f64) {
         thickness: THICKNESS,
         hourglass_scale: 1.0,
     };
-    let body = |name: &str, free: [bool; 2], y: f64| RigidBody::<2> {
-        name: name.into(),
-        reference_point: SVector::<f64, 2>::new(0.0, y),
-        mass: 0.0,
-        rotary_inertia: 0.0,
-        free_translations: free,
-        rotation_axis: None,
-        initial_velocity: SVector::zeros(),
-        initial_angular_velocity: 0.0,
-    };
+    let body = common::translating_body;
     let model = Model::new(
         part,
         vec![

@@ -5,11 +5,12 @@
 //!   equilibrium, and the equilibrium must not depend on the Newton matrix's mass regularisation;
 //! - nearly incompressible (K/mu = 1e7): preload and dynamics must run without cutbacks.
 
+mod common;
+
 use nalgebra::{SVector, Vector3};
 use skid_contact::plane::RigidPlane;
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
-use skid_fem::rigid::RigidBody;
 use skid_integrator::stepper::{IncrementReport, Observer, Settings, Step, StepKind, run};
 use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, State, Tie};
 
@@ -50,16 +51,7 @@ fn pad(pressure: f64, d1: f64) -> Model<2> {
         thickness: WIDTH,
         hourglass_scale: 1.0,
     };
-    let body = |name: &str, free: [bool; 2], y: f64| RigidBody::<2> {
-        name: name.into(),
-        reference_point: SVector::<f64, 2>::new(0.0, y),
-        mass: 0.0,
-        rotary_inertia: 0.0,
-        free_translations: free,
-        rotation_axis: None,
-        initial_velocity: SVector::zeros(),
-        initial_angular_velocity: 0.0,
-    };
+    let body = common::translating_body;
     Model::new(
         part,
         vec![
