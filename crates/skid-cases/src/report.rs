@@ -105,6 +105,9 @@ pub struct RunSummary {
     pub max_gap_violation_m: f64,
     /// Largest gap at a contact carrying force while sliding, m.
     pub max_sliding_separation_m: f64,
+    /// Largest hourglass energy / strain energy over the dynamic steps.
+    #[serde(default)]
+    pub max_hourglass_ratio: Option<f64>,
     /// Converged increments.
     pub increments: usize,
     /// Newton iterations.
@@ -487,6 +490,7 @@ pub(crate) mod test_runs {
                 energy_balance_residual_j: Some(0.3),
                 max_gap_violation_m: 1e-12,
                 max_sliding_separation_m: 1e-12,
+                max_hourglass_ratio: Some(0.005),
                 increments: 1500,
                 newton_iterations: 3000,
                 contact_solves: 3000,

@@ -46,6 +46,7 @@ fn write_run(dir: &Path, case: &Value, decel: f64, dt: f64, energy_error: f64) {
         "energy_balance_error": energy_error,
         "energy_balance_residual_j": energy_error * 315.0,
         "max_gap_violation_m": 1e-12,
+        "max_hourglass_ratio": 0.005,
         "max_sliding_separation_m": 1e-11,
         "increments": n + 5,
         "newton_iterations": 2 * n,
@@ -84,7 +85,7 @@ fn hard_cases_are_checked_from_their_case_and_failures_exit_1() {
     write_run(&hard.join("2d-good"), &good, 600.0 / 1.007, 1e-3, 1e-3);
     let (code, stdout, stderr, text) = report(&[("--hard", "hard")], tmp.path());
     assert_eq!(code, Some(0), "{stdout}\n{stderr}\n{text}");
-    assert!(stdout.contains("5 passed, 0 failed"), "{stdout}");
+    assert!(stdout.contains("6 passed, 0 failed"), "{stdout}");
     assert!(text.contains("## Hard cases"), "{text}");
     assert!(
         !text.contains("## Benchmark"),
@@ -102,7 +103,7 @@ fn hard_cases_are_checked_from_their_case_and_failures_exit_1() {
     write_run(&hard.join("2d-lossy"), &lossy, 600.0, 1e-3, 0.02);
     let (code, stdout, _, text) = report(&[("--hard", "hard")], tmp.path());
     assert_eq!(code, Some(1), "{stdout}");
-    assert!(stdout.contains("9 passed, 1 failed"), "{stdout}");
+    assert!(stdout.contains("11 passed, 1 failed"), "{stdout}");
     assert!(
         text.contains("- **FAIL** energy: 2.000 % of the drum energy lost (limit 1 %)"),
         "{text}"

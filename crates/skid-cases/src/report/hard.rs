@@ -16,7 +16,8 @@
 //!   relative;
 //! - **post-stop**: after the stop, over at least one rocking period, `|omega|` and the angle
 //!   change stay below DRUM.md's limits (5 rad/s, 0.03 rad) scaled by the case's elastic
-//!   spring-back relative to the benchmark's ([`SpringBack`]).
+//!   spring-back relative to the benchmark's ([`SpringBack`]);
+//! - **hourglass**: the hourglass energy stays below [`HOURGLASS_LIMIT`] of the strain energy.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -36,6 +37,9 @@ use crate::schema::{Case, MaterialSpec};
 pub const T_STOP_TOLERANCE: f64 = 0.02;
 /// Energy balance tolerance (issue 4).
 pub const ENERGY_TOLERANCE: f64 = 0.01;
+/// Largest hourglass energy / strain energy (issue 4): the stabilisation must not carry a
+/// visible share of the pad's deformation.
+pub const HOURGLASS_LIMIT: f64 = 0.01;
 /// Largest `|omega - omega0| / |omega0|` without a friction torque (issue 4).
 pub const OMEGA_CONSTANCY: f64 = 1e-9;
 /// Largest penetration, and gap of a sliding contact carrying force, m: 1e-6 m is 0.05 % of
@@ -46,7 +50,14 @@ const POST_STOP_OMEGA: f64 = 5.0;
 /// DRUM.md section 3: largest angle change after the stop, rad, at the benchmark's spring-back.
 const POST_STOP_ANGLE: f64 = 0.03;
 /// The names of the checks, in table order.
-pub const CHECKS: [&str; 5] = ["completed", "contact", "energy", "drum", "post-stop"];
+pub const CHECKS: [&str; 6] = [
+    "completed",
+    "contact",
+    "energy",
+    "drum",
+    "post-stop",
+    "hourglass",
+];
 
 /// The drum's rocking after the stop, estimated from the pad's shear spring: the friction force
 /// `F = mu p A` has sheared the pad (stiffness `k = G A / h`, initial shear modulus
@@ -182,7 +193,7 @@ pub struct Assessment {
     /// The energy error the energy check used (relative).
     pub energy_error: Option<f64>,
     /// The checks, in the order of [`CHECKS`].
-    pub checks: [Check; 5],
+    pub checks: [Check; 6],
 }
 
 fn completed(run: &Run) -> Check {
@@ -215,6 +226,20 @@ fn contact(run: &Run) -> Check {
             plain(CONTACT_LIMIT_M)
         ),
     )
+}
+
+fn hourglass(run: &Run) -> Check {
+    match run.summary.max_hourglass_ratio {
+        Some(ratio) => check(
+            within(ratio, HOURGLASS_LIMIT),
+            format!(
+                "max hourglass energy / strain energy {} % (limit {} %)",
+                percent(Some(ratio)),
+                plain(100.0 * HOURGLASS_LIMIT)
+            ),
+        ),
+        None => check(false, "no hourglass energy ratio in the summary".into()),
+    }
 }
 
 /// The energy check and the relative error it used.
@@ -363,6 +388,7 @@ pub fn assess(run: &Run, case: &Case) -> Assessment {
             energy_check,
             drum_check,
             post_stop(run, &e),
+            hourglass(run),
         ],
     }
 }
@@ -460,7 +486,8 @@ pub fn section(
          with F = mu p A the friction force and k = 2 (C10 + C01) A / h the pad's shear \
          stiffness (benchmark: 2.4 rad/s, 0.0095 rad, period 2 pi sqrt(I / (k R^2)) = 25 ms; \
          DRUM.md 2.3 measured 2 to 2.5 rad/s, 0.01 rad, 28 ms). Creeping or a reversal into \
-         sliding carries the drum much further.\n\n\
+         sliding carries the drum much further;\n\
+         - **hourglass**: max hourglass energy / strain energy <= {hourglass} % (issue 4).\n\n\
          ![omega / omega0 against t / t_est: every run with friction, and the estimate \
          1 - t / t_est]({HARD_OMEGA_SVG})\n\n",
         dir = dir.display(),
@@ -468,6 +495,7 @@ pub fn section(
         energy = plain(100.0 * ENERGY_TOLERANCE),
         tol = plain(100.0 * T_STOP_TOLERANCE),
         spin = Sig(OMEGA_CONSTANCY),
+        hourglass = plain(100.0 * HOURGLASS_LIMIT),
     );
     table(&assessed, &mut out);
     out.push_str("\n### The cases\n");
@@ -543,7 +571,7 @@ mod tests {
     fn a_run_that_behaves_as_estimated_passes_every_check() {
         let run = spin_down("2d-x", 600.0 / 1.007);
         let a = assess(&run, &case(&[]));
-        assert_eq!(verdicts(&a), vec![Verdict::Pass; 5], "{a:#?}");
+        assert_eq!(verdicts(&a), vec![Verdict::Pass; 6], "{a:#?}");
         assert!((a.deviation.expect("stops") - 0.007).abs() < 1e-9);
     }
 
@@ -590,6 +618,11 @@ mod tests {
         let mut run = spin_down("x", 600.0);
         run.summary.post_stop_max_angle_change = Some(0.04);
         assert_eq!(failing(&run), ["post-stop"]);
+        let mut run = spin_down("x", 600.0);
+        run.summary.max_hourglass_ratio = Some(0.011);
+        assert_eq!(failing(&run), ["hourglass"]);
+        run.summary.max_hourglass_ratio = None;
+        assert_eq!(failing(&run), ["hourglass"]);
     }
 
     #[test]
@@ -621,6 +654,7 @@ mod tests {
             Verdict::Pass,
             Verdict::Pass,
             Verdict::NotApplicable,
+            Verdict::Pass,
         ];
         assert_eq!(verdicts(&a), expected, "{a:#?}");
         assert!((a.energy_error.expect("energy") - 1e-8 / 315.0).abs() < 1e-18);
@@ -642,7 +676,7 @@ mod tests {
         let runs = [good, late];
         let (text, counts, plots) =
             section(Path::new("out/hard"), &runs, dir.path()).expect("section");
-        assert_eq!(counts.passed, 9);
+        assert_eq!(counts.passed, 11);
         assert_eq!(counts.failed, 1);
         assert!(plots[0].is_file());
         let row = |name: &str| {
@@ -656,7 +690,7 @@ mod tests {
             "{}",
             row("2d-good")
         );
-        assert!(row("2d-late").ends_with("| PASS | PASS | PASS | FAIL | PASS |"));
+        assert!(row("2d-late").ends_with("| PASS | PASS | PASS | FAIL | PASS | PASS |"));
         assert!(text.contains("Expectation: why it differs"), "{text}");
         let mut orphan = spin_down("2d-orphan", 600.0);
         orphan.case = None;
