@@ -214,14 +214,24 @@ pub fn solve_increment<const D: usize>(
             }
         }
 
-        if let IncrementKind::Static { regularization, .. } = kind {
-            // Raise the static step's mass shift until `K + c M` is positive definite (see
-            // `Assembler::factorize_shifted`); the factorizations below then reuse that shift.
-            assembler.factorize_shifted(mass, regularization, held)?;
-        }
+        let clock = Instant::now();
+        // A static step raises its mass shift until `K + c M` is positive definite (see
+        // `Assembler::factorize_shifted`). Without contact that factor is the step's; the
+        // contact step factorizes the shifted matrix again, in its own equation order.
+        let shifted = match kind {
+            IncrementKind::Static { regularization, .. } => {
+                Some(assembler.factorize_shifted(mass, regularization, held)?.0)
+            }
+            IncrementKind::Dynamic { .. } => None,
+        };
+        timings.linear_solve += clock.elapsed();
         let dx = if rows.is_empty() {
             let clock = Instant::now();
-            let dx = assembler.factorize()?.solve(&(-&residual));
+            let factor = match shifted {
+                Some(factor) => factor,
+                None => assembler.factorize()?,
+            };
+            let dx = factor.solve(&(-&residual));
             timings.linear_solve += clock.elapsed();
             last = Some((DVector::zeros(0), DVector::zeros(0)));
             dx
@@ -284,11 +294,6 @@ fn scaled_force_residual<const D: usize>(
     if scale > 0.0 { worst / scale } else { worst }
 }
 
-/// `M^{-1} f` for the lumped mass matrix; equations without mass (which carry no force) get 0.
-fn acceleration_of<const D: usize>(model: &Model<D>, f: &DVector<f64>) -> DVector<f64> {
-    f.zip_map(model.mass(), |f, m| if m > 0.0 { f / m } else { 0.0 })
-}
-
 /// The converged iterate: unknowns, their rates, and the forces evaluated there.
 struct Iterate {
     x: DVector<f64>,
@@ -323,7 +328,7 @@ fn finish<const D: usize>(
     let (r, v, a) = match kind {
         IncrementKind::Static { .. } => (r.clone(), v, a),
         IncrementKind::Dynamic { hht, h } => {
-            let contact = acceleration_of(model, &rows.transpose_times(r, x.len()));
+            let contact = model.acceleration_of(&rows.transpose_times(r, x.len()));
             let (v, a) = hht.split_impulse(h, &start.v, &start.a, &a, &contact);
             (r * hht.impulse_force_factor(), v, a)
         }

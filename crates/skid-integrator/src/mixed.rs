@@ -107,18 +107,15 @@ impl MixedPressures {
             .zip(elements)
             .map(|(at, nodes)| {
                 at.as_ref().map(|lin| {
-                    let du = DVector::from_iterator(
-                        D * nodes.len(),
-                        nodes.iter().flat_map(|&n| {
-                            model
-                                .dofs()
-                                .node_displacement(dx, n)
-                                .into_iter()
-                                .copied()
-                                .collect::<Vec<_>>()
-                        }),
-                    );
-                    lin.pressure + lin.stiffness * lin.volume_gradient.dot(&du)
+                    let dj: f64 = nodes
+                        .iter()
+                        .enumerate()
+                        .map(|(k, &n)| {
+                            let du = model.dofs().node_displacement(dx, n);
+                            lin.volume_gradient.fixed_rows::<D>(D * k).dot(&du)
+                        })
+                        .sum();
+                    lin.pressure + lin.stiffness * dj
                 })
             })
             .collect();

@@ -278,6 +278,11 @@ impl<const D: usize> Model<D> {
     pub fn mass(&self) -> &DVector<f64> {
         &self.mass
     }
+    /// `M^{-1} f` for the lumped mass matrix; equations without mass (which carry no force)
+    /// get 0.
+    pub fn acceleration_of(&self, f: &DVector<f64>) -> DVector<f64> {
+        f.zip_map(&self.mass, |f, m| if m > 0.0 { f / m } else { 0.0 })
+    }
     /// Size of the scene (diagonal of the bounding box of nodes and body reference points), m.
     pub fn length_scale(&self) -> f64 {
         self.length_scale

@@ -212,15 +212,11 @@ fn consistent_acceleration<const D: usize>(
     state: &State,
     held: &[bool],
 ) -> DVector<f64> {
-    let n = model.dofs().len();
-    DVector::from_fn(n, |i, _| {
-        let m = model.mass()[i];
-        if held[i] || m <= 0.0 {
-            0.0
-        } else {
-            -state.net_force[i] / m
-        }
-    })
+    let mut a = -model.acceleration_of(&state.net_force);
+    for (a, _) in a.iter_mut().zip(held).filter(|(_, h)| **h) {
+        *a = 0.0;
+    }
+    a
 }
 
 fn validate_steps<const D: usize>(model: &Model<D>, steps: &[Step]) -> Result<(), RunError> {
