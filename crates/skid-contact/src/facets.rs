@@ -3,7 +3,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use nalgebra::{Vector2, Vector3};
+use nalgebra::{Matrix3, Vector2, Vector3};
 
 use crate::error::ContactError;
 use crate::surface::{AnalyticCylinder, Projection, RigidSurface};
@@ -22,7 +22,9 @@ use crate::surface::{AnalyticCylinder, Projection, RigidSurface};
 ///   (`0 < xi_k < 1`): `g = nu_k.q - d`, `dg/dy = nu_k`, `xi_0 = s_k + xi_k L` with `s_k = k L`,
 ///   `d xi_0/dy = tau_k`. In the exterior wedge of vertex `V_j`: `g = |q - V_j|`,
 ///   `dg/dy = (q - V_j)/|q - V_j|` (the bisector `(nu_{j-1} + nu_j)/|nu_{j-1} + nu_j|` when
-///   `|q - V_j| ~ 0`), `xi_0 = s_j`, `d xi_0/dy = 0`. This distance is C1.
+///   `|q - V_j| ~ 0`), `d^2g/dy^2 = (I - e e^T - dg/dy dg/dy^T)/|q - V_j|` (zero when
+///   `|q - V_j| ~ 0`), `xi_0 = s_j`, `d xi_0/dy = 0`. This distance is C1. All other second
+///   derivatives vanish: gaps and coordinates are affine on a facet.
 /// * Inside: `g = max_k (nu_k.q - d)`, attained on the facet `k` of the angular sector of `q`,
 ///   with `dg/dy = nu_k`, `xi_0 = s_k + xi_k L`, `d xi_0/dy = tau_k`. Across a vertex bisector the
 ///   nearest facet switches, so `dg/dy` and `xi_0` jump there by design (penetrated states only).
@@ -167,17 +169,18 @@ impl RigidSurface for FacetedCylinder {
             (k, facet, plane_gap, xi)
         });
         let tiny = 64.0 * f64::EPSILON * (self.radius + q.norm());
-        // (g, dg/dy, xi_0, d xi_0/dy) with facet k as the closest feature
+        // (g, dg/dy, d^2g/dy^2, xi_0, d xi_0/dy) with facet k as the closest feature
         let on_facet = |(k, facet, plane_gap, xi): &(usize, Facet, f64, f64)| {
             (
                 *plane_gap,
                 self.lift(&facet.normal),
+                Matrix3::zeros(),
                 (*k as f64 + xi) * self.length,
                 self.lift(&facet.tangent),
             )
         };
         let nearest_plane = candidates.iter().max_by(|a, b| a.2.total_cmp(&b.2))?;
-        let (gap, gap_gradient, arc, arc_gradient) = if nearest_plane.2 < -tiny {
+        let (gap, gap_gradient, gap_hessian, arc, arc_gradient) = if nearest_plane.2 < -tiny {
             on_facet(nearest_plane)
         } else if let Some(front) = candidates
             .iter()
@@ -194,15 +197,20 @@ impl RigidSurface for FacetedCylinder {
                 })
                 .min_by(|a, b| a.1.norm().total_cmp(&b.1.norm()))?;
             let distance = offset.norm();
-            let direction = if distance > tiny {
-                offset / distance
+            let (direction, curvature) = if distance > tiny {
+                let direction = self.lift(&(offset / distance));
+                let across = Matrix3::identity()
+                    - self.axis * self.axis.transpose()
+                    - direction * direction.transpose();
+                (direction, across / distance)
             } else {
                 let (sin, cos) = self.vertex_angle(j).sin_cos();
-                Vector2::new(cos, sin)
+                (self.lift(&Vector2::new(cos, sin)), Matrix3::zeros())
             };
             (
                 distance,
-                self.lift(&direction),
+                direction,
+                curvature,
                 j as f64 * self.length,
                 Vector3::zeros(),
             )
@@ -212,6 +220,9 @@ impl RigidSurface for FacetedCylinder {
             gap_gradient,
             coords: Vector2::new(arc, self.axis.dot(y)),
             coords_gradient: [arc_gradient, self.axis],
+            gap_hessian,
+            // xi_0 is affine on a facet and constant in a wedge; xi_1 is linear
+            coords_hessian: [Matrix3::zeros(); 2],
         })
     }
 
@@ -232,10 +243,14 @@ pub(crate) mod tests {
         surface.project(y).expect("projection defined")
     }
 
-    /// Central differences of gap and (unwrapped) coordinates against the exact gradients.
+    /// Central differences of gap and (unwrapped) coordinates against the exact gradients, and
+    /// of the gradients against the exact second derivatives (relative to their size).
     pub(crate) fn check_gradients(surface: &dyn RigidSurface, y: &Vector3<f64>, tol: f64) {
         let p = project(surface, y);
         let h = 1e-7;
+        let gradients =
+            |p: &Projection| [p.gap_gradient, p.coords_gradient[0], p.coords_gradient[1]];
+        let hessians = [p.gap_hessian, p.coords_hessian[0], p.coords_hessian[1]];
         for k in 0..3 {
             let mut yp = *y;
             let mut ym = *y;
@@ -244,15 +259,20 @@ pub(crate) mod tests {
             let (pp, pm) = (project(surface, &yp), project(surface, &ym));
             let slip = slip_increment(surface, &pm.coords, &pp.coords);
             let fd = [pp.gap - pm.gap, slip[0], slip[1]].map(|d| d / (2.0 * h));
-            let exact = [
-                p.gap_gradient[k],
-                p.coords_gradient[0][k],
-                p.coords_gradient[1][k],
-            ];
+            let exact = gradients(&p).map(|g| g[k]);
             for (f, e) in fd.iter().zip(exact) {
                 assert!(
                     (f - e).abs() <= tol,
                     "at {y:?}, component {k}: finite difference {fd:?} vs exact {exact:?}"
+                );
+            }
+            for ((plus, minus), hessian) in gradients(&pp).iter().zip(gradients(&pm)).zip(&hessians)
+            {
+                let fd = (plus - minus) / (2.0 * h);
+                let exact = hessian.column(k);
+                assert!(
+                    (fd - exact).amax() <= tol * (1.0 + hessian.amax()),
+                    "at {y:?}, column {k}: finite difference {fd:?} vs exact {exact:?}"
                 );
             }
         }

@@ -3,10 +3,16 @@
 //!
 //! With body reference point `c`, unit world axis `e` and angle `theta`, `Q(theta)` is the rotation
 //! by `theta` about `e` and the body frame is `y = Q^T (x - c)`. Since `dQ/dtheta = [e]x Q` and
-//! `Q^T e = e`, `dy = Q^T dx - (e x y) dtheta`. For any surface function `f(y)` this gives
-//! `df/dx = Q (df/dy)` and `df/dtheta = -(df/dy) . (e x y)`.
+//! `Q^T e = e`, `dy = Q^T dx - (e x y) dtheta`. For any surface function `f(y)` with gradient
+//! `G = df/dy` and Hessian `F = d^2f/dy^2` this gives, with `w = e x y`,
+//! - `df/dx = Q G` and `df/dtheta = -G . w`;
+//! - `d^2f/dx^2 = Q F Q^T`, `d^2f/dx dtheta = e x (Q G) - Q F w` and
+//!   `d^2f/dtheta^2 = w . F w + G . (e x w)` (from `dw/dtheta = -e x w`).
+//!
+//! The second derivatives give the stiffness of the contact forces `r` on a curved or rotating
+//! surface, `sum_k r_k d^2 u_k` (see `skid_integrator::coupling`).
 
-use nalgebra::{Rotation3, Unit, Vector2, Vector3};
+use nalgebra::{Matrix3, Rotation3, Unit, Vector2, Vector3};
 
 use crate::surface::RigidSurface;
 
@@ -22,7 +28,7 @@ pub struct RotatingFrame {
     pub angle: f64,
 }
 
-/// Gap, convected coordinates and their exact first derivatives for one slave node.
+/// Gap, convected coordinates and their exact first and second derivatives for one slave node.
 #[derive(Clone, Debug)]
 pub struct ContactKinematics {
     /// Signed gap `g` (`> 0` open).
@@ -37,9 +43,15 @@ pub struct ContactKinematics {
     /// Derivatives of `[g, xi_0, xi_1]` with respect to the body's rotation angle `theta`:
     /// `-(df/dy) . (e x y)`.
     pub d_dangle: [f64; 3],
+    /// Second derivatives of `[g, xi_0, xi_1]` with respect to `x`: `Q F Q^T`.
+    pub d2_dx2: [Matrix3<f64>; 3],
+    /// Mixed second derivatives with respect to `x` and `theta`: `e x (Q G) - Q F w`.
+    pub d2_dx_dangle: [Vector3<f64>; 3],
+    /// Second derivatives with respect to `theta`: `w . F w + G . (e x w)`.
+    pub d2_dangle2: [f64; 3],
 }
 
-/// Evaluate gap, convected coordinates and their exact first derivatives for a node at world
+/// Evaluate gap, convected coordinates and their exact first and second derivatives for a node at world
 /// position `x` (2D problems pass `z = 0` and a `z` axis).
 ///
 /// Returns `None` if the frame is degenerate (zero or non-finite axis, non-finite centre or angle)
@@ -62,6 +74,19 @@ pub fn evaluate(
         projection.coords_gradient[0],
         projection.coords_gradient[1],
     ];
+    let hessians = [
+        projection.gap_hessian,
+        projection.coords_hessian[0],
+        projection.coords_hessian[1],
+    ];
+    let world = rotation.matrix();
+    let mut d2_dx_dangle = [Vector3::zeros(); 3];
+    let mut d2_dangle2 = [0.0; 3];
+    for (k, (g, f)) in gradients.iter().zip(&hessians).enumerate() {
+        let f_w = f * body_velocity;
+        d2_dx_dangle[k] = axis.cross(&(rotation * g)) - rotation * f_w;
+        d2_dangle2[k] = body_velocity.dot(&f_w) + g.dot(&axis.cross(&body_velocity));
+    }
     let normal_world = rotation * projection.gap_gradient;
     let normal_norm = normal_world.norm();
     let normal = if normal_norm > 0.0 {
@@ -75,6 +100,9 @@ pub fn evaluate(
         normal,
         d_dx: gradients.map(|g| rotation * g),
         d_dangle: gradients.map(|g| -g.dot(&body_velocity)),
+        d2_dx2: hessians.map(|f| world * f * world.transpose()),
+        d2_dx_dangle,
+        d2_dangle2,
     })
 }
 
@@ -163,6 +191,61 @@ mod tests {
         for (difference, derivative) in d.iter().zip(k.d_dangle) {
             assert_relative_eq!(difference / (2.0 * h), derivative, epsilon = 1e-7);
         }
+        check_second_derivatives(surface, frame, x)
+    }
+
+    /// Central differences of the first derivatives against the second ones.
+    fn check_second_derivatives(
+        surface: &dyn RigidSurface,
+        frame: &RotatingFrame,
+        x: &Vector3<f64>,
+    ) -> Result<(), ContactError> {
+        let k = eval(surface, frame, x)?;
+        let h = 1e-7;
+        let tolerance = |exact: f64| 1e-6 * (1.0 + exact.abs());
+        for j in 0..3 {
+            let mut xp = *x;
+            let mut xm = *x;
+            xp[j] += h;
+            xm[j] -= h;
+            let (plus, minus) = (eval(surface, frame, &xp)?, eval(surface, frame, &xm)?);
+            for c in 0..3 {
+                let column = (plus.d_dx[c] - minus.d_dx[c]) / (2.0 * h);
+                for i in 0..3 {
+                    let exact = k.d2_dx2[c][(i, j)];
+                    assert!(
+                        (column[i] - exact).abs() <= tolerance(exact),
+                        "d2/dx2 {c} ({i},{j}): {} vs {exact}",
+                        column[i]
+                    );
+                }
+                let mixed = (plus.d_dangle[c] - minus.d_dangle[c]) / (2.0 * h);
+                let exact = k.d2_dx_dangle[c][j];
+                assert!(
+                    (mixed - exact).abs() <= tolerance(exact),
+                    "d2/dx dtheta {c} {j}: {mixed} vs {exact}"
+                );
+            }
+        }
+        let turned = |angle: f64| eval(surface, &RotatingFrame { angle, ..*frame }, x);
+        let (plus, minus) = (turned(frame.angle + h)?, turned(frame.angle - h)?);
+        for c in 0..3 {
+            let mixed = (plus.d_dx[c] - minus.d_dx[c]) / (2.0 * h);
+            for i in 0..3 {
+                let exact = k.d2_dx_dangle[c][i];
+                assert!(
+                    (mixed[i] - exact).abs() <= tolerance(exact),
+                    "d2/dtheta dx {c} {i}: {} vs {exact}",
+                    mixed[i]
+                );
+            }
+            let second = (plus.d_dangle[c] - minus.d_dangle[c]) / (2.0 * h);
+            let exact = k.d2_dangle2[c];
+            assert!(
+                (second - exact).abs() <= tolerance(exact),
+                "d2/dtheta2 {c}: {second} vs {exact}"
+            );
+        }
         Ok(())
     }
 
@@ -185,6 +268,25 @@ mod tests {
             for x in &points {
                 check_derivatives(&drum, &frame, x)?;
             }
+        }
+        Ok(())
+    }
+
+    /// On a faceted drum the body-frame curvature vanishes on a facet but the rotation still
+    /// turns the facet under the node; in a vertex wedge the gap is curved.
+    #[test]
+    fn faceted_drum_derivatives_match_finite_differences() -> Result<(), ContactError> {
+        let drum = crate::facets::FacetedCylinder::new(0.2, Vector3::z(), 72, 0.0)?;
+        let frame = RotatingFrame {
+            center: Vector3::new(0.05, -0.1, 0.0),
+            axis: Vector3::z(),
+            angle: 0.4,
+        };
+        // in front of a facet (body angle 2.5 degrees, mid-facet) and off a vertex (0 degrees)
+        for body_angle in [2.5_f64.to_radians(), 0.0] {
+            let offset = Vector3::new(body_angle.cos(), body_angle.sin(), 0.0) * 0.203;
+            let rotation = Rotation3::from_axis_angle(&Vector3::z_axis(), frame.angle);
+            check_derivatives(&drum, &frame, &(frame.center + rotation * offset))?;
         }
         Ok(())
     }

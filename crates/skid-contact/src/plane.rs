@@ -1,13 +1,13 @@
 //! Analytical rigid plane (a line in 2D).
 
-use nalgebra::{Vector2, Vector3};
+use nalgebra::{Matrix3, Vector2, Vector3};
 
 use crate::error::ContactError;
 use crate::surface::{Projection, RigidSurface};
 
 /// The plane through the body-frame origin with outward unit normal `n`.
 ///
-/// `g = n . y`, `dg/dy = n`; convected coordinates `xi_0 = t1 . y`, `xi_1 = t2 . y` with the
+/// `g = n . y`, `dg/dy = n` (all second derivatives vanish); convected coordinates `xi_0 = t1 . y`, `xi_1 = t2 . y` with the
 /// in-plane unit vectors `t1` (given) and `t2 = n x t1`.
 #[derive(Clone, Debug)]
 pub struct RigidPlane {
@@ -51,6 +51,8 @@ impl RigidSurface for RigidPlane {
             gap_gradient: self.normal,
             coords: Vector2::new(self.t1.dot(y), self.t2.dot(y)),
             coords_gradient: [self.t1, self.t2],
+            gap_hessian: Matrix3::zeros(),
+            coords_hessian: [Matrix3::zeros(); 2],
         })
     }
 

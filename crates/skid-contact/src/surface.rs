@@ -1,7 +1,7 @@
 //! Rigid surfaces, described in the body frame of the rigid body that carries them (they are
 //! static in that frame), with closest-point projections.
 
-use nalgebra::{Vector2, Vector3};
+use nalgebra::{Matrix3, Vector2, Vector3};
 
 use crate::error::ContactError;
 
@@ -16,6 +16,10 @@ pub struct Projection {
     pub coords: Vector2<f64>,
     /// `d xi_k / dy` for `k = 0, 1`.
     pub coords_gradient: [Vector3<f64>; 2],
+    /// `d^2 g / dy^2` (symmetric; the curvature of the distance function).
+    pub gap_hessian: Matrix3<f64>,
+    /// `d^2 xi_k / dy^2` for `k = 0, 1` (symmetric).
+    pub coords_hessian: [Matrix3<f64>; 2],
 }
 
 /// A rigid surface, static in the body frame of its rigid body.
@@ -32,8 +36,9 @@ pub trait RigidSurface: Send + Sync + std::fmt::Debug {
 /// the body-frame origin.
 ///
 /// With `y_perp = y - (e.y) e`, `rho = |y_perp|`, `n = y_perp / rho` and `t = e x n`:
-/// `g = rho - R`, `dg/dy = n`; `xi_0 = R atan2(y.b2, y.b1)` (arc length, counter-clockwise about
-/// `e`), `d xi_0/dy = (R/rho) t`; `xi_1 = e.y`, `d xi_1/dy = e`.
+/// `g = rho - R`, `dg/dy = n`, `d^2g/dy^2 = t t^T / rho`; `xi_0 = R atan2(y.b2, y.b1)` (arc
+/// length, counter-clockwise about `e`), `d xi_0/dy = (R/rho) t`,
+/// `d^2 xi_0/dy^2 = -(R/rho^2) (t n^T + n t^T)`; `xi_1 = e.y`, `d xi_1/dy = e`, no curvature.
 #[derive(Clone, Debug)]
 pub struct AnalyticCylinder {
     radius: f64,
@@ -107,11 +112,17 @@ impl RigidSurface for AnalyticCylinder {
         let normal = radial / rho;
         let tangent = self.axis.cross(&normal);
         let angle = self.b2.dot(y).atan2(self.b1.dot(y));
+        let twist = tangent * normal.transpose();
         Some(Projection {
             gap: rho - self.radius,
             gap_gradient: normal,
             coords: Vector2::new(self.radius * angle, axial),
             coords_gradient: [tangent * (self.radius / rho), self.axis],
+            gap_hessian: tangent * tangent.transpose() / rho,
+            coords_hessian: [
+                -(twist + twist.transpose()) * (self.radius / (rho * rho)),
+                Matrix3::zeros(),
+            ],
         })
     }
 
@@ -172,6 +183,7 @@ mod tests {
     fn gradients_match_finite_differences_for_oblique_axis() -> Result<(), ContactError> {
         let drum = AnalyticCylinder::new(0.2, Vector3::new(0.3, -0.5, 0.8))?;
         let y = Vector3::new(0.11, 0.17, -0.05);
+        crate::facets::tests::check_gradients(&drum, &y, 1e-6);
         let p = drum
             .project(&y)
             .ok_or(ContactError::InvalidSurface("none".into()))?;

@@ -137,10 +137,12 @@ impl Triangle {
 /// Voronoi region, Ericson 2005 §5.1.5) and `N` the angle-weighted pseudo-normal of its feature
 /// (Baerentzen & Aanaes 2005), `s = sign((y - p).N)` (`+` on ties):
 /// * `g = s |y - p|` (`= n.(y - a)` in a face region), `dg/dy = s (y - p)/|y - p|` (`= n` in a
-///   face region; `N/|N|` when `|y - p| ~ 0`);
+///   face region; `N/|N|` when `|y - p| ~ 0`), `d^2g/dy^2 = s (I - dp/dy - d d^T)/|y - p|` with
+///   `d = (y - p)/|y - p|` (zero in a face region and when `|y - p| ~ 0`);
 /// * `xi = (R atan2(p.b2, p.b1), e.p)` from the [`CylinderChart`], with
 ///   `d xi/dy = (dp/dy)^T d xi/dp`, `dp/dy = I - n n^T` (face), `u u^T` (edge of direction `u`),
-///   `0` (vertex); `xi_0` has period `2 pi R`.
+///   `0` (vertex), and, `p` being affine in `y` within a region,
+///   `d^2 xi/dy^2 = (dp/dy)^T (d^2 xi/dp^2) dp/dy`; `xi_0` has period `2 pi R`.
 ///
 /// The sign is that of a closed, consistently oriented mesh; on an open mesh it is only
 /// meaningful near the surface. Equally distant features (to round-off) resolve to the face,
@@ -318,9 +320,10 @@ impl RigidSurface for TriangulatedSurface {
         let tiny = 64.0 * f64::EPSILON * (self.scale + y.norm());
         let (index, closest) = self.nearest(y, tiny)?;
         let triangle = &self.triangles[index];
-        let (gap, gap_gradient) = if closest.feature == Feature::Face {
+        let jacobian = triangle.closest_point_jacobian(closest.feature);
+        let (gap, gap_gradient, gap_hessian) = if closest.feature == Feature::Face {
             let height = triangle.normal.dot(&(y - triangle.corners[0]));
-            (height, triangle.normal)
+            (height, triangle.normal, Matrix3::zeros())
         } else {
             let offset = y - closest.point;
             let pseudo = triangle.pseudo_normal(closest.feature);
@@ -329,20 +332,24 @@ impl RigidSurface for TriangulatedSurface {
             } else {
                 -1.0
             };
-            let gradient = if closest.distance > tiny {
-                offset * (sign / closest.distance)
+            let (gradient, curvature) = if closest.distance > tiny {
+                let direction = offset / closest.distance;
+                let across = Matrix3::identity() - jacobian - direction * direction.transpose();
+                (direction * sign, across * (sign / closest.distance))
             } else {
-                pseudo.try_normalize(0.0).unwrap_or(triangle.normal)
+                let normal = pseudo.try_normalize(0.0).unwrap_or(triangle.normal);
+                (normal, Matrix3::zeros())
             };
-            (sign * closest.distance, gradient)
+            (sign * closest.distance, gradient, curvature)
         };
         let chart = self.chart.project(&closest.point)?;
-        let jacobian = triangle.closest_point_jacobian(closest.feature);
         Some(Projection {
             gap,
             gap_gradient,
             coords: chart.coords,
             coords_gradient: chart.coords_gradient.map(|g| jacobian * g),
+            gap_hessian,
+            coords_hessian: chart.coords_hessian.map(|h| jacobian * h * jacobian),
         })
     }
 

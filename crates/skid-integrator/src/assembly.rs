@@ -11,6 +11,7 @@ use skid_fem::error::FemError;
 use skid_fem::pressure::pressure_face_forces;
 use skid_fem::solid::{ElementResponse, Tangent};
 
+use crate::coupling::{ContactRows, contact_coordinates};
 use crate::error::{IncrementFailure, ModelError};
 use crate::mixed::MixedPressures;
 use crate::model::Model;
@@ -45,6 +46,9 @@ pub struct InternalState {
 pub struct Assembler {
     pattern: SparsePattern,
     scatter: Vec<ElementScatter>,
+    /// Per contact candidate (pairs in order, then their nodes), where its local coordinates'
+    /// stiffness goes (see [`crate::coupling::contact_coordinates`]).
+    contact_scatter: Vec<ElementScatter>,
     diagonal: Vec<usize>,
     slot_position: Vec<(usize, usize)>,
     values: Vec<f64>,
@@ -65,10 +69,7 @@ impl Assembler {
             slot_position.push((i.max(j), i.min(j)));
             builder.push(i, j)
         };
-        let mut scatter = Vec::with_capacity(model.elements().len());
-        for conn in &model.part().mesh.elements {
-            let eqs: Vec<Option<usize>> =
-                conn.iter().flat_map(|&n| *model.dofs().node(n)).collect();
+        let mut scatter_of = |eqs: Vec<Option<usize>>| {
             let mut entries = Vec::new();
             for (p, ep) in eqs.iter().enumerate() {
                 for (q, eq) in eqs.iter().enumerate() {
@@ -79,8 +80,22 @@ impl Assembler {
                     }
                 }
             }
-            scatter.push(ElementScatter { eqs, entries });
-        }
+            ElementScatter { eqs, entries }
+        };
+        let scatter = model
+            .part()
+            .mesh
+            .elements
+            .iter()
+            .map(|conn| scatter_of(conn.iter().flat_map(|&n| *model.dofs().node(n)).collect()))
+            .collect();
+        let contact_scatter = model
+            .contacts()
+            .iter()
+            .enumerate()
+            .flat_map(|(p, pair)| pair.nodes.iter().map(move |&node| (p, node)))
+            .map(|(p, node)| scatter_of(contact_coordinates(model, p, node)))
+            .collect();
         let n = model.dofs().len();
         let diagonal = (0..n).map(|i| push(&mut builder, i, i)).collect();
         let pattern = SparsePattern::new(n, builder, &[]).map_err(ModelError::Invalid)?;
@@ -88,6 +103,7 @@ impl Assembler {
         Ok(Self {
             pattern,
             scatter,
+            contact_scatter,
             diagonal,
             slot_position,
             values,
@@ -188,6 +204,17 @@ impl Assembler {
     /// predicts the element pressures the next tangent uses; see [`crate::mixed`].
     pub fn advance_mixed_pressures<const D: usize>(&mut self, model: &Model<D>, dx: &DVector<f64>) {
         self.mixed.advance(model, dx);
+    }
+
+    /// Adds the geometric stiffness of the contact forces `r` (one per contact row) to the
+    /// effective tangent: [`ContactRows::curvature_stiffness`] of every candidate.
+    pub fn add_contact_curvature(&mut self, rows: &ContactRows, r: &DVector<f64>) {
+        for (c, scatter) in self.contact_scatter.iter().enumerate().take(rows.len()) {
+            let k = rows.curvature_stiffness(c, r);
+            for &(p, q, slot) in &scatter.entries {
+                self.values[slot] += k[(p, q)];
+            }
+        }
     }
 
     /// Adds `d_i` to each diagonal entry of the effective tangent (mass terms).
@@ -323,7 +350,7 @@ mod tests {
 
     impl Assembler {
         /// The stored lower triangle expanded to a dense symmetric matrix.
-        fn dense(&self, n: usize) -> DMatrix<f64> {
+        pub(crate) fn dense(&self, n: usize) -> DMatrix<f64> {
             let mut k = DMatrix::zeros(n, n);
             for (slot, &(i, j)) in self.slot_position.iter().enumerate() {
                 k[(i, j)] += self.values[slot];

@@ -24,7 +24,7 @@
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 use skid_contact::coulomb::{CoulombSettings, CoulombSolution, FrictionProblem, solve_coulomb};
 use skid_contact::error::ContactError;
-use skid_contact::kinematics::{RotatingFrame, evaluate, slip_increment};
+use skid_contact::kinematics::{ContactKinematics, RotatingFrame, evaluate, slip_increment};
 
 use crate::error::IncrementFailure;
 use skid_fem::cell::embed;
@@ -49,6 +49,10 @@ pub struct ContactRows {
     pub coords: Vec<Vector2<f64>>,
     /// Friction coefficient per contact.
     pub mu: Vec<f64>,
+    /// Per row, the second derivatives of its `u` in the candidate's local coordinates
+    /// `z = (node position [D], body translation [D], body angle)` (see [`contact_coordinates`]),
+    /// a symmetric `(2D + 1)^2` matrix.
+    pub curvature: Vec<DMatrix<f64>>,
 }
 
 impl ContactRows {
@@ -71,6 +75,24 @@ impl ContactRows {
             }
         }
         f
+    }
+
+    /// The stiffness of the contact forces `r` of candidate `c` on its local coordinates:
+    /// `-sum_k r_k d^2 u_k / dz^2` over the candidate's rows. The force on the equations is
+    /// `H^T r`, so the residual `R - H^T r` has the derivative `K - H^T dr/dx - sum_k r_k
+    /// d^2 u_k/dx^2`; this is the last term, the geometric stiffness of contact on a curved or
+    /// rotating surface (a normal force on a convex drum softens the tangential motion by
+    /// `r_N / rho`).
+    pub fn curvature_stiffness(&self, c: usize, r: &DVector<f64>) -> DMatrix<f64> {
+        let d = self.components;
+        let mut k = DMatrix::<f64>::zeros(2 * d + 1, 2 * d + 1);
+        for row in c * d..(c + 1) * d {
+            let force = r.get(row).copied().unwrap_or(0.0);
+            if force != 0.0 {
+                k -= &self.curvature[row] * force;
+            }
+        }
+        k
     }
 
     /// `H dx`.
@@ -361,6 +383,7 @@ pub fn contact_rows<const D: usize>(
         u: DVector::zeros(0),
         coords: Vec::new(),
         mu: Vec::new(),
+        curvature: Vec::new(),
     };
     let mut u = Vec::new();
     let mut k = 0;
@@ -396,6 +419,7 @@ pub fn contact_rows<const D: usize>(
                 }
                 add(dofs.body_rotation(pair.body), kin.d_dangle[comp]);
                 out.rows.push(row);
+                out.curvature.push(local_curvature::<D>(&kin, comp));
                 u.push(if comp == 0 { kin.gap } else { slip[comp - 1] });
             }
             out.coords.push(kin.coords);
@@ -405,6 +429,40 @@ pub fn contact_rows<const D: usize>(
     }
     out.u = DVector::from_vec(u);
     Ok(out)
+}
+
+/// The equations of a candidate's local coordinates `z = (node position [D], body translation
+/// [D], body angle)`, `None` where fixed: the order of [`ContactRows::curvature`].
+pub fn contact_coordinates<const D: usize>(
+    model: &Model<D>,
+    pair: usize,
+    node: usize,
+) -> Vec<Option<usize>> {
+    let dofs = model.dofs();
+    let body = model.contacts()[pair].body;
+    dofs.node(node)
+        .iter()
+        .chain(dofs.body_translation(body))
+        .copied()
+        .chain([dofs.body_rotation(body)])
+        .collect()
+}
+
+/// Second derivatives of component `comp` of `u` in the local coordinates of
+/// [`contact_coordinates`]. The node position `x` and the body translation `c` enter only as
+/// `x - c`, so with `A = d^2u/dx^2`, `b = d^2u/dx dtheta` and `s = d^2u/dtheta^2`:
+/// `[[A, -A, b], [-A, A, -b], [b^T, -b^T, s]]`.
+fn local_curvature<const D: usize>(kin: &ContactKinematics, comp: usize) -> DMatrix<f64> {
+    let a = &kin.d2_dx2[comp];
+    let b = &kin.d2_dx_dangle[comp];
+    let m = 2 * D + 1;
+    let sign = |i: usize| if i < D { 1.0 } else { -1.0 };
+    DMatrix::from_fn(m, m, |i, j| match (i, j) {
+        (i, j) if i == 2 * D && j == 2 * D => kin.d2_dangle2[comp],
+        (i, j) if i == 2 * D => sign(j) * b[j % D],
+        (i, j) if j == 2 * D => sign(i) * b[i % D],
+        (i, j) => sign(i) * sign(j) * a[(i % D, j % D)],
+    })
 }
 
 #[cfg(test)]
@@ -605,6 +663,68 @@ mod tests {
         );
         assert!((&local.r - &all.r).amax() < 1e-6 * all.r.amax());
         assert!(local.u.iter().step_by(D).all(|&g| g > -1e-9));
+    }
+
+    /// With the contact forces `r` held fixed, the tangent `K_T` plus the contact curvature
+    /// stiffness is the derivative of `f_int(x) - H(x)^T r`: node, drum translation and drum
+    /// rotation coupled through the curved, rotating surface.
+    fn contact_curvature_completes_the_tangent<const D: usize>() {
+        let n = block_on_drum::<D>().dofs().len();
+        // the block pressed 1 mm into the drum, sheared, the drum turned and shifted
+        let x = DVector::from_fn(n, |i, _| 1e-3 * ((i as f64 * 1.3).sin() - 0.5));
+        let (model, mut assembler) = assembled::<D>(&x);
+        let held = vec![false; n];
+        let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
+        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let r = DVector::from_fn(rows.rows.len(), |k, _| {
+            if k % D == 0 {
+                700.0 + 10.0 * k as f64
+            } else {
+                -80.0 + 3.0 * k as f64
+            }
+        });
+        assembler.internal(&model, &x, Some(1.0)).expect("internal");
+        let without = assembler.dense(n);
+        assembler.add_contact_curvature(&rows, &r);
+        let k = assembler.dense(n);
+        let residual = |assembler: &mut Assembler, x: &DVector<f64>| {
+            let rows = contact_rows(&model, x, &start, &held).expect("rows");
+            assembler.internal(&model, x, None).expect("internal").force
+                - rows.transpose_times(&r, n)
+        };
+        let eps = 1e-7;
+        let mut worst: f64 = 0.0;
+        let mut worst_without: f64 = 0.0;
+        for j in 0..n {
+            let mut xp = x.clone();
+            let mut xm = x.clone();
+            xp[j] += eps;
+            xm[j] -= eps;
+            let column =
+                (residual(&mut assembler, &xp) - residual(&mut assembler, &xm)) / (2.0 * eps);
+            worst = worst.max((&column - k.column(j)).amax());
+            worst_without = worst_without.max((&column - without.column(j)).amax());
+        }
+        assert!(
+            worst < 1e-6 * k.amax(),
+            "{D}D: worst {worst:e} vs {:e}",
+            k.amax()
+        );
+        // the curvature term is not negligible here: without it the tangent is visibly wrong
+        assert!(
+            worst_without > 1e3 * worst,
+            "{D}D: {worst_without:e} vs {worst:e}"
+        );
+    }
+
+    #[test]
+    fn contact_curvature_completes_the_tangent_2d() {
+        contact_curvature_completes_the_tangent::<2>();
+    }
+
+    #[test]
+    fn contact_curvature_completes_the_tangent_3d() {
+        contact_curvature_completes_the_tangent::<3>();
     }
 
     #[test]

@@ -165,6 +165,7 @@ pub fn solve_increment<const D: usize>(
         };
         assembler.add_diagonal(&(mass * m_factor));
         let rows = contact_rows(model, &x, &previous_coords, held)?;
+        assembler.add_contact_curvature(&rows, &warm);
         for (eq, &h) in held.iter().enumerate() {
             if h {
                 residual[eq] = 0.0;
