@@ -2,7 +2,8 @@
 # The drum validation: builds skid (release); runs every drum idealization of cases/drum and
 # every hard case of cases/hard in parallel, and the convergence study (scripts/convergence.sh);
 # writes the report validation/report.md (benchmark, hard cases, convergence) with its plots;
-# and checks the 2D benchmark's convergence in time step and insensitivity to the pad density.
+# and checks the 2D benchmark's convergence in time step, its insensitivity to the pad density,
+# and that the conic (clarabel) Coulomb solve gives the run of the default Newton-first one.
 # Results go to out/. Exit status 0 only if every run completed and every check passed.
 #
 # HARD_CASES: the hard case files or directories to run instead of cases/hard (words, globs
@@ -33,5 +34,6 @@ run() { # name case [overrides...]
 run 2d-analytic cases/drum/2d-analytic.json
 run 2d-analytic-dt-half cases/drum/2d-analytic.json 'steps[1].dt=5e-5'
 run 2d-analytic-density-x2 cases/drum/2d-analytic.json 'pad.density=2000'
+run 2d-analytic-conic cases/drum/2d-analytic.json 'solver.coulomb_method="conic"'
 python3 scripts/check_drum.py "$out" || status=1
 exit $status

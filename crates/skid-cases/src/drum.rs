@@ -198,6 +198,7 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
         coulomb: skid_contact::coulomb::CoulombSettings {
             tolerance: s.coulomb_tolerance,
             max_fixed_point_iterations: s.max_fixed_point_iterations,
+            method: s.coulomb_method.into(),
             ..Default::default()
         },
         cutback: CutbackSettings {

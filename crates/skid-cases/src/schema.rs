@@ -262,6 +262,8 @@ pub struct SolverSpec {
     pub coulomb_tolerance: f64,
     /// Fixed-point iteration limit of the Coulomb solve.
     pub max_fixed_point_iterations: usize,
+    /// Which algorithm leads the Coulomb solve.
+    pub coulomb_method: CoulombMethodSpec,
     /// Increment size factor after a failure.
     pub cutback_factor: f64,
     /// Consecutive cutbacks before the run stops.
@@ -279,8 +281,30 @@ impl Default for SolverSpec {
             contact_tolerance: newton.contact_tolerance,
             coulomb_tolerance: coulomb.tolerance,
             max_fixed_point_iterations: coulomb.max_fixed_point_iterations,
+            coulomb_method: CoulombMethodSpec::default(),
             cutback_factor: cutback.factor,
             max_cutbacks: cutback.max_cutbacks,
+        }
+    }
+}
+
+/// Which algorithm leads the exact Coulomb solve of every Newton iteration (see
+/// `skid_contact::coulomb::CoulombMethod`).
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum CoulombMethodSpec {
+    /// Semismooth Newton from the last forces, the conic (clarabel) fixed point where it fails.
+    #[default]
+    NewtonFirst,
+    /// The conic (clarabel) fixed point every time: slower, an independent check.
+    Conic,
+}
+
+impl From<CoulombMethodSpec> for skid_contact::coulomb::CoulombMethod {
+    fn from(spec: CoulombMethodSpec) -> Self {
+        match spec {
+            CoulombMethodSpec::NewtonFirst => Self::NewtonFirst,
+            CoulombMethodSpec::Conic => Self::Conic,
         }
     }
 }

@@ -56,6 +56,20 @@ pub struct CoulombSettings {
     pub conic_tolerance: f64,
     /// Clarabel's interior-point iteration limit. Default 100.
     pub conic_max_iterations: u32,
+    /// Which algorithm leads. Default [`CoulombMethod::NewtonFirst`].
+    pub method: CoulombMethod,
+}
+
+/// How [`solve_coulomb`] reaches the exact Coulomb law.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CoulombMethod {
+    /// Semismooth Newton from the warm start; the conic fixed point only where it fails.
+    #[default]
+    NewtonFirst,
+    /// The conic (clarabel) fixed point from the start: clarabel decides the active set every
+    /// time, each iterate refined as described in [`solve_coulomb`]. Slower; an independent
+    /// check of the Newton path.
+    Conic,
 }
 
 impl Default for CoulombSettings {
@@ -65,6 +79,7 @@ impl Default for CoulombSettings {
             max_fixed_point_iterations: 50,
             conic_tolerance: 1e-10,
             conic_max_iterations: 100,
+            method: CoulombMethod::NewtonFirst,
         }
     }
 }
@@ -104,7 +119,8 @@ pub struct CoulombSolution {
 }
 
 /// Solve the exact Coulomb problem: semismooth Newton from `initial_forces`, then, if that does
-/// not reach `settings.tolerance`, the fixed point on the De Saxcé shift.
+/// not reach `settings.tolerance`, the fixed point on the De Saxcé shift
+/// ([`CoulombMethod::NewtonFirst`]); or the fixed point alone ([`CoulombMethod::Conic`]).
 ///
 /// `initial_forces` (length `m`, finite, e.g. the forces `r` of the previous solve) start the
 /// Newton iteration; without them it starts from `r = 0`. The fixed point starts from the shift
@@ -141,7 +157,9 @@ pub fn solve_coulomb(
         check_forces(forces, problem.q.len())?;
     }
     let dim = problem.dim;
-    if problem.q.iter().step_by(dim).all(|&q_n| q_n >= 0.0) {
+    if settings.method == CoulombMethod::Conic
+        || problem.q.iter().step_by(dim).all(|&q_n| q_n >= 0.0)
+    {
         return solve_fixed_point(problem, settings, None, true);
     }
     let w = symmetric_part(problem.w);

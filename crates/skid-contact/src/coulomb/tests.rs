@@ -581,8 +581,8 @@ proptest! {
         ..ProptestConfig::default()
     })]
 
-    /// Semismooth Newton (from `r = 0`) and the conic fixed point find the same forces on random
-    /// coupled instances, both satisfying the exact law; warm-started with the solution, Newton
+    /// Semismooth Newton (from `r = 0`) and the conic fixed point ([`CoulombMethod::Conic`])
+    /// find the same forces on random coupled instances, both satisfying the exact law; warm-started with the solution, Newton
     /// confirms it without a conic solve in at most one step.
     #[test]
     fn newton_and_conic_fixed_point_agree(
@@ -601,8 +601,12 @@ proptest! {
         let mu: Vec<f64> = (0..n).map(|_| rng.uniform(0.0, mu_max)).collect();
         let problem = FrictionProblem { dim, w: &w, q: &q, mu: &mu };
         let newton = solve_coulomb(&problem, &tight(), None);
-        let conic = solve_fixed_point(&problem, &tight(), None, true);
+        let conic_settings = CoulombSettings { method: CoulombMethod::Conic, ..tight() };
+        let conic = solve_coulomb(&problem, &conic_settings, Some(&DVector::zeros(dim * n)));
         prop_assert!(newton.is_ok() && conic.is_ok(), "{:?} {:?}", newton, conic);
+        if let Ok(conic) = &conic && q.iter().step_by(dim).any(|&q_n| q_n < 0.0) {
+            prop_assert!(conic.conic_solves > 0, "the conic method always asks clarabel");
+        }
         let (Ok(newton), Ok(conic)) = (newton, conic) else { return Ok(()) };
         check_coulomb_law(dim, &mu, &newton, 1e3, 1e-3);
         check_coulomb_law(dim, &mu, &conic, 1e3, 1e-3);
