@@ -78,6 +78,31 @@ pub fn evaluate(
     })
 }
 
+/// World-frame discrete gradient of the gap over an increment (see
+/// [`RigidSurface::gap_discrete_gradient`]) for a node now at world position `x` that started
+/// the increment at `start_offset = x_start - c_start` from the body reference point: the start
+/// point is taken into the current body frame, which the surface's rotation invariance allows.
+/// Then `G . ((x - c) - start_offset)` is exactly the change of the gap over the increment.
+///
+/// `None` if the frame is degenerate or the surface offers no discrete gradient.
+pub fn gap_discrete_gradient(
+    surface: &dyn RigidSurface,
+    frame: &RotatingFrame,
+    start_offset: &Vector3<f64>,
+    x: &Vector3<f64>,
+) -> Option<Vector3<f64>> {
+    if !(frame.angle.is_finite() && frame.center.iter().all(|c| c.is_finite())) {
+        return None;
+    }
+    let axis = Unit::try_new(frame.axis, 0.0).filter(|a| a.iter().all(|c| c.is_finite()))?;
+    let rotation = Rotation3::from_axis_angle(&axis, frame.angle);
+    let y_end = rotation.inverse_transform_vector(&(x - frame.center));
+    let y_start = rotation.inverse_transform_vector(start_offset);
+    surface
+        .gap_discrete_gradient(&y_start, &y_end, &axis)
+        .map(|g| rotation * g)
+}
+
 /// Slip increment `current - previous` between two convected-coordinate states, each periodic
 /// component unwrapped with its surface period `p` into `(-p/2, p/2]`.
 pub fn slip_increment(

@@ -24,7 +24,7 @@
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 use skid_contact::coulomb::{CoulombSettings, CoulombSolution, FrictionProblem, solve_coulomb};
 use skid_contact::error::ContactError;
-use skid_contact::kinematics::{RotatingFrame, evaluate, slip_increment};
+use skid_contact::kinematics::{RotatingFrame, evaluate, gap_discrete_gradient, slip_increment};
 
 use crate::error::IncrementFailure;
 use skid_fem::cell::embed;
@@ -345,11 +345,21 @@ pub fn solve_contact_forces(
 /// coordinates at the start of the increment (one per candidate, pair by pair); `held` marks
 /// equations whose increment is zero in this step (their columns are dropped).
 ///
+/// `start` is the displacement at the start of the increment (`None` for rows at the start
+/// itself). Against a surface with a discrete gap gradient (the analytical circle and cylinder,
+/// see [`skid_contact::RigidSurface::gap_discrete_gradient`]) the normal row is that gradient
+/// between the start and current positions instead of the current normal: the contact force
+/// acts along it, so its work over the increment, `p_N H_N dx`, is exactly `p_N dg` (zero for a
+/// node sliding along the drum at zero gap). With the current normal a loaded node moving `ds`
+/// along the circle of radius R gains `p_N ds^2 / (2 R)` per increment. `u` stays the exact gap,
+/// so a converged increment satisfies the contact law exactly either way.
+///
 /// # Errors
 /// [`IncrementFailure::NoProjection`] if a node has no projection on its master surface.
 pub fn contact_rows<const D: usize>(
     model: &Model<D>,
     x: &DVector<f64>,
+    start: Option<&DVector<f64>>,
     previous: &[Vector2<f64>],
     held: &[bool],
 ) -> Result<ContactRows, IncrementFailure> {
@@ -371,10 +381,21 @@ pub fn contact_rows<const D: usize>(
             axis: body.rotation_axis.unwrap_or_else(Vector3::z),
             angle: dofs.body_angle(x, pair.body),
         };
+        let start_center =
+            start.map(|x0| embed(&(body.reference_point + dofs.body_displacement(x0, pair.body))));
         for &node in &pair.nodes {
             let pos = model.node_position(x, node);
-            let kin = evaluate(pair.surface.as_ref(), &frame, &pos)
+            let mut kin = evaluate(pair.surface.as_ref(), &frame, &pos)
                 .ok_or(IncrementFailure::NoProjection { pair: p, node })?;
+            if let (Some(x0), Some(c0)) = (start, start_center) {
+                let offset = model.node_position(x0, node) - c0;
+                if let Some(g) = gap_discrete_gradient(pair.surface.as_ref(), &frame, &offset, &pos)
+                {
+                    // the surface is invariant under the body's rotation: no angle term
+                    kin.d_dx[0] = g;
+                    kin.d_dangle[0] = 0.0;
+                }
+            }
             let slip = slip_increment(pair.surface.as_ref(), &previous[k], &kin.coords);
             for comp in 0..components {
                 let mut row: Vec<(usize, f64)> = Vec::with_capacity(2 * D + 1);
@@ -439,11 +460,11 @@ mod tests {
         let held = vec![false; n];
         let x = DVector::from_fn(n, |i, _| 1e-3 * (i as f64 * 0.9).sin());
         let start: Vec<Vector2<f64>> = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
         let previous = rows.coords.clone();
         let dx = DVector::from_fn(n, |i, _| 1e-7 * (i as f64 * 2.3).cos());
-        let plus = contact_rows(&model, &(&x + &dx), &previous, &held).expect("rows");
-        let minus = contact_rows(&model, &(&x - &dx), &previous, &held).expect("rows");
+        let plus = contact_rows(&model, &(&x + &dx), None, &previous, &held).expect("rows");
+        let minus = contact_rows(&model, &(&x - &dx), None, &previous, &held).expect("rows");
         let predicted = rows.times(&dx);
         let measured = (&plus.u - &minus.u) / 2.0;
         assert!(
@@ -462,7 +483,7 @@ mod tests {
         for &eq in &drum_eqs {
             held[eq] = true;
         }
-        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
         assert!(
             rows.rows
                 .iter()
@@ -527,7 +548,7 @@ mod tests {
         let (model, mut assembler) = assembled::<D>(&x);
         let held = vec![false; n];
         let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
         let subset: Vec<usize> = (0..rows.len()).step_by(2).collect();
         assembler
             .eliminate_last(&rows.equations(&subset))
@@ -562,7 +583,7 @@ mod tests {
         let (model, mut assembler) = assembled::<D>(&x);
         let held = vec![false; n];
         let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
         // the drum is held by its mass term; every pad node is pushed down by 1 cm
         let mut residual = DVector::zeros(n);
         for node in 0..model.part().mesh.nodes.len() {

@@ -164,7 +164,7 @@ pub fn solve_increment<const D: usize>(
             }
         };
         assembler.add_diagonal(&(mass * m_factor));
-        let rows = contact_rows(model, &x, &previous_coords, held)?;
+        let rows = contact_rows(model, &x, Some(&start.x), &previous_coords, held)?;
         for (eq, &h) in held.iter().enumerate() {
             if h {
                 residual[eq] = 0.0;
