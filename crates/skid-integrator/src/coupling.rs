@@ -345,8 +345,8 @@ pub fn solve_contact_forces(
 /// coordinates at the start of the increment (one per candidate, pair by pair); `held` marks
 /// equations whose increment is zero in this step (their columns are dropped).
 ///
-/// `start` is the displacement at the start of the increment (`None` for rows at the start
-/// itself). Against a surface with a discrete gap gradient (the analytical circle and cylinder,
+/// `start` is the displacement at the start of a dynamic increment (`None` for rows at the
+/// start itself and for static equilibrium, which needs the normal at the solution). Against a surface with a discrete gap gradient (the analytical circle and cylinder,
 /// see [`skid_contact::RigidSurface::gap_discrete_gradient`]) the normal row is that gradient
 /// between the start and current positions instead of the current normal: the contact force
 /// acts along it, so its work over the increment, `p_N H_N dx`, is exactly `p_N dg` (zero for a
