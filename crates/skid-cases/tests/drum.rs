@@ -76,6 +76,25 @@ fn drum_spins_down_in_a_straight_line_and_rocks_in_stick_after_the_stop() {
     assert_eq!(written["t_stop"].as_f64(), Some(t_stop));
 }
 
+/// Under ten times the pressure, friction switched on at full speed sets the pad's contact
+/// nodes sliding back and forth along the drum by about a millimetre per increment under some
+/// 5 kN each. The contact force must do no work on that motion beyond `p_N dg`: along the
+/// end-of-increment normal it did `p_N ds^2 / (2 R)` per node and increment, 3.5 J created in
+/// these 4 ms (first order in the time step). Without numerical dissipation (alpha = 0) what is
+/// left is the trapezoidal rule's error, about 0.15 J.
+#[test]
+fn normal_contact_forces_do_no_work_on_nodes_sliding_along_the_drum() {
+    let (s, _dir) = run(&[
+        "back_plate.pressure=3.5e6",
+        "pad.hourglass_scale=3",
+        "steps[1].alpha=0",
+        "steps[1].duration=0.004",
+    ]);
+    assert_eq!(s.status, "completed", "{:?}", s.error);
+    let residual = s.energy_balance_residual_j.expect("residual");
+    assert!(residual.abs() < 0.5, "energy residual {residual} J");
+}
+
 #[test]
 fn without_friction_the_drum_keeps_its_speed() {
     let (s, dir) = run(&["contact.mu=0", "steps[1].duration=0.01"]);
@@ -134,8 +153,10 @@ fn tetrahedral_drum_and_general_contact_agree_with_the_3d_analytic_pair() {
 /// stiffness of the contact forces on the curved drum: Newton converges quadratically only
 /// because that term is in its matrix. Read from `newton.csv`: each force residual below 0.1
 /// is followed by one below its square (`e_k+1 <= C e_k^2` with `C = 1`; measured `C` up to
-/// 0.42, while the linear rate 0.05 that the matrix without the term gave means `C ~ 500` at
-/// `e_k = 1e-4`), wherever the next one is above round-off.
+/// 0.55, while the linear rate 0.05 that the matrix without the term gave means `C ~ 500` at
+/// `e_k = 1e-4`), wherever the next one is above 1e-9, the accuracy of the contact forces
+/// (below it an iteration taken for the contact residual, which converges linearly with the
+/// secant normal rows, lands on round-off).
 #[test]
 fn large_steps_converge_quadratically() {
     let (s, dir) = run(&["steps[1].dt=1.6e-3", "steps[1].duration=0.02"]);
@@ -153,7 +174,7 @@ fn large_steps_converge_quadratically() {
     let constants: Vec<f64> = histories
         .values()
         .flat_map(|history| history.windows(2))
-        .filter(|e| e[0] < 0.1 && e[1] > 1e-12)
+        .filter(|e| e[0] < 0.1 && e[1] > 1e-9)
         .map(|e| e[1] / (e[0] * e[0]))
         .collect();
     assert!(constants.len() >= 10, "too few iterations: {histories:?}");

@@ -14,7 +14,7 @@
 
 use nalgebra::{Matrix3, Rotation3, Unit, Vector2, Vector3};
 
-use crate::surface::RigidSurface;
+use crate::surface::{DiscreteGradient, RigidSurface};
 
 /// Placement of a rigid body rotating about a fixed axis.
 #[derive(Clone, Copy, Debug)]
@@ -104,6 +104,38 @@ pub fn evaluate(
         d2_dx_dangle,
         d2_dangle2,
     })
+}
+
+/// World-frame discrete gradient of the gap over an increment (see
+/// [`RigidSurface::gap_discrete_gradient`]) for a node now at world position `x` that started
+/// the increment at `start_offset = x_start - c_start` from the body reference point: the start
+/// point is taken into the current body frame, which the surface's rotation invariance allows.
+/// Then `G . ((x - c) - start_offset)` is exactly the change of the gap over the increment.
+///
+/// Its Jacobian (in `x`, rotated to the world frame alike) is independent of the body's angle
+/// for the same reason.
+///
+/// `None` if the frame is degenerate or the surface offers no discrete gradient.
+pub fn gap_discrete_gradient(
+    surface: &dyn RigidSurface,
+    frame: &RotatingFrame,
+    start_offset: &Vector3<f64>,
+    x: &Vector3<f64>,
+) -> Option<DiscreteGradient> {
+    if !(frame.angle.is_finite() && frame.center.iter().all(|c| c.is_finite())) {
+        return None;
+    }
+    let axis = Unit::try_new(frame.axis, 0.0).filter(|a| a.iter().all(|c| c.is_finite()))?;
+    let rotation = Rotation3::from_axis_angle(&axis, frame.angle);
+    let y_end = rotation.inverse_transform_vector(&(x - frame.center));
+    let y_start = rotation.inverse_transform_vector(start_offset);
+    let world = rotation.matrix();
+    surface
+        .gap_discrete_gradient(&y_start, &y_end, &axis)
+        .map(|g| DiscreteGradient {
+            gradient: rotation * g.gradient,
+            jacobian: world * g.jacobian * world.transpose(),
+        })
 }
 
 /// Slip increment `current - previous` between two convected-coordinate states, each periodic

@@ -27,7 +27,9 @@ pub use coulomb::{
 };
 pub use error::ContactError;
 pub use facets::FacetedCylinder;
-pub use kinematics::{ContactKinematics, RotatingFrame, evaluate, slip_increment};
+pub use kinematics::{
+    ContactKinematics, RotatingFrame, evaluate, gap_discrete_gradient, slip_increment,
+};
 pub use plane::RigidPlane;
-pub use surface::{AnalyticCylinder, Projection, RigidSurface};
+pub use surface::{AnalyticCylinder, DiscreteGradient, Projection, RigidSurface};
 pub use triangles::{CylinderChart, TriangulatedSurface};

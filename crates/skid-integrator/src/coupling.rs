@@ -24,7 +24,9 @@
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 use skid_contact::coulomb::{CoulombSettings, CoulombSolution, FrictionProblem, solve_coulomb};
 use skid_contact::error::ContactError;
-use skid_contact::kinematics::{ContactKinematics, RotatingFrame, evaluate, slip_increment};
+use skid_contact::kinematics::{
+    ContactKinematics, RotatingFrame, evaluate, gap_discrete_gradient, slip_increment,
+};
 
 use crate::error::IncrementFailure;
 use skid_fem::cell::embed;
@@ -367,11 +369,21 @@ pub fn solve_contact_forces(
 /// coordinates at the start of the increment (one per candidate, pair by pair); `held` marks
 /// equations whose increment is zero in this step (their columns are dropped).
 ///
+/// `start` is the displacement at the start of a dynamic increment (`None` for rows at the
+/// start itself and for static equilibrium, which needs the normal at the solution). Against a surface with a discrete gap gradient (the analytical circle and cylinder,
+/// see [`skid_contact::RigidSurface::gap_discrete_gradient`]) the normal row is that gradient
+/// between the start and current positions instead of the current normal: the contact force
+/// acts along it, so its work over the increment, `p_N H_N dx`, is exactly `p_N dg` (zero for a
+/// node sliding along the drum at zero gap). With the current normal a loaded node moving `ds`
+/// along the circle of radius R gains `p_N ds^2 / (2 R)` per increment. `u` stays the exact gap,
+/// so a converged increment satisfies the contact law exactly either way.
+///
 /// # Errors
 /// [`IncrementFailure::NoProjection`] if a node has no projection on its master surface.
 pub fn contact_rows<const D: usize>(
     model: &Model<D>,
     x: &DVector<f64>,
+    start: Option<&DVector<f64>>,
     previous: &[Vector2<f64>],
     held: &[bool],
 ) -> Result<ContactRows, IncrementFailure> {
@@ -394,10 +406,25 @@ pub fn contact_rows<const D: usize>(
             axis: body.rotation_axis.unwrap_or_else(Vector3::z),
             angle: dofs.body_angle(x, pair.body),
         };
+        let start_center =
+            start.map(|x0| embed(&(body.reference_point + dofs.body_displacement(x0, pair.body))));
         for &node in &pair.nodes {
             let pos = model.node_position(x, node);
-            let kin = evaluate(pair.surface.as_ref(), &frame, &pos)
+            let mut kin = evaluate(pair.surface.as_ref(), &frame, &pos)
                 .ok_or(IncrementFailure::NoProjection { pair: p, node })?;
+            if let (Some(x0), Some(c0)) = (start, start_center) {
+                let offset = model.node_position(x0, node) - c0;
+                if let Some(secant) =
+                    gap_discrete_gradient(pair.surface.as_ref(), &frame, &offset, &pos)
+                {
+                    // the surface is invariant under the body's rotation: no angle terms
+                    kin.d_dx[0] = secant.gradient;
+                    kin.d_dangle[0] = 0.0;
+                    kin.d2_dx2[0] = secant.jacobian;
+                    kin.d2_dx_dangle[0] = Vector3::zeros();
+                    kin.d2_dangle2[0] = 0.0;
+                }
+            }
             let slip = slip_increment(pair.surface.as_ref(), &previous[k], &kin.coords);
             for comp in 0..components {
                 let mut row: Vec<(usize, f64)> = Vec::with_capacity(2 * D + 1);
@@ -497,11 +524,11 @@ mod tests {
         let held = vec![false; n];
         let x = DVector::from_fn(n, |i, _| 1e-3 * (i as f64 * 0.9).sin());
         let start: Vec<Vector2<f64>> = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
         let previous = rows.coords.clone();
         let dx = DVector::from_fn(n, |i, _| 1e-7 * (i as f64 * 2.3).cos());
-        let plus = contact_rows(&model, &(&x + &dx), &previous, &held).expect("rows");
-        let minus = contact_rows(&model, &(&x - &dx), &previous, &held).expect("rows");
+        let plus = contact_rows(&model, &(&x + &dx), None, &previous, &held).expect("rows");
+        let minus = contact_rows(&model, &(&x - &dx), None, &previous, &held).expect("rows");
         let predicted = rows.times(&dx);
         let measured = (&plus.u - &minus.u) / 2.0;
         assert!(
@@ -520,7 +547,7 @@ mod tests {
         for &eq in &drum_eqs {
             held[eq] = true;
         }
-        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
         assert!(
             rows.rows
                 .iter()
@@ -585,7 +612,7 @@ mod tests {
         let (model, mut assembler) = assembled::<D>(&x);
         let held = vec![false; n];
         let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
         let subset: Vec<usize> = (0..rows.len()).step_by(2).collect();
         assembler
             .eliminate_last(&rows.equations(&subset))
@@ -620,7 +647,7 @@ mod tests {
         let (model, mut assembler) = assembled::<D>(&x);
         let held = vec![false; n];
         let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
         // the drum is held by its mass term; every pad node is pushed down by 1 cm
         let mut residual = DVector::zeros(n);
         for node in 0..model.part().mesh.nodes.len() {
@@ -667,15 +694,19 @@ mod tests {
 
     /// With the contact forces `r` held fixed, the tangent `K_T` plus the contact curvature
     /// stiffness is the derivative of `f_int(x) - H(x)^T r`: node, drum translation and drum
-    /// rotation coupled through the curved, rotating surface.
-    fn contact_curvature_completes_the_tangent<const D: usize>() {
+    /// rotation coupled through the curved, rotating surface. With `secant`, the normal rows are
+    /// the discrete gap gradients from a start 10 um away (a dynamic increment), whose
+    /// derivative Newton takes in its symmetric part.
+    fn contact_curvature_completes_the_tangent<const D: usize>(secant: bool) {
         let n = block_on_drum::<D>().dofs().len();
         // the block pressed 1 mm into the drum, sheared, the drum turned and shifted
         let x = DVector::from_fn(n, |i, _| 1e-3 * ((i as f64 * 1.3).sin() - 0.5));
+        let x0 = DVector::from_fn(n, |i, _| x[i] - 1e-5 * (i as f64 * 0.7).cos());
+        let increment_start = secant.then_some(&x0);
         let (model, mut assembler) = assembled::<D>(&x);
         let held = vec![false; n];
         let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, &start, &held).expect("rows");
+        let rows = contact_rows(&model, &x, increment_start, &start, &held).expect("rows");
         let r = DVector::from_fn(rows.rows.len(), |k, _| {
             if k % D == 0 {
                 700.0 + 10.0 * k as f64
@@ -688,7 +719,7 @@ mod tests {
         assembler.add_contact_curvature(&rows, &r);
         let k = assembler.dense(n);
         let residual = |assembler: &mut Assembler, x: &DVector<f64>| {
-            let rows = contact_rows(&model, x, &start, &held).expect("rows");
+            let rows = contact_rows(&model, x, increment_start, &start, &held).expect("rows");
             assembler.internal(&model, x, None).expect("internal").force
                 - rows.transpose_times(&r, n)
         };
@@ -707,7 +738,7 @@ mod tests {
         }
         assert!(
             worst < 1e-6 * k.amax(),
-            "{D}D: worst {worst:e} vs {:e}",
+            "{D}D, secant {secant}: worst {worst:e} vs {:e}",
             k.amax()
         );
         // the curvature term is not negligible here: without it the tangent is visibly wrong
@@ -719,12 +750,14 @@ mod tests {
 
     #[test]
     fn contact_curvature_completes_the_tangent_2d() {
-        contact_curvature_completes_the_tangent::<2>();
+        contact_curvature_completes_the_tangent::<2>(false);
+        contact_curvature_completes_the_tangent::<2>(true);
     }
 
     #[test]
     fn contact_curvature_completes_the_tangent_3d() {
-        contact_curvature_completes_the_tangent::<3>();
+        contact_curvature_completes_the_tangent::<3>(false);
+        contact_curvature_completes_the_tangent::<3>(true);
     }
 
     #[test]

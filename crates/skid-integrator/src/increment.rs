@@ -115,6 +115,13 @@ pub fn solve_increment<const D: usize>(
     let mass = model.mass();
     let length = model.length_scale();
     let previous_coords: Vec<Vector2<f64>> = start.contacts.iter().map(|c| c.coords).collect();
+    // Dynamic increments take the normal rows between the start and the end positions, so
+    // that the contact impulse does the work `p_N dg` (see `contact_rows`); a static
+    // equilibrium takes the normal at the solution itself.
+    let row_start = match kind {
+        IncrementKind::Static { .. } => None,
+        IncrementKind::Dynamic { .. } => Some(&start.x),
+    };
     let (lambda, k_factor, m_factor) = match kind {
         IncrementKind::Static {
             load_factor,
@@ -164,7 +171,7 @@ pub fn solve_increment<const D: usize>(
             }
         };
         assembler.add_diagonal(&(mass * m_factor));
-        let rows = contact_rows(model, &x, &previous_coords, held)?;
+        let rows = contact_rows(model, &x, row_start, &previous_coords, held)?;
         assembler.add_contact_curvature(&rows, &warm);
         for (eq, &h) in held.iter().enumerate() {
             if h {

@@ -166,7 +166,7 @@ pub fn initial_state<const D: usize>(
         .flat_map(|p| p.nodes.iter())
         .map(|_| nalgebra::Vector2::zeros())
         .collect();
-    let rows = contact_rows(model, &x, &coords0, &held)?;
+    let rows = contact_rows(model, &x, None, &coords0, &held)?;
     let d = rows.components;
     let contacts = model
         .contacts()
