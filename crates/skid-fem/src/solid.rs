@@ -3,7 +3,9 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6xX, SVector, Vector3};
 
-use crate::cell::{ReferenceGeometry, corner_count, embed, hourglass_base_vectors};
+use crate::cell::{
+    ReferenceGeometry, corner_count, corners, embed, hourglass_base_vectors, jacobian,
+};
 use crate::error::FemError;
 use crate::material::{Hyperelastic, VOIGT_PAIRS};
 
@@ -18,6 +20,10 @@ pub struct OnePointSolid<const D: usize> {
     hourglass_vectors: DMatrix<f64>,
     /// Hourglass stiffness `k_i` per displacement direction.
     hourglass_stiffness: SVector<f64, D>,
+    /// Reference nodal coordinates, for the corner check of [`Self::respond`].
+    reference_nodes: Vec<SVector<f64, D>>,
+    /// `det J` of the isoparametric map at each corner of the reference cell.
+    reference_corner_jacobians: Vec<f64>,
 }
 
 /// Response of one element at a given displacement.
@@ -136,6 +142,11 @@ impl<const D: usize> OnePointSolid<D> {
             mean_gradients: b,
             hourglass_vectors,
             hourglass_stiffness,
+            reference_nodes: x_ref.to_vec(),
+            reference_corner_jacobians: corners::<D>()
+                .iter()
+                .map(|xi| jacobian(x_ref, xi).determinant())
+                .collect(),
         })
     }
 
@@ -195,9 +206,15 @@ impl<const D: usize> OnePointSolid<D> {
     /// With [`Tangent::Mixed`] the stress `tau` of the geometric term and the tangent `c^tau`
     /// are those of the mixed formulation at the given pressure.
     ///
+    /// The single integration point does not see an element folded by its hourglass modes (the
+    /// mean `F` stays that of the affine part), so `J` is also checked at every corner of the
+    /// cell: `J_c = det J(xi_c; X + u) / det J(xi_c; X)`, the volume ratio of the full bilinear
+    /// (trilinear) field there.
+    ///
     /// # Errors
     /// [`FemError::LengthMismatch`] if `u` does not hold one vector per node,
-    /// [`FemError::InvertedElement`] if `J <= 0` or `F` is not finite.
+    /// [`FemError::InvertedElement`] if `J <= 0` at the centre or at a corner, or `F` is not
+    /// finite (`det_f` is the offending volume ratio).
     pub fn respond(
         &self,
         material: &dyn Hyperelastic,
@@ -217,6 +234,18 @@ impl<const D: usize> OnePointSolid<D> {
         let inverted = FemError::InvertedElement { det_f };
         if !(det_f > 0.0 && f.iter().all(|v| v.is_finite())) {
             return Err(inverted);
+        }
+        let current: Vec<SVector<f64, D>> = self
+            .reference_nodes
+            .iter()
+            .zip(u)
+            .map(|(x, u)| x + u)
+            .collect();
+        for (xi, det_ref) in corners::<D>().iter().zip(&self.reference_corner_jacobians) {
+            let det_f = jacobian(&current, xi).determinant() / det_ref;
+            if det_f.is_nan() || det_f <= 0.0 {
+                return Err(FemError::InvertedElement { det_f });
+            }
         }
         let f_inv_t = f.try_inverse().ok_or(inverted)?.transpose();
         let tau = material.kirchhoff_stress(&f);
@@ -667,6 +696,25 @@ mod tests {
             hex.evaluate(&m, &u, false),
             Err(FemError::InvertedElement { .. })
         ));
+        // folded by its hourglass mode u_x = q xi eta: F at the centre is the identity, but at
+        // the corners eta = -1 the bilinear field has dx/dX = 1 - 2q < 0
+        let square: Vec<Vector2<f64>> = corners::<2>()
+            .iter()
+            .map(|xi| (xi.add_scalar(1.0)) * 0.5)
+            .collect();
+        let quad = OnePointSolid::<2>::new(&square, 1.0, 1.0, 1.0)?;
+        let fold = |q: f64| -> Vec<Vector2<f64>> {
+            corners::<2>()
+                .iter()
+                .map(|xi| Vector2::new(q * xi[0] * xi[1], 0.0))
+                .collect()
+        };
+        assert!((quad.deformation_gradient(&fold(0.6)) - Matrix3::identity()).amax() < 1e-15);
+        assert!(matches!(
+            quad.evaluate(&m, &fold(0.6), false),
+            Err(FemError::InvertedElement { det_f }) if (det_f + 0.2).abs() < 1e-12
+        ));
+        assert!(quad.evaluate(&m, &fold(0.4), false).is_ok());
         let mut nan = vec![V3::zeros(); 8];
         nan[3].x = f64::NAN;
         assert!(matches!(
