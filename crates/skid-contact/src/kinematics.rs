@@ -28,6 +28,18 @@ pub struct RotatingFrame {
     pub angle: f64,
 }
 
+impl RotatingFrame {
+    /// The unit axis `e` and the rotation `Q(theta)`; `None` if the frame is degenerate (zero or
+    /// non-finite axis, non-finite centre or angle).
+    fn orientation(&self) -> Option<(Unit<Vector3<f64>>, Rotation3<f64>)> {
+        if !(self.angle.is_finite() && self.center.iter().all(|c| c.is_finite())) {
+            return None;
+        }
+        let axis = Unit::try_new(self.axis, 0.0).filter(|a| a.iter().all(|c| c.is_finite()))?;
+        Some((axis, Rotation3::from_axis_angle(&axis, self.angle)))
+    }
+}
+
 /// Gap, convected coordinates and their exact first and second derivatives for one slave node.
 #[derive(Clone, Debug)]
 pub struct ContactKinematics {
@@ -61,11 +73,7 @@ pub fn evaluate(
     frame: &RotatingFrame,
     x: &Vector3<f64>,
 ) -> Option<ContactKinematics> {
-    if !(frame.angle.is_finite() && frame.center.iter().all(|c| c.is_finite())) {
-        return None;
-    }
-    let axis = Unit::try_new(frame.axis, 0.0).filter(|a| a.iter().all(|c| c.is_finite()))?;
-    let rotation = Rotation3::from_axis_angle(&axis, frame.angle);
+    let (axis, rotation) = frame.orientation()?;
     let y = rotation.inverse_transform_vector(&(x - frame.center));
     let projection = surface.project(&y)?;
     let body_velocity = axis.cross(&y);
@@ -122,11 +130,7 @@ pub fn gap_discrete_gradient(
     start_offset: &Vector3<f64>,
     x: &Vector3<f64>,
 ) -> Option<DiscreteGradient> {
-    if !(frame.angle.is_finite() && frame.center.iter().all(|c| c.is_finite())) {
-        return None;
-    }
-    let axis = Unit::try_new(frame.axis, 0.0).filter(|a| a.iter().all(|c| c.is_finite()))?;
-    let rotation = Rotation3::from_axis_angle(&axis, frame.angle);
+    let (axis, rotation) = frame.orientation()?;
     let y_end = rotation.inverse_transform_vector(&(x - frame.center));
     let y_start = rotation.inverse_transform_vector(start_offset);
     let world = rotation.matrix();
