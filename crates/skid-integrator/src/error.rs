@@ -100,7 +100,7 @@ impl IncrementFailure {
 pub enum RunError {
     /// An increment failed even at the smallest allowed size.
     #[error(
-        "step '{step}' failed at increment {increment} (time {time:.6e} s, size {size:.3e}) after {cutbacks} cutbacks: {cause}"
+        "step '{step}' failed at increment {increment} (time {time:.6e} s, size {size:.3e}) after {cutbacks} consecutive cutbacks: {cause}"
     )]
     StepFailed {
         /// Step name.
@@ -111,7 +111,8 @@ pub enum RunError {
         time: f64,
         /// Size of the last attempted increment (time, or load factor for static steps).
         size: f64,
-        /// Cutbacks made before giving up.
+        /// Consecutive cutbacks of this increment before giving up (earlier increments' cutbacks
+        /// may already have left `size` below the nominal one).
         cutbacks: usize,
         /// The last failure.
         cause: IncrementFailure,
