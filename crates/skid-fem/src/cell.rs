@@ -76,19 +76,28 @@ pub fn shape_gradients<const D: usize>(xi: &SVector<f64, D>) -> Vec<SVector<f64,
         .collect()
 }
 
+/// The parametric axes whose coordinates multiply to each hourglass base function `h_alpha`
+/// (in the order of [`hourglass_base_vectors`]): D = 2: `[{0, 1}]`; D = 3:
+/// `[{0, 1}, {1, 2}, {2, 0}, {0, 1, 2}]`.
+///
+/// # Errors
+/// [`FemError::UnsupportedDimension`] unless D is 2 or 3.
+pub fn hourglass_mode_axes<const D: usize>() -> Result<&'static [&'static [usize]], FemError> {
+    match D {
+        2 => Ok(&[&[0, 1]]),
+        3 => Ok(&[&[0, 1], &[1, 2], &[2, 0], &[0, 1, 2]]),
+        _ => Err(FemError::UnsupportedDimension { dim: D }),
+    }
+}
+
 /// Hourglass base vectors `h_alpha` (values at the corners): D = 2: `[xi eta]`;
 /// D = 3: `[xi eta, eta zeta, zeta xi, xi eta zeta]`.
 ///
 /// # Errors
 /// [`FemError::UnsupportedDimension`] unless D is 2 or 3.
 pub fn hourglass_base_vectors<const D: usize>() -> Result<Vec<DVector<f64>>, FemError> {
-    let products: &[&[usize]] = match D {
-        2 => &[&[0, 1]],
-        3 => &[&[0, 1], &[1, 2], &[2, 0], &[0, 1, 2]],
-        _ => return Err(FemError::UnsupportedDimension { dim: D }),
-    };
     let corners = corners::<D>();
-    Ok(products
+    Ok(hourglass_mode_axes::<D>()?
         .iter()
         .map(|axes| {
             DVector::from_iterator(
