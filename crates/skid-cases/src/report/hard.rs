@@ -487,7 +487,12 @@ pub fn section(
          stiffness (benchmark: 2.4 rad/s, 0.0095 rad, period 2 pi sqrt(I / (k R^2)) = 25 ms; \
          DRUM.md 2.3 measured 2 to 2.5 rad/s, 0.01 rad, 28 ms). Creeping or a reversal into \
          sliding carries the drum much further;\n\
-         - **hourglass**: max hourglass energy / strain energy <= {hourglass} % (issue 4).\n\n\
+         - **hourglass**: max hourglass energy / strain energy <= {hourglass} % (issue 4). A pad \
+         with one element through its thickness can bend around the drum only through its \
+         hourglass modes, so on the 10 x 1 (x 1) pads of DRUM.md this energy is the pad's \
+         bending, 4.5-5 % of the strain energy already in the frictionless preload and in \
+         proportion to the stabilisation stiffness; two or more elements through the \
+         thickness carry it in their mean strains (40 x 8: 0.4 %).\n\n\
          ![omega / omega0 against t / t_est: every run with friction, and the estimate \
          1 - t / t_est]({HARD_OMEGA_SVG})\n\n",
         dir = dir.display(),
