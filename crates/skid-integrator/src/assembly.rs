@@ -263,33 +263,36 @@ impl Assembler {
         self.pattern.factorize(&self.values)
     }
 
-    /// Factorizes `K + c_k M` (the current values hold `K + c_0 M`, held equations already
-    /// replaced by identity rows), with the first `c_k = c_0 10^k`, `k = 0, 1, ...,`
-    /// [`MAX_SHIFT_DECADES`], for which it is positive definite; returns the factor and `c_k`.
+    /// Runs `solve` (which factorizes the current matrix) on `K + c_k M` (the current values
+    /// hold `K + c_0 M`, held equations already replaced by identity rows), with the first
+    /// `c_k = c_0 10^k`, `k = 0, 1, ...,` [`MAX_SHIFT_DECADES`], for which the factorization
+    /// succeeds; returns its result and `c_k`.
     ///
-    /// This is the pseudo-transient continuation of a static Newton step: the mass term is not
-    /// in the residual, so the converged state does not depend on it; a larger `c` only turns
-    /// Newton's step into a damped, shorter one. It is needed where the tangent of the solid
-    /// *without its contacts* is indefinite although the contact-constrained problem is stable:
-    /// a pad pressed harder than its shear modulus by a load balanced only by contact forces
-    /// (its free front face may shear and tilt at negative stiffness, `tau : Omega^T Omega < 0`
-    /// for a compressive Kirchhoff stress), which the Cholesky-based contact reduction cannot
-    /// factor. A `c_0` of zero is not escalated.
+    /// This is pseudo-transient continuation: the mass term of the matrix is not that of the
+    /// residual, so the converged state does not depend on it; a larger `c` only turns Newton's
+    /// step into a damped, shorter one. It is needed where the tangent of the solid *without its
+    /// contacts* is indefinite although the contact-constrained problem is stable: a pad pressed
+    /// harder than its shear modulus by a load balanced only by contact forces (its free front
+    /// face may shear and tilt at negative stiffness, `tau : Omega^T Omega < 0` for a
+    /// compressive Kirchhoff stress), which the Cholesky-based contact reduction cannot factor.
+    /// A static step meets it with its regularisation `c_0 = 1/h_s^2`, a long dynamic step
+    /// (5 ms) with `c_0 = 1/(beta h^2)`. A `c_0` of zero is not escalated.
     ///
     /// # Errors
     /// [`IncrementFailure::LinearSolve`] if even `c_0 10^MAX_SHIFT_DECADES` leaves the matrix
-    /// indefinite, or for non-finite entries.
-    pub fn factorize_shifted(
+    /// indefinite, or for non-finite entries; any other failure of `solve`.
+    pub fn with_mass_shift<T>(
         &mut self,
         mass: &DVector<f64>,
         c0: f64,
         held: &[bool],
-    ) -> Result<(Factorization, f64), IncrementFailure> {
+        mut solve: impl FnMut(&mut Self) -> Result<T, IncrementFailure>,
+    ) -> Result<(T, f64), IncrementFailure> {
         let mut c = c0;
         let mut decades = 0;
         loop {
-            match self.factorize() {
-                Ok(factor) => return Ok((factor, c)),
+            match solve(self) {
+                Ok(result) => return Ok((result, c)),
                 Err(IncrementFailure::LinearSolve(message))
                     if decades < MAX_SHIFT_DECADES
                         && c > 0.0
@@ -306,8 +309,8 @@ impl Assembler {
     }
 }
 
-/// How many tenfold increases of the static step's mass shift [`Assembler::factorize_shifted`]
-/// tries before it reports the tangent as indefinite.
+/// How many tenfold increases of the mass shift [`Assembler::with_mass_shift`] tries before it
+/// reports the tangent as indefinite.
 pub const MAX_SHIFT_DECADES: usize = 8;
 
 /// External nodal forces of the pressure loads at load factor `lambda`, on the current
@@ -417,6 +420,33 @@ mod tests {
     #[test]
     fn assembled_tangent_matches_finite_differences_3d() {
         tangent_matches_finite_differences::<3>();
+    }
+
+    /// An indefinite matrix gets mass added tenfold at a time until it factorizes; a failure
+    /// other than an indefinite matrix is passed on at once.
+    #[test]
+    fn mass_shift_escalates_until_the_matrix_factorizes() {
+        let model = tied_block::<2>();
+        let n = model.dofs().len();
+        let mut assembler = Assembler::new(&model).expect("assembler");
+        let x = DVector::zeros(n);
+        assembler.internal(&model, &x, Some(1.0)).expect("internal");
+        let mass = model.mass().clone();
+        let held = vec![false; n];
+        // pretend the values hold K + 1e3 M while they hold K - 1e9 M
+        assembler.add_diagonal(&(&mass * -1e9));
+        assert!(assembler.factorize().is_err());
+        let (_, c) = assembler
+            .with_mass_shift(&mass, 1e3, &held, |a| a.factorize())
+            .expect("shifted");
+        assert!((1e9..=1e11).contains(&c), "c = {c:e}");
+        let mut calls = 0;
+        let failure = assembler.with_mass_shift(&mass, 1e3, &held, |_| -> Result<(), _> {
+            calls += 1;
+            Err(IncrementFailure::NonFinite { iteration: 0 })
+        });
+        assert!(matches!(failure, Err(IncrementFailure::NonFinite { .. })));
+        assert_eq!(calls, 1);
     }
 
     #[test]

@@ -9,13 +9,17 @@
 //! - the actual gaps and slips differ from those the linearised problem predicted (and for which
 //!   the Coulomb law holds exactly) by less than `contact_tolerance` times the model size.
 //!
+//! A step whose end folds an element (`J <= 0` at an element's centre or corner) is halved, up to
+//! [`MAX_STEP_HALVINGS`] times, before the increment is given up for a cutback; so is the HHT
+//! predictor, which extrapolates the start velocity over the whole increment.
+//!
 //! Dynamic residual (HHT): `R = M a + (1 + alpha) F(x) - alpha F_n`; tangent
 //! `M/(beta h^2) + (1 + alpha) K_T`. Static residual: `R = F(x)` with `F = f_int - lambda f_ext`;
 //! tangent `K_T + M/h_s^2`. The mass term of the static tangent only regularises the Newton
-//! step (it keeps a pad that is not yet held by contact from being singular, and it grows
-//! tenfold at a time where the tangent without contact is indefinite, see
-//! [`Assembler::factorize_shifted`]); it is not in the residual, so the converged state is
-//! exactly static.
+//! step (it keeps a pad that is not yet held by contact from being singular); it is not in the
+//! residual, so the converged state is exactly static. Where the tangent without contact is
+//! indefinite, the mass term of either matrix grows tenfold at a time until it can be factorized
+//! (see [`Assembler::with_mass_shift`]), which again changes only Newton's path.
 
 use std::time::{Duration, Instant};
 
@@ -143,6 +147,12 @@ pub fn solve_increment<const D: usize>(
     let mut warm = start.warm_forces.clone();
     // Contact forces and linearised kinematics of the last conic solve.
     let mut last: Option<(DVector<f64>, DVector<f64>)> = None;
+    // The last step (at first the predictor's) and how often it has been halved (see below).
+    let mut last_step: Option<DVector<f64>> = match kind {
+        IncrementKind::Static { .. } => None,
+        IncrementKind::Dynamic { .. } => Some(&x - &start.x),
+    };
+    let mut halvings = 0;
 
     for iteration in 0..=newton.max_iterations {
         let clock = Instant::now();
@@ -160,7 +170,24 @@ pub fn solve_increment<const D: usize>(
                 (v, a)
             }
         };
-        let internal = assembler.internal(model, &x, Some(k_factor))?;
+        let internal = match assembler.internal(model, &x, Some(k_factor)) {
+            Ok(internal) => internal,
+            // A full Newton step that folds an element overshoots; half of it may not. The
+            // iterate stays a Newton iterate (the next step starts from it, and convergence
+            // is still judged by the residuals), so only the path changes.
+            Err(IncrementFailure::InvertedElement { .. })
+                if halvings < MAX_STEP_HALVINGS && last_step.is_some() =>
+            {
+                if let Some(step) = last_step.as_mut() {
+                    *step *= 0.5;
+                    x -= &*step;
+                    assembler.advance_mixed_pressures(model, step);
+                }
+                halvings += 1;
+                continue;
+            }
+            Err(failure) => return Err(failure),
+        };
         let f_ext = external_forces(model, &x, lambda)?;
         let net = &internal.force - &f_ext;
         let inertia = mass.component_mul(&a);
@@ -222,37 +249,29 @@ pub fn solve_increment<const D: usize>(
             }
         }
 
-        let clock = Instant::now();
-        // A static step raises its mass shift until `K + c M` is positive definite (see
-        // `Assembler::factorize_shifted`). Without contact that factor is the step's; the
-        // contact step factorizes the shifted matrix again, in its own equation order.
-        let shifted = match kind {
-            IncrementKind::Static { regularization, .. } => {
-                Some(assembler.factorize_shifted(mass, regularization, held)?.0)
-            }
-            IncrementKind::Dynamic { .. } => None,
-        };
-        timings.linear_solve += clock.elapsed();
+        // The mass term of the matrix is raised until `K + c M` can be factorized (see
+        // `Assembler::with_mass_shift`): a static step's regularisation, or a long dynamic
+        // step's `1/(beta h^2)` where the compressed pad's tangent without its contacts is
+        // indefinite. The residual keeps the true inertia, so only Newton's path changes.
         let dx = if rows.is_empty() {
             let clock = Instant::now();
-            let factor = match shifted {
-                Some(factor) => factor,
-                None => assembler.factorize()?,
-            };
+            let (factor, _) = assembler.with_mass_shift(mass, m_factor, held, |a| a.factorize())?;
             let dx = factor.solve(&(-&residual));
             timings.linear_solve += clock.elapsed();
             last = Some((DVector::zeros(0), DVector::zeros(0)));
             dx
         } else {
-            let (dx, solution) = contact_step(
-                assembler,
-                &rows,
-                &residual,
-                &warm,
-                length,
-                &settings.coulomb,
-                timings,
-            )?;
+            let ((dx, solution), _) = assembler.with_mass_shift(mass, m_factor, held, |a| {
+                contact_step(
+                    a,
+                    &rows,
+                    &residual,
+                    &warm,
+                    length,
+                    &settings.coulomb,
+                    timings,
+                )
+            })?;
             counters.contact_solves += solution.conic_solves;
             counters.fixed_point_iterations += solution.fixed_point_iterations;
             counters.contact_newton_steps += solution.newton_steps;
@@ -265,7 +284,9 @@ pub fn solve_increment<const D: usize>(
             return Err(IncrementFailure::NonFinite { iteration });
         }
         assembler.advance_mixed_pressures(model, &dx);
-        x += dx;
+        x += &dx;
+        last_step = Some(dx);
+        halvings = 0;
     }
     // The loop returns from inside: either converged or at the last convergence check.
     Err(IncrementFailure::NewtonNotConverged {
@@ -274,6 +295,10 @@ pub fn solve_increment<const D: usize>(
         contact_residual: f64::NAN,
     })
 }
+
+/// How often one Newton step may be halved because its end folds an element, before the
+/// increment fails (and is cut back).
+const MAX_STEP_HALVINGS: usize = 4;
 
 /// `max_i |R_i| / s_i` with `s` the largest magnitude among the given force vectors; moments
 /// are divided by the model size so that both compare as forces.
