@@ -26,11 +26,15 @@ pub enum FemError {
         /// Admissible range, in words.
         expected: &'static str,
     },
-    /// The deformation gradient has `J = det F <= 0` or non-finite entries.
-    #[error("inverted element: det F = {det_f}")]
+    /// The deformation gradient has `J = det F <= 0` or non-finite entries, at the element's
+    /// centre or at one of its corners.
+    #[error("inverted element: det F = {det_f} {}", inversion_point(*.corner))]
     InvertedElement {
-        /// Determinant of the deformation gradient.
+        /// Determinant of the deformation gradient (the volume ratio) where it failed.
         det_f: f64,
+        /// The corner where it failed (its index in the cell corner order), `None` for the
+        /// centre (the integration point).
+        corner: Option<usize>,
     },
     /// The reference geometry has a non-positive (or non-finite) Jacobian determinant.
     #[error("degenerate reference element: det J = {det_j}")]
@@ -73,4 +77,13 @@ pub enum FemError {
         /// What is wrong.
         reason: String,
     },
+}
+
+/// Where an element inverted, in words: at its centre, or at a corner while the centre is not
+/// (the element is folded, typically by its hourglass modes).
+pub fn inversion_point(corner: Option<usize>) -> String {
+    match corner {
+        None => "at its centre".into(),
+        Some(k) => format!("at corner {k}; its centre is not, the element is folded"),
+    }
 }

@@ -252,7 +252,10 @@ impl<const D: usize> OnePointSolid<D> {
         }
         let f = self.deformation_gradient(u);
         let det_f = f.determinant();
-        let inverted = FemError::InvertedElement { det_f };
+        let inverted = FemError::InvertedElement {
+            det_f,
+            corner: None,
+        };
         if !(det_f > 0.0 && f.iter().all(|v| v.is_finite())) {
             return Err(inverted);
         }
@@ -262,10 +265,17 @@ impl<const D: usize> OnePointSolid<D> {
             .zip(u)
             .map(|(x, u)| x + u)
             .collect();
-        for (xi, det_ref) in corners::<D>().iter().zip(&self.reference_corner_jacobians) {
+        for (corner, (xi, det_ref)) in corners::<D>()
+            .iter()
+            .zip(&self.reference_corner_jacobians)
+            .enumerate()
+        {
             let det_f = jacobian(&current, xi).determinant() / det_ref;
             if det_f.is_nan() || det_f <= 0.0 {
-                return Err(FemError::InvertedElement { det_f });
+                return Err(FemError::InvertedElement {
+                    det_f,
+                    corner: Some(corner),
+                });
             }
         }
         let f_inv_t = f.try_inverse().ok_or(inverted)?.transpose();
@@ -788,7 +798,7 @@ mod tests {
         let flip = Matrix3::from_diagonal(&V3::new(-0.5, 1.0, 1.0));
         let u = affine(&flip, &distorted::<2>());
         assert!(
-            matches!(quad.evaluate(&m, &u, true), Err(FemError::InvertedElement { det_f }) if det_f < 0.0)
+            matches!(quad.evaluate(&m, &u, true), Err(FemError::InvertedElement { det_f, corner: None }) if det_f < 0.0)
         );
         let hex = OnePointSolid::<3>::new(&distorted(), 1.0, 1.0, 1.0)?;
         let flip = Matrix3::from_diagonal(&V3::new(1.0, 1.0, -0.5));
@@ -813,8 +823,17 @@ mod tests {
         assert!((quad.deformation_gradient(&fold(0.6)) - Matrix3::identity()).amax() < 1e-15);
         assert!(matches!(
             quad.evaluate(&m, &fold(0.6), false),
-            Err(FemError::InvertedElement { det_f }) if (det_f + 0.2).abs() < 1e-12
+            Err(FemError::InvertedElement { det_f, corner: Some(_) }) if (det_f + 0.2).abs() < 1e-12
         ));
+        let message = quad
+            .evaluate(&m, &fold(0.6), false)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            message.contains("corner") && message.contains("folded"),
+            "{message}"
+        );
         assert!(quad.evaluate(&m, &fold(0.4), false).is_ok());
         let mut nan = vec![V3::zeros(); 8];
         nan[3].x = f64::NAN;

@@ -137,8 +137,12 @@ impl Assembler {
             model.elements()[e]
                 .respond(part.material.as_ref(), &u, tangent)
                 .map_err(|err| match err {
-                    FemError::InvertedElement { det_f } => {
-                        IncrementFailure::InvertedElement { element: e, det_f }
+                    FemError::InvertedElement { det_f, corner } => {
+                        IncrementFailure::InvertedElement {
+                            element: e,
+                            det_f,
+                            corner,
+                        }
                     }
                     other => IncrementFailure::Element {
                         element: e,

@@ -43,13 +43,15 @@ pub enum IncrementFailure {
         /// Iteration at which it was detected.
         iteration: usize,
     },
-    /// An element turned inside out (J <= 0).
-    #[error("element {element} inverted (J = {det_f:.3e})")]
+    /// An element turned inside out (J <= 0), at its centre or at a corner.
+    #[error("element {element} inverted (J = {det_f:.3e} {})", skid_fem::error::inversion_point(*.corner))]
     InvertedElement {
         /// Element index in the mesh.
         element: usize,
         /// Volume ratio found.
         det_f: f64,
+        /// The corner where it was found, `None` for the centre.
+        corner: Option<usize>,
     },
     /// An element could not be evaluated for another reason.
     #[error("element {element}: {message}")]
