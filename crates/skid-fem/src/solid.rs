@@ -5,7 +5,7 @@ use nalgebra::{DMatrix, DVector, Matrix3, Matrix6xX, SVector, Vector3};
 
 use crate::cell::{
     ReferenceGeometry, corner_count, corners, embed, hourglass_base_vectors, hourglass_mode_axes,
-    jacobian,
+    jacobian, restrict, shape_gradients,
 };
 use crate::error::FemError;
 use crate::material::{Hyperelastic, VOIGT_PAIRS};
@@ -24,10 +24,9 @@ pub struct OnePointSolid<const D: usize> {
     /// Per displacement direction i, the constant stabilisation stiffness on the nodes'
     /// i-components: `Gamma^T diag(k_{. i}) Gamma`.
     hourglass_matrices: Vec<DMatrix<f64>>,
-    /// Reference nodal coordinates, for the corner check of [`Self::respond`].
-    reference_nodes: Vec<SVector<f64, D>>,
-    /// `det J` of the isoparametric map at each corner of the reference cell.
-    reference_corner_jacobians: Vec<f64>,
+    /// Per corner of the cell, the reference gradients `grad_X N_I` there, for the corner check
+    /// of [`Self::respond`].
+    corner_gradients: Vec<Vec<SVector<f64, D>>>,
 }
 
 /// Response of one element at a given displacement.
@@ -163,11 +162,10 @@ impl<const D: usize> OnePointSolid<D> {
             hourglass_vectors,
             hourglass_stiffness,
             hourglass_matrices,
-            reference_nodes: x_ref.to_vec(),
-            reference_corner_jacobians: corners::<D>()
+            corner_gradients: corners::<D>()
                 .iter()
-                .map(|xi| jacobian(x_ref, xi).determinant())
-                .collect(),
+                .map(|xi| reference_gradients(x_ref, xi))
+                .collect::<Result<_, _>>()?,
         })
     }
 
@@ -186,12 +184,7 @@ impl<const D: usize> OnePointSolid<D> {
     ///
     /// `u` must hold one displacement per node; [`Self::evaluate`] checks this.
     pub fn deformation_gradient(&self, u: &[SVector<f64, D>]) -> Matrix3<f64> {
-        self.mean_gradients
-            .iter()
-            .zip(u)
-            .fold(Matrix3::identity(), |f, (b, u)| {
-                f + embed(u) * embed(b).transpose()
-            })
+        gradient_of(&self.mean_gradients, u)
     }
 
     /// Internal force, optional consistent tangent, energies and stress at displacement u
@@ -259,18 +252,8 @@ impl<const D: usize> OnePointSolid<D> {
         if !(det_f > 0.0 && f.iter().all(|v| v.is_finite())) {
             return Err(inverted);
         }
-        let current: Vec<SVector<f64, D>> = self
-            .reference_nodes
-            .iter()
-            .zip(u)
-            .map(|(x, u)| x + u)
-            .collect();
-        for (corner, (xi, det_ref)) in corners::<D>()
-            .iter()
-            .zip(&self.reference_corner_jacobians)
-            .enumerate()
-        {
-            let det_f = jacobian(&current, xi).determinant() / det_ref;
+        for (corner, gradients) in self.corner_gradients.iter().enumerate() {
+            let det_f = gradient_of(gradients, u).determinant();
             if det_f.is_nan() || det_f <= 0.0 {
                 return Err(FemError::InvertedElement {
                     det_f,
@@ -383,6 +366,50 @@ fn strain_displacement<const D: usize>(g: &[Vector3<f64>]) -> Matrix6xX<f64> {
     b
 }
 
+/// `F = I + sum_I u_I (x) g_I` for the shape-function gradients `g_I` at one point, embedded in
+/// 3D.
+fn gradient_of<const D: usize>(
+    gradients: &[SVector<f64, D>],
+    u: &[SVector<f64, D>],
+) -> Matrix3<f64> {
+    gradients
+        .iter()
+        .zip(u)
+        .fold(Matrix3::identity(), |f, (g, u)| {
+            f + embed(u) * embed(g).transpose()
+        })
+}
+
+/// The inverse reference Jacobian at `xi`, `J^-1 = d xi / dX`.
+///
+/// # Errors
+/// [`FemError::DegenerateElement`] if the Jacobian is singular.
+fn inverse_jacobian<const D: usize>(
+    x_ref: &[SVector<f64, D>],
+    xi: &SVector<f64, D>,
+) -> Result<Matrix3<f64>, FemError> {
+    let j = jacobian(x_ref, xi);
+    j.try_inverse().ok_or(FemError::DegenerateElement {
+        det_j: j.determinant(),
+    })
+}
+
+/// `grad_X N_I = J^-T grad_xi N_I` at `xi`: then `det F` there, with [`gradient_of`], is
+/// `det J(xi; X + u) / det J(xi; X)`.
+///
+/// # Errors
+/// [`FemError::DegenerateElement`] if the Jacobian is singular.
+fn reference_gradients<const D: usize>(
+    x_ref: &[SVector<f64, D>],
+    xi: &SVector<f64, D>,
+) -> Result<Vec<SVector<f64, D>>, FemError> {
+    let inverse_t = inverse_jacobian(x_ref, xi)?.transpose();
+    Ok(shape_gradients::<D>(xi)
+        .iter()
+        .map(|dn| restrict(&(inverse_t * embed(dn))))
+        .collect())
+}
+
 /// `g_m = grad_X xi_m` at the cell centre: the rows of the inverse reference Jacobian there.
 ///
 /// # Errors
@@ -390,10 +417,7 @@ fn strain_displacement<const D: usize>(g: &[Vector3<f64>]) -> Matrix6xX<f64> {
 fn geometry_gradients<const D: usize>(
     x_ref: &[SVector<f64, D>],
 ) -> Result<Vec<SVector<f64, D>>, FemError> {
-    let j = jacobian(x_ref, &SVector::zeros());
-    let inverse = j.try_inverse().ok_or(FemError::DegenerateElement {
-        det_j: j.determinant(),
-    })?;
+    let inverse = inverse_jacobian(x_ref, &SVector::zeros())?;
     Ok((0..D)
         .map(|m| SVector::from_fn(|i, _| inverse[(m, i)]))
         .collect())
@@ -410,6 +434,8 @@ fn hourglass_stiffness<const D: usize>(
 ) -> Result<DMatrix<f64>, FemError> {
     let modes = hourglass_mode_axes::<D>()?;
     let mut k = DMatrix::zeros(modes.len(), D);
+    // w_mi = (g_m . e_i)^2 / |g_m|^2, normalised over m
+    let weights = DMatrix::from_fn(D, D, |m, i| g[m][i] * g[m][i] / g[m].norm_squared());
     for (alpha, axes) in modes.iter().enumerate() {
         // <(dh/dxi_l)^2> = (1/3)^(|S| - 1) for every l in S
         let mean_square = (1.0_f64 / 3.0).powi(axes.len() as i32 - 1);
@@ -421,12 +447,9 @@ fn hourglass_stiffness<const D: usize>(
             }
         };
         for i in 0..D {
-            let weights: Vec<f64> = g
-                .iter()
-                .map(|g_m| g_m[i] * g_m[i] / g_m.norm_squared())
-                .collect();
-            let total: f64 = weights.iter().sum();
-            k[(alpha, i)] = c * (0..D).map(|m| weights[m] * along_axis(m)).sum::<f64>() / total;
+            let column = weights.column(i);
+            k[(alpha, i)] =
+                c * (0..D).map(|m| column[m] * along_axis(m)).sum::<f64>() / column.sum();
         }
     }
     Ok(k)

@@ -214,7 +214,9 @@ impl Assembler {
     /// effective tangent: [`ContactRows::curvature_stiffness`] of every candidate.
     pub fn add_contact_curvature(&mut self, rows: &ContactRows, r: &DVector<f64>) {
         for (c, scatter) in self.contact_scatter.iter().enumerate().take(rows.len()) {
-            let k = rows.curvature_stiffness(c, r);
+            let Some(k) = rows.curvature_stiffness(c, r) else {
+                continue;
+            };
             for &(p, q, slot) in &scatter.entries {
                 self.values[slot] += k[(p, q)];
             }

@@ -84,17 +84,14 @@ impl ContactRows {
     /// `H^T r`, so the residual `R - H^T r` has the derivative `K - H^T dr/dx - sum_k r_k
     /// d^2 u_k/dx^2`; this is the last term, the geometric stiffness of contact on a curved or
     /// rotating surface (a normal force on a convex drum softens the tangential motion by
-    /// `r_N / rho`).
-    pub fn curvature_stiffness(&self, c: usize, r: &DVector<f64>) -> DMatrix<f64> {
+    /// `r_N / rho`). `None` for a candidate without force.
+    pub fn curvature_stiffness(&self, c: usize, r: &DVector<f64>) -> Option<DMatrix<f64>> {
         let d = self.components;
-        let mut k = DMatrix::<f64>::zeros(2 * d + 1, 2 * d + 1);
-        for row in c * d..(c + 1) * d {
-            let force = r.get(row).copied().unwrap_or(0.0);
-            if force != 0.0 {
-                k -= &self.curvature[row] * force;
-            }
-        }
-        k
+        let forces = (c * d..(c + 1) * d).map(|row| (row, r.get(row).copied().unwrap_or(0.0)));
+        forces
+            .filter(|&(_, force)| force != 0.0)
+            .map(|(row, force)| &self.curvature[row] * -force)
+            .reduce(|k, term| k + term)
     }
 
     /// `H dx`.
@@ -370,8 +367,9 @@ pub fn solve_contact_forces(
 /// equations whose increment is zero in this step (their columns are dropped).
 ///
 /// `start` is the displacement at the start of a dynamic increment (`None` for rows at the
-/// start itself and for static equilibrium, which needs the normal at the solution). Against a surface with a discrete gap gradient (the analytical circle and cylinder,
-/// see [`skid_contact::RigidSurface::gap_discrete_gradient`]) the normal row is that gradient
+/// start itself and for static equilibrium, which needs the normal at the solution). Against a
+/// surface with a discrete gap gradient (the analytical circle and cylinder, see
+/// [`skid_contact::RigidSurface::gap_discrete_gradient`]) the normal row is that gradient
 /// between the start and current positions instead of the current normal: the contact force
 /// acts along it, so its work over the increment, `p_N H_N dx`, is exactly `p_N dg` (zero for a
 /// node sliding along the drum at zero gap). With the current normal a loaded node moving `ds`
