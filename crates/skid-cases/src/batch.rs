@@ -18,10 +18,13 @@ use crate::validate::load_case;
 
 /// How one case of a batch ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
+#[serde(rename_all = "snake_case")]
 pub enum BatchStatus {
     /// The run reached the end of its last step.
     Completed,
+    /// The run stopped early with the failure its case expects (`expect.failure`); its
+    /// summary says where and why.
+    FailedAsExpected,
     /// The run started but stopped early; its summary says where and why.
     Failed,
     /// The case could not be run: unreadable or invalid file, model or output error.
@@ -29,10 +32,17 @@ pub enum BatchStatus {
 }
 
 impl BatchStatus {
-    /// The lowercase name used in `batch.json` and in listings.
+    /// Whether the case ended as its file says it should: completed, or stopped with the
+    /// failure it expects.
+    pub fn as_expected(self) -> bool {
+        matches!(self, Self::Completed | Self::FailedAsExpected)
+    }
+
+    /// The name used in `batch.json` and in listings.
     pub fn as_str(self) -> &'static str {
         match self {
             Self::Completed => "completed",
+            Self::FailedAsExpected => "failed_as_expected",
             Self::Failed => "failed",
             Self::Error => "error",
         }
@@ -176,10 +186,12 @@ fn run_one(file: &Path, case: &Case, out: &Path) -> BatchEntry {
         Ok(summary) => BatchEntry {
             case_file: file.to_path_buf(),
             name: case.name.clone(),
-            status: if summary.error.is_none() {
-                BatchStatus::Completed
-            } else {
-                BatchStatus::Failed
+            status: match (&summary.error, case.expect.failure) {
+                (None, _) => BatchStatus::Completed,
+                (Some(_), Some(expected)) if expected.matches(summary.failure.as_deref()) => {
+                    BatchStatus::FailedAsExpected
+                }
+                (Some(_), _) => BatchStatus::Failed,
             },
             error: summary.error.clone(),
             summary: Some(summary),
@@ -290,5 +302,21 @@ mod tests {
                 .as_deref()
                 .is_some_and(|e| e.contains("bad.json"))
         );
+    }
+
+    #[test]
+    fn a_run_that_stops_with_the_failure_its_case_expects_is_failed_as_expected() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let text = include_str!("../../../cases/hard/2d-pressure-x10.json");
+        let file = Path::new("2d-pressure-x10.json");
+        let case = crate::validate::parse_case(text, file, &[]).expect("valid case");
+        let entry = run_one(file, &case, dir.path());
+        assert_eq!(entry.status, BatchStatus::FailedAsExpected, "{entry:?}");
+        assert!(entry.status.as_expected());
+        let other = r#"expect.failure="newton_not_converged""#.to_string();
+        let case = crate::validate::parse_case(text, file, &[other]).expect("valid case");
+        let entry = run_one(file, &case, dir.path());
+        assert_eq!(entry.status, BatchStatus::Failed, "{entry:?}");
+        assert!(!entry.status.as_expected());
     }
 }

@@ -85,6 +85,9 @@ pub struct RunSummary {
     /// Why the run stopped early, if it did.
     #[serde(default)]
     pub error: Option<String>,
+    /// The kind of failure that stopped it early (e.g. `"inverted element"`).
+    #[serde(default)]
+    pub failure: Option<String>,
     /// Stop time from the start of the dynamic step, s.
     pub t_stop: Option<f64>,
     /// Initial angular velocity, rad/s.
@@ -480,6 +483,7 @@ pub(crate) mod test_runs {
                 dimension: 3,
                 status: "completed".into(),
                 error: None,
+                failure: None,
                 t_stop: (decel > 0.0).then(|| 60.0 / decel),
                 omega0: 60.0,
                 deceleration: Some(decel),

@@ -102,8 +102,7 @@ fn run_in<const D: usize>(case: &Case, source: &Path, dir: &Path) -> Result<Summ
             .finish(&scene.model)
             .map_err(output(fields_dir.clone()))?;
     }
-    let error = result.err().map(|e| e.to_string());
-    let summary = summarize(case, &samples, &stats, error);
+    let summary = summarize(case, &samples, &stats, result.err().as_ref());
     write_atomic(
         &dir.join("summary.json"),
         &serde_json::to_string_pretty(&summary).unwrap_or_default(),

@@ -330,4 +330,77 @@ pub struct ExpectSpec {
     pub t_stop_estimate_tolerance: Option<f64>,
     /// Why the case departs from the defaults (shown in the report).
     pub note: String,
+    /// The run is expected to stop early with this kind of failure: the case lies beyond what
+    /// the model can represent, and shows that skid stops with a clear message and keeps its
+    /// results (issue 4). `None`: the run is expected to complete.
+    pub failure: Option<ExpectedFailure>,
+}
+
+/// A kind of failure a case may be built to show (see [`ExpectSpec::failure`]).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ExpectedFailure {
+    /// An element turned inside out or folded.
+    InvertedElement,
+    /// Newton-Raphson did not converge, even after the cutbacks.
+    NewtonNotConverged,
+    /// The frictional contact problem was not solved.
+    ContactSolve,
+}
+
+impl ExpectedFailure {
+    /// The name the run's summary gives this failure (`summary.json`'s `failure`, from
+    /// [`skid_integrator::IncrementFailure::kind`]).
+    pub fn kind(self) -> &'static str {
+        match self {
+            Self::InvertedElement => "inverted element",
+            Self::NewtonNotConverged => "newton not converged",
+            Self::ContactSolve => "contact solve",
+        }
+    }
+
+    /// Whether a run whose summary says `failure` (its kind, `None` if it completed) stopped
+    /// as expected.
+    pub fn matches(self, failure: Option<&str>) -> bool {
+        failure == Some(self.kind())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use skid_integrator::IncrementFailure;
+
+    use super::ExpectedFailure;
+
+    #[test]
+    fn expected_failures_name_the_kinds_the_integrator_reports() {
+        let pairs = [
+            (
+                ExpectedFailure::InvertedElement,
+                IncrementFailure::InvertedElement {
+                    element: 0,
+                    det_f: -1e-3,
+                    corner: Some(3),
+                },
+            ),
+            (
+                ExpectedFailure::NewtonNotConverged,
+                IncrementFailure::NewtonNotConverged {
+                    iterations: 25,
+                    force_residual: 1e-3,
+                    contact_residual: 0.0,
+                },
+            ),
+            (
+                ExpectedFailure::ContactSolve,
+                IncrementFailure::Contact("no solution".into()),
+            ),
+        ];
+        for (expected, failure) in pairs {
+            assert_eq!(expected.kind(), failure.kind());
+            assert!(expected.matches(Some(failure.kind())));
+            assert!(!expected.matches(None));
+        }
+        assert!(!ExpectedFailure::InvertedElement.matches(Some("newton not converged")));
+    }
 }

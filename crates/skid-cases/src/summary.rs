@@ -2,7 +2,7 @@
 //! the stop, the energy balance and the contact accuracy, with the cost of the run.
 
 use serde::Serialize;
-use skid_integrator::RunStatistics;
+use skid_integrator::{RunError, RunStatistics};
 
 use crate::history::Sample;
 use crate::schema::Case;
@@ -18,6 +18,9 @@ pub struct Summary {
     pub status: String,
     /// Why the run stopped early, if it did.
     pub error: Option<String>,
+    /// The kind of failure that stopped it (e.g. `"inverted element"`, see
+    /// [`skid_integrator::RunError::kind`]), if it stopped early.
+    pub failure: Option<String>,
     /// First time the drum's angular velocity reaches zero (interpolated), s.
     pub t_stop: Option<f64>,
     /// Initial angular velocity, rad/s.
@@ -107,12 +110,13 @@ fn slope(samples: &[&Sample]) -> Option<f64> {
     (sxx > 0.0).then(|| sxy / sxx)
 }
 
-/// Computes the summary from the recorded samples and run statistics.
+/// Computes the summary from the recorded samples and run statistics; `error` is why the run
+/// stopped early, if it did.
 pub fn summarize(
     case: &Case,
     samples: &[Sample],
     stats: &RunStatistics,
-    error: Option<String>,
+    error: Option<&RunError>,
 ) -> Summary {
     let omega0 = case.drum.omega0;
     let area = case.pad.length * case.pad.width;
@@ -202,7 +206,8 @@ pub fn summarize(
             "failed"
         }
         .into(),
-        error,
+        error: error.map(ToString::to_string),
+        failure: error.map(|e| e.kind().to_string()),
         t_stop,
         omega0,
         deceleration,
@@ -303,10 +308,12 @@ mod tests {
             &case(),
             &samples,
             &RunStatistics::default(),
-            Some("boom".into()),
+            Some(&RunError::Invalid("boom".into())),
         );
         assert_eq!(s.t_stop, None);
         assert_eq!(s.status, "failed");
+        assert_eq!(s.error.as_deref(), Some("boom"));
+        assert_eq!(s.failure.as_deref(), Some("invalid"));
         assert!((s.deceleration.expect("fit over the run") - 600.0).abs() < 1e-6);
     }
 }

@@ -30,7 +30,7 @@ fn line(entry: &BatchEntry, width: usize) -> String {
         .and_then(|s| s.t_stop)
         .map_or_else(|| "-".to_string(), |t| format!("{t:.6}"));
     format!(
-        "{:<width$}  {:<9}  t_stop {:>8} s  wall {:>8.2} s",
+        "{:<width$}  {:<18}  t_stop {:>8} s  wall {:>8.2} s",
         entry.name,
         entry.status.as_str(),
         t_stop,
@@ -77,16 +77,16 @@ pub fn run(paths: &[PathBuf], out: &Path, jobs: usize) -> ExitCode {
     for entry in &entries {
         println!("{}", line(entry, width));
     }
-    let completed = entries
-        .iter()
-        .filter(|e| e.status == BatchStatus::Completed)
-        .count();
+    let count = |status| entries.iter().filter(|e| e.status == status).count();
+    let expected_failures = count(BatchStatus::FailedAsExpected);
+    let as_expected = entries.iter().filter(|e| e.status.as_expected()).count();
     println!(
-        "{completed} of {} cases completed; see {}",
+        "{} of {} cases completed, {expected_failures} failed as their case expects; see {}",
+        count(BatchStatus::Completed),
         entries.len(),
         out.join("batch.json").display()
     );
-    if completed == entries.len() {
+    if as_expected == entries.len() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)

@@ -126,3 +126,15 @@ pub enum RunError {
     #[error("{0}")]
     Invalid(String),
 }
+
+impl RunError {
+    /// A short name of why the run stopped: the kind of the increment failure that exhausted
+    /// the cutbacks (see [`IncrementFailure::kind`]), `"output"` or `"invalid"`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::StepFailed { cause, .. } => cause.kind(),
+            Self::Output(_) => "output",
+            Self::Invalid(_) => "invalid",
+        }
+    }
+}

@@ -2,8 +2,9 @@
 //! as run) implies, the same rules for every case and no rule tied to a case name (issue 4,
 //! DRUM.md section 3):
 //!
-//! - **completed**: the run reached the end of its last step and `history.csv` holds no NaN or
-//!   infinity;
+//! - **outcome**: the run reached the end of its last step, or, where the case expects a failure
+//!   (`expect.failure`: a case beyond what the model can represent), it stopped with that kind
+//!   of failure; and `history.csv` holds no NaN or infinity;
 //! - **contact**: the deepest penetration and the largest gap of a sliding contact that carries
 //!   force stay below [`CONTACT_LIMIT_M`] (the contact law held at every increment);
 //! - **energy**: the energy balance residual is at most [`ENERGY_TOLERANCE`] of the drum's
@@ -13,11 +14,16 @@
 //!   `t_est = I omega0 / (mu p A R)` (DRUM.md 2.2: plate force `p A`, friction `mu p A` at the
 //!   drum radius) to [`T_STOP_TOLERANCE`], or the case's `expect.t_stop_estimate_tolerance`;
 //!   without one (`mu p = 0`) the angular velocity stays at omega0 to [`OMEGA_CONSTANCY`]
-//!   relative;
+//!   relative; not applicable to a run expected to stop early;
 //! - **post-stop**: after the stop, over at least one rocking period, `|omega|` and the angle
 //!   change stay below DRUM.md's limits (5 rad/s, 0.03 rad) scaled by the case's elastic
 //!   spring-back relative to the benchmark's ([`SpringBack`]);
-//! - **hourglass**: the hourglass energy stays below [`HOURGLASS_LIMIT`] of the strain energy.
+//! - **hourglass**: on a pad with [`HOURGLASS_MIN_LAYERS`] or more elements through its
+//!   thickness, the hourglass energy stays below [`HOURGLASS_LIMIT`] of the strain energy. A pad
+//!   with one element through its thickness bends around the drum only through its hourglass
+//!   modes, so there the ratio is the pad's bending (reported, not checked); that its
+//!   stabilisation does not drive the spin-down is checked by varying `pad.hourglass_scale`
+//!   (`scripts/check_drum.py`).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -26,7 +32,7 @@ use super::format::{Counts, Sig, percent, plain, show};
 use super::plot::{HARD_OMEGA_SVG, plot_normalized_spin_down};
 use super::{ReportError, Run};
 use crate::runner::CASE_JSON;
-use crate::schema::{Case, MaterialSpec};
+use crate::schema::{Case, ExpectedFailure, MaterialSpec};
 
 /// Default relative tolerance of t_stop against the estimate. The estimate ignores the tilt of
 /// the contact normals on the curved drum (the independent model of DRUM.md 2.2 finds the
@@ -37,9 +43,14 @@ use crate::schema::{Case, MaterialSpec};
 pub const T_STOP_TOLERANCE: f64 = 0.02;
 /// Energy balance tolerance (issue 4).
 pub const ENERGY_TOLERANCE: f64 = 0.01;
-/// Largest hourglass energy / strain energy (issue 4): the stabilisation must not carry a
-/// visible share of the pad's deformation.
+/// Largest hourglass energy / strain energy (issue 4) on a pad that resolves its bending through
+/// the thickness: the stabilisation must not carry a visible share of the pad's deformation.
 pub const HOURGLASS_LIMIT: f64 = 0.01;
+/// Elements through the pad's thickness from which [`HOURGLASS_LIMIT`] applies. The ratio is a
+/// discretisation measure of the bending the one-point elements cannot hold in their mean
+/// strain: on the 2D benchmark pad it falls from 5.9 % (10 x 1) to 1.0 % (40 x 4) and 0.37 %
+/// (40 x 8); in 3D, 1.1 % on 40 x 4 x 8 and 0.5 % on 40 x 8 x 8.
+pub const HOURGLASS_MIN_LAYERS: usize = 2;
 /// Largest `|omega - omega0| / |omega0|` without a friction torque (issue 4).
 pub const OMEGA_CONSTANCY: f64 = 1e-9;
 /// Largest penetration, and gap of a sliding contact carrying force, m: 1e-6 m is 0.05 % of
@@ -51,7 +62,7 @@ const POST_STOP_OMEGA: f64 = 5.0;
 const POST_STOP_ANGLE: f64 = 0.03;
 /// The names of the checks, in table order.
 pub const CHECKS: [&str; 6] = [
-    "completed",
+    "outcome",
     "contact",
     "energy",
     "drum",
@@ -196,19 +207,37 @@ pub struct Assessment {
     pub checks: [Check; 6],
 }
 
-fn completed(run: &Run) -> Check {
+fn outcome(run: &Run, expected: Option<ExpectedFailure>) -> Check {
     let s = &run.summary;
-    if s.status != "completed" {
-        let why = s.error.as_deref().unwrap_or("no reason given");
-        return check(false, format!("{}: {why}", s.status));
-    }
+    let why = s.error.as_deref().unwrap_or("no reason given");
+    let ended = match expected {
+        None if s.status == "completed" => "completed".to_string(),
+        None => return check(false, format!("{}: {why}", s.status)),
+        Some(kind) if s.status == "completed" => {
+            return check(
+                false,
+                format!(
+                    "completed, but the case expects it to stop with {}: the expectation is \
+                     out of date",
+                    kind.kind()
+                ),
+            );
+        }
+        Some(kind) if !kind.matches(s.failure.as_deref()) => {
+            return check(
+                false,
+                format!("expected to stop with {}, stopped with: {why}", kind.kind()),
+            );
+        }
+        Some(_) => format!("stopped as expected: {why}"),
+    };
     if run.history.time.is_empty() {
         return check(false, "no dynamic increment in history.csv".into());
     }
     let n = run.history.non_finite;
     check(
         n == 0,
-        format!("completed, {n} non-finite numbers in history.csv"),
+        format!("{ended}; {n} non-finite numbers in history.csv"),
     )
 }
 
@@ -228,18 +257,30 @@ fn contact(run: &Run) -> Check {
     )
 }
 
-fn hourglass(run: &Run) -> Check {
-    match run.summary.max_hourglass_ratio {
-        Some(ratio) => check(
-            within(ratio, HOURGLASS_LIMIT),
-            format!(
-                "max hourglass energy / strain energy {} % (limit {} %)",
-                percent(Some(ratio)),
+fn hourglass(run: &Run, case: &Case) -> Check {
+    let Some(ratio) = run.summary.max_hourglass_ratio else {
+        return check(false, "no hourglass energy ratio in the summary".into());
+    };
+    let layers = case.pad.elements.radial;
+    let measured = format!(
+        "max hourglass energy / strain energy {} %",
+        percent(Some(ratio))
+    );
+    if layers < HOURGLASS_MIN_LAYERS {
+        return Check {
+            verdict: Verdict::NotApplicable,
+            detail: format!(
+                "{measured} with {layers} element(s) through the thickness, where the hourglass \
+                 modes carry part of the pad's bending (limit {} % from {HOURGLASS_MIN_LAYERS} \
+                 elements)",
                 plain(100.0 * HOURGLASS_LIMIT)
             ),
-        ),
-        None => check(false, "no hourglass energy ratio in the summary".into()),
+        };
     }
+    check(
+        within(ratio, HOURGLASS_LIMIT),
+        format!("{measured} (limit {} %)", plain(100.0 * HOURGLASS_LIMIT)),
+    )
 }
 
 /// The energy check and the relative error it used.
@@ -376,19 +417,28 @@ pub fn assess(run: &Run, case: &Case) -> Assessment {
         .t_stop_estimate_tolerance
         .unwrap_or(T_STOP_TOLERANCE);
     let (energy_check, energy_error) = energy(run, &e);
-    let (drum_check, deviation) = drum(run, &e, tolerance);
+    let (drum_check, deviation, post_stop_check) = if case.expect.failure.is_some() {
+        let early = || Check {
+            verdict: Verdict::NotApplicable,
+            detail: "the case expects the run to stop before the drum does".into(),
+        };
+        (early(), None, early())
+    } else {
+        let (c, deviation) = drum(run, &e, tolerance);
+        (c, deviation, post_stop(run, &e))
+    };
     Assessment {
         estimates: e,
         tolerance,
         deviation,
         energy_error,
         checks: [
-            completed(run),
+            outcome(run, case.expect.failure),
             contact(run),
             energy_check,
             drum_check,
-            post_stop(run, &e),
-            hourglass(run),
+            post_stop_check,
+            hourglass(run, case),
         ],
     }
 }
@@ -467,8 +517,11 @@ pub fn section(
          Runs in `{dir}` (`skid batch cases/hard`). Each case file says what it stresses and \
          what is expected (quoted below). The checks are derived from each run's case \
          (`case.json`, the case as run), the same rules for every case:\n\n\
-         - **completed**: the run reached the end of its last step, and `history.csv` holds no \
-         NaN or infinity;\n\
+         - **outcome**: the run reached the end of its last step or, where the case expects a \
+         failure (`expect.failure`: a case beyond what the model can represent, kept to show \
+         that skid stops cleanly, says where and why, and keeps its results), it stopped with \
+         that kind of failure; and `history.csv` holds no NaN or infinity. The drum and \
+         post-stop checks do not apply to a run expected to stop early;\n\
          - **contact**: max penetration and max gap of a sliding contact carrying force \
          <= {contact} m;\n\
          - **energy**: |energy balance residual| <= {energy} % of the drum energy lost \
@@ -487,12 +540,16 @@ pub fn section(
          stiffness (benchmark: 2.4 rad/s, 0.0095 rad, period 2 pi sqrt(I / (k R^2)) = 25 ms; \
          DRUM.md 2.3 measured 2 to 2.5 rad/s, 0.01 rad, 28 ms). Creeping or a reversal into \
          sliding carries the drum much further;\n\
-         - **hourglass**: max hourglass energy / strain energy <= {hourglass} % (issue 4). A pad \
-         with one element through its thickness can bend around the drum only through its \
-         hourglass modes, so on the 10 x 1 (x 1) pads of DRUM.md this energy is the pad's \
-         bending, 4.5-5 % of the strain energy already in the frictionless preload and in \
-         proportion to the stabilisation stiffness; two or more elements through the \
-         thickness carry it in their mean strains (40 x 8: 0.4 %).\n\n\
+         - **hourglass**: max hourglass energy / strain energy <= {hourglass} % (issue 4) on pads \
+         with {layers} or more elements through the thickness. The ratio measures the bending \
+         that one-point elements cannot hold in their mean strain, and falls with the layers \
+         through the thickness: 2D benchmark pad 5.9 % (10 x 1), 1.0 % (40 x 4), 0.37 % \
+         (40 x 8); 3D 1.1 % (40 x 4 x 8), 0.5 % (40 x 8 x 8). On DRUM.md's 10 x 1 (x 1) pads \
+         the hourglass modes carry the pad's bending around the drum (4.5-5 % of the strain \
+         energy already in the frictionless preload, in proportion to the stabilisation \
+         stiffness), so there the ratio is reported, not checked (n/a); instead \
+         `scripts/check_drum.py` checks that halving or doubling `pad.hourglass_scale` leaves \
+         the 2D and 3D spin-down unchanged.\n\n\
          ![omega / omega0 against t / t_est: every run with friction, and the estimate \
          1 - t / t_est]({HARD_OMEGA_SVG})\n\n",
         dir = dir.display(),
@@ -501,6 +558,7 @@ pub fn section(
         tol = plain(100.0 * T_STOP_TOLERANCE),
         spin = Sig(OMEGA_CONSTANCY),
         hourglass = plain(100.0 * HOURGLASS_LIMIT),
+        layers = HOURGLASS_MIN_LAYERS,
     );
     table(&assessed, &mut out);
     out.push_str("\n### The cases\n");
@@ -575,14 +633,14 @@ mod tests {
     #[test]
     fn a_run_that_behaves_as_estimated_passes_every_check() {
         let run = spin_down("2d-x", 600.0 / 1.007);
-        let a = assess(&run, &case(&[]));
+        let a = assess(&run, &case(&["pad.elements.radial=8"]));
         assert_eq!(verdicts(&a), vec![Verdict::Pass; 6], "{a:#?}");
         assert!((a.deviation.expect("stops") - 0.007).abs() < 1e-9);
     }
 
     #[test]
     fn each_check_fails_on_its_own_defect() {
-        let c = case(&[]);
+        let c = case(&["pad.elements.radial=8"]);
         let failing = |run: &Run| -> Vec<&'static str> {
             let a = assess(run, &c);
             CHECKS
@@ -594,10 +652,10 @@ mod tests {
         };
         let mut run = spin_down("x", 600.0);
         run.history.non_finite = 1;
-        assert_eq!(failing(&run), ["completed"]);
+        assert_eq!(failing(&run), ["outcome"]);
         let mut run = spin_down("x", 600.0);
         run.summary.status = "failed".into();
-        assert_eq!(failing(&run), ["completed"]);
+        assert_eq!(failing(&run), ["outcome"]);
         let mut run = spin_down("x", 600.0);
         run.summary.max_gap_violation_m = 2e-6;
         assert_eq!(failing(&run), ["contact"]);
@@ -610,7 +668,10 @@ mod tests {
         // 2.5 % late: outside the default 2 %, inside a case's own 3 %.
         let run = spin_down("x", 600.0 / 1.025);
         assert_eq!(failing(&run), ["drum"]);
-        let loose = case(&["expect.t_stop_estimate_tolerance=0.03"]);
+        let loose = case(&[
+            "pad.elements.radial=8",
+            "expect.t_stop_estimate_tolerance=0.03",
+        ]);
         assert!(
             assess(&run, &loose)
                 .checks
@@ -624,10 +685,62 @@ mod tests {
         run.summary.post_stop_max_angle_change = Some(0.04);
         assert_eq!(failing(&run), ["post-stop"]);
         let mut run = spin_down("x", 600.0);
-        run.summary.max_hourglass_ratio = Some(0.011);
-        assert_eq!(failing(&run), ["hourglass"]);
         run.summary.max_hourglass_ratio = None;
         assert_eq!(failing(&run), ["hourglass"]);
+    }
+
+    #[test]
+    fn the_hourglass_limit_applies_from_two_elements_through_the_thickness() {
+        let mut run = spin_down("x", 600.0);
+        run.summary.max_hourglass_ratio = Some(0.011);
+        let single = assess(&run, &case(&[]));
+        assert_eq!(single.checks[5].verdict, Verdict::NotApplicable);
+        assert!(single.checks[5].detail.contains("1.100 %"), "{single:#?}");
+        let layered = case(&["pad.elements.radial=2"]);
+        assert_eq!(assess(&run, &layered).checks[5].verdict, Verdict::Fail);
+        run.summary.max_hourglass_ratio = Some(0.009);
+        assert_eq!(assess(&run, &layered).checks[5].verdict, Verdict::Pass);
+    }
+
+    #[test]
+    fn a_case_that_expects_a_failure_passes_only_on_that_failure() {
+        let expects = case(&[r#"expect.failure="inverted_element""#]);
+        let mut run = spin_down("x", 600.0);
+        run.summary.status = "failed".into();
+        run.summary.error = Some("element 0 inverted (J = -1e-7 at corner 3)".into());
+        run.summary.failure = Some("inverted element".into());
+        run.summary.t_stop = None;
+        let a = assess(&run, &expects);
+        let expected = [
+            Verdict::Pass,
+            Verdict::Pass,
+            Verdict::Pass,
+            Verdict::NotApplicable,
+            Verdict::NotApplicable,
+            Verdict::NotApplicable,
+        ];
+        assert_eq!(verdicts(&a), expected, "{a:#?}");
+        assert!(a.checks[0].detail.contains("corner 3"), "{a:#?}");
+        // Another failure, a completed run, or NaN in the history fail the outcome.
+        run.summary.failure = Some("newton not converged".into());
+        let a = assess(&run, &expects);
+        assert_eq!(a.checks[0].verdict, Verdict::Fail);
+        assert!(
+            a.checks[0]
+                .detail
+                .contains("expected to stop with inverted element")
+        );
+        let completed = spin_down("x", 600.0);
+        let a = assess(&completed, &expects);
+        assert_eq!(a.checks[0].verdict, Verdict::Fail);
+        assert!(a.checks[0].detail.contains("out of date"), "{a:#?}");
+        run.summary.failure = Some("inverted element".into());
+        run.history.non_finite = 2;
+        assert_eq!(assess(&run, &expects).checks[0].verdict, Verdict::Fail);
+        // The run's energy balance is still checked.
+        run.history.non_finite = 0;
+        run.summary.energy_balance_error = Some(0.02);
+        assert_eq!(assess(&run, &expects).checks[2].verdict, Verdict::Fail);
     }
 
     #[test]
@@ -659,7 +772,7 @@ mod tests {
             Verdict::Pass,
             Verdict::Pass,
             Verdict::NotApplicable,
-            Verdict::Pass,
+            Verdict::NotApplicable,
         ];
         assert_eq!(verdicts(&a), expected, "{a:#?}");
         assert!((a.energy_error.expect("energy") - 1e-8 / 315.0).abs() < 1e-18);
@@ -681,7 +794,8 @@ mod tests {
         let runs = [good, late];
         let (text, counts, plots) =
             section(Path::new("out/hard"), &runs, dir.path()).expect("section");
-        assert_eq!(counts.passed, 11);
+        // Five checks each; the hourglass check does not apply to the single-layer pads.
+        assert_eq!(counts.passed, 9);
         assert_eq!(counts.failed, 1);
         assert!(plots[0].is_file());
         let row = |name: &str| {
@@ -695,7 +809,7 @@ mod tests {
             "{}",
             row("2d-good")
         );
-        assert!(row("2d-late").ends_with("| PASS | PASS | PASS | FAIL | PASS | PASS |"));
+        assert!(row("2d-late").ends_with("| PASS | PASS | PASS | FAIL | PASS | n/a |"));
         assert!(text.contains("Expectation: why it differs"), "{text}");
         let mut orphan = spin_down("2d-orphan", 600.0);
         orphan.case = None;
