@@ -3,7 +3,8 @@
 # every hard case of cases/hard in parallel, and the convergence study (scripts/convergence.sh);
 # writes the report validation/report.md (benchmark, hard cases, convergence) with its plots;
 # and checks the 2D benchmark's convergence in time step, its insensitivity to the pad density,
-# and that the conic (clarabel) Coulomb solve gives the run of the default Newton-first one.
+# that the conic (clarabel) Coulomb solve gives the run of the default Newton-first one, and
+# that the 2D and 3D spin-downs do not depend on the hourglass stabilisation's stiffness.
 # Results go to out/. Exit status 0 only if every run completed and every check passed.
 #
 # HARD_CASES: the hard case files or directories to run instead of cases/hard (words, globs
@@ -35,5 +36,11 @@ run 2d-analytic cases/drum/2d-analytic.json
 run 2d-analytic-dt-half cases/drum/2d-analytic.json 'steps[1].dt=5e-5'
 run 2d-analytic-density-x2 cases/drum/2d-analytic.json 'pad.density=2000'
 run 2d-analytic-conic cases/drum/2d-analytic.json 'solver.coulomb_method="conic"'
+for d in 2d 3d; do
+    [ "$d" = 3d ] && run 3d-analytic cases/drum/3d-analytic.json
+    for scale in 0.5 2; do
+        run "$d-analytic-hourglass-x$scale" "cases/drum/$d-analytic.json" "pad.hourglass_scale=$scale"
+    done
+done
 python3 scripts/check_drum.py "$out" || status=1
 exit $status
