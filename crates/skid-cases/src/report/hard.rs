@@ -270,8 +270,8 @@ fn hourglass(run: &Run, case: &Case) -> Check {
         return Check {
             verdict: Verdict::NotApplicable,
             detail: format!(
-                "{measured} with {layers} element(s) through the thickness, where the hourglass \
-                 modes carry part of the pad's bending (limit {} % from {HOURGLASS_MIN_LAYERS} \
+                "{measured} with one element through the thickness, where the hourglass modes \
+                 carry part of the pad's bending (limit {} % from {HOURGLASS_MIN_LAYERS} \
                  elements)",
                 plain(100.0 * HOURGLASS_LIMIT)
             ),
@@ -454,8 +454,12 @@ fn table(runs: &[(&Run, &Case, Assessment)], out: &mut String) {
     out.push_str("\n|---|---|---|---|---|---|---|---|---|---|");
     out.push_str(&"---|".repeat(CHECKS.len()));
     out.push('\n');
-    for (run, _, a) in runs {
+    for (run, case, a) in runs {
         let s = &run.summary;
+        let status = match case.expect.failure {
+            Some(kind) if kind.matches(s.failure.as_deref()) => "failed (as expected)",
+            _ => s.status.as_str(),
+        };
         let stop = match (s.t_stop, run.history.omega.last()) {
             (Some(t), _) => Sig(t).to_string(),
             (None, Some(&w)) => format!("omega {} rad/s", Sig(w)),
@@ -463,10 +467,9 @@ fn table(runs: &[(&Run, &Case, Assessment)], out: &mut String) {
         };
         let _ = write!(
             out,
-            "| {} | {}D | {} | {stop} | {} | {} | {} | {} | {} | {:.2} |",
+            "| {} | {}D | {status} | {stop} | {} | {} | {} | {} | {} | {:.2} |",
             run.name,
             s.dimension,
-            s.status,
             show(a.estimates.t_stop),
             a.deviation
                 .map_or_else(|| "n/a".into(), |d| format!("{:+.2}", 100.0 * d)),
@@ -791,11 +794,17 @@ mod tests {
         good.case = Some(case(&[]));
         let mut late = spin_down("2d-late", 600.0 / 1.05);
         late.case = Some(case(&["expect.note=why it differs"]));
-        let runs = [good, late];
+        let mut folded = spin_down("2d-folded", 600.0);
+        folded.summary.status = "failed".into();
+        folded.summary.failure = Some("inverted element".into());
+        folded.summary.t_stop = None;
+        folded.case = Some(case(&[r#"expect.failure="inverted_element""#]));
+        let runs = [good, late, folded];
         let (text, counts, plots) =
             section(Path::new("out/hard"), &runs, dir.path()).expect("section");
-        // Five checks each; the hourglass check does not apply to the single-layer pads.
-        assert_eq!(counts.passed, 9);
+        // Five checks each for the runs that complete, three for the one expected to fail;
+        // the hourglass check does not apply to the single-layer pads.
+        assert_eq!(counts.passed, 12);
         assert_eq!(counts.failed, 1);
         assert!(plots[0].is_file());
         let row = |name: &str| {
@@ -811,6 +820,11 @@ mod tests {
         );
         assert!(row("2d-late").ends_with("| PASS | PASS | PASS | FAIL | PASS | n/a |"));
         assert!(text.contains("Expectation: why it differs"), "{text}");
+        assert!(
+            row("2d-folded").contains("| failed (as expected) |"),
+            "{}",
+            row("2d-folded")
+        );
         let mut orphan = spin_down("2d-orphan", 600.0);
         orphan.case = None;
         let e = section(Path::new("out/hard"), &[orphan], dir.path()).expect_err("no case");
