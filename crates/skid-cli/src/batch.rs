@@ -80,8 +80,13 @@ pub fn run(paths: &[PathBuf], out: &Path, jobs: usize) -> ExitCode {
     let count = |status| entries.iter().filter(|e| e.status == status).count();
     let expected_failures = count(BatchStatus::FailedAsExpected);
     let as_expected = entries.iter().filter(|e| e.status.as_expected()).count();
+    let expected = if expected_failures > 0 {
+        format!(", {expected_failures} stopped with the failure their case expects")
+    } else {
+        String::new()
+    };
     println!(
-        "{} of {} cases completed, {expected_failures} failed as their case expects; see {}",
+        "{} of {} cases completed{expected}; see {}",
         count(BatchStatus::Completed),
         entries.len(),
         out.join("batch.json").display()

@@ -150,3 +150,51 @@ fn batch_runs_good_cases_past_a_bad_one_and_report_compares_them() {
     assert_eq!(missing.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&missing.stderr).contains("short-a"));
 }
+
+/// A case that stops with the failure it expects does not fail the batch; one that expects
+/// another failure does, and both keep their results.
+#[test]
+fn batch_exits_0_when_a_case_fails_as_it_expects() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let cases = tmp.path().join("cases");
+    std::fs::create_dir(&cases).expect("mkdir");
+    let shipped = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../cases/hard/2d-pressure-x10.json"
+    );
+    std::fs::copy(shipped, cases.join("folds.json")).expect("copy");
+    let runs = tmp.path().join("runs");
+    let batch = |dir: &Path| {
+        let out = skid()
+            .arg("batch")
+            .arg(dir)
+            .arg("--out")
+            .arg(&runs)
+            .output()
+            .expect("runs");
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).to_string(),
+        )
+    };
+    let (code, stdout) = batch(&cases);
+    assert_eq!(code, Some(0), "{stdout}");
+    assert!(
+        stdout.contains("2d-pressure-x10  failed_as_expected"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("0 of 1 cases completed, 1 stopped with the failure their case expects"),
+        "{stdout}"
+    );
+    assert!(runs.join("2d-pressure-x10/history.csv").is_file());
+
+    let text = std::fs::read_to_string(shipped).expect("shipped case");
+    let mut case: serde_json::Value = serde_json::from_str(&text).expect("json");
+    case["expect"]["failure"] = "newton_not_converged".into();
+    std::fs::write(cases.join("folds.json"), case.to_string()).expect("write");
+    let (code, stdout) = batch(&cases);
+    assert_eq!(code, Some(1), "{stdout}");
+    assert!(stdout.contains("2d-pressure-x10  failed "), "{stdout}");
+    assert!(runs.join("2d-pressure-x10/summary.json").is_file());
+}
