@@ -48,8 +48,9 @@ pub const ENERGY_TOLERANCE: f64 = 0.01;
 pub const HOURGLASS_LIMIT: f64 = 0.01;
 /// Elements through the pad's thickness from which [`HOURGLASS_LIMIT`] applies. The ratio is a
 /// discretisation measure of the bending the one-point elements cannot hold in their mean
-/// strain: on the 2D benchmark pad it falls from 5.9 % (10 x 1) to 1.0 % (40 x 4) and 0.37 %
-/// (40 x 8); in 3D, 1.1 % on 40 x 4 x 8 and 0.5 % on 40 x 8 x 8.
+/// strain (largest over the spin-down): on the 2D benchmark pad it falls from 6.4 % (10 x 1) to
+/// 1.2 % (40 x 4) and 0.40 % (40 x 8); in 3D from 8.3 % (10 x 1 x 1) to 1.3 % (40 x 4 x 8) and
+/// 0.65 % (40 x 8 x 8).
 pub const HOURGLASS_MIN_LAYERS: usize = 2;
 /// Largest `|omega - omega0| / |omega0|` without a friction torque (issue 4).
 pub const OMEGA_CONSTANCY: f64 = 1e-9;
@@ -546,8 +547,9 @@ pub fn section(
          - **hourglass**: max hourglass energy / strain energy <= {hourglass} % (issue 4) on pads \
          with {layers} or more elements through the thickness. The ratio measures the bending \
          that one-point elements cannot hold in their mean strain, and falls with the layers \
-         through the thickness: 2D benchmark pad 5.9 % (10 x 1), 1.0 % (40 x 4), 0.37 % \
-         (40 x 8); 3D 1.1 % (40 x 4 x 8), 0.5 % (40 x 8 x 8). On DRUM.md's 10 x 1 (x 1) pads \
+         through the thickness (largest over the spin-down, 2D: 6.4 % on 10 x 1, 1.2 % on \
+         40 x 4, 0.40 % on 40 x 8; 3D: 8.3 % on 10 x 1 x 1, 1.3 % on 40 x 4 x 8, 0.65 % on \
+         40 x 8 x 8). On DRUM.md's 10 x 1 (x 1) pads \
          the hourglass modes carry the pad's bending around the drum (4.5-5 % of the strain \
          energy already in the frictionless preload, in proportion to the stabilisation \
          stiffness), so there the ratio is reported, not checked (n/a); instead \
