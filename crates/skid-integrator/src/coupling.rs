@@ -188,8 +188,13 @@ const NEAR_GAP_FRACTION: f64 = 0.001;
 /// into the surface (`u_N < 0`) joins them and the step is repeated; the result then solves the
 /// Coulomb law for all candidates. `warm` (one force per row) warm-starts the solve.
 ///
+/// `K` is the assembler's current matrix, or the factorization `reuse` of an earlier one (a
+/// modified Newton step: see [`crate::increment`]) unless the near set needs equations it does
+/// not eliminate last. Returns the step, the Coulomb solution and the factorization used.
+///
 /// # Errors
 /// The failures of the factorization and of the Coulomb solve.
+#[allow(clippy::too_many_arguments)] // the inputs of one Newton step, each used once
 pub fn contact_step(
     assembler: &mut Assembler,
     rows: &ContactRows,
@@ -197,8 +202,9 @@ pub fn contact_step(
     warm: &DVector<f64>,
     length: f64,
     settings: &CoulombSettings,
+    reuse: Option<Factorization>,
     timings: &mut Timings,
-) -> Result<(DVector<f64>, CoulombSolution), IncrementFailure> {
+) -> Result<(DVector<f64>, CoulombSolution, Factorization), IncrementFailure> {
     let d = rows.components;
     let nc = rows.len();
     let n = residual.len();
@@ -208,13 +214,22 @@ pub fn contact_step(
         })
         .collect();
     let (mut conic_solves, mut fixed_point_iterations, mut newton_steps) = (0, 0, 0);
+    let mut reuse = reuse;
     let mut current = None;
     loop {
         let clock = Instant::now();
         let candidates: Vec<usize> = (0..nc).filter(|&c| near[c]).collect();
         let needed = rows.equations(&candidates);
+        let eliminated_last =
+            |trailing: &[usize]| needed.iter().all(|eq| trailing.binary_search(eq).is_ok());
+        if reuse
+            .as_ref()
+            .is_some_and(|f| !eliminated_last(f.trailing()))
+        {
+            reuse = None;
+        }
         let trailing = assembler.trailing();
-        if needed.iter().any(|eq| trailing.binary_search(eq).is_err()) {
+        if !eliminated_last(trailing) {
             let mut grown = [trailing, &needed].concat();
             grown.sort_unstable();
             grown.dedup();
@@ -224,7 +239,10 @@ pub fn contact_step(
         let (factor, dx0) = match current.take() {
             Some(current) => current,
             None => {
-                let f = assembler.factorize()?;
+                let f = match reuse.take() {
+                    Some(f) => f,
+                    None => assembler.factorize()?,
+                };
                 let dx0 = f.solve(&(-residual));
                 (f, dx0)
             }
@@ -280,7 +298,7 @@ pub fn contact_step(
                 newton_steps,
                 natural_map_error: solution.natural_map_error,
             };
-            return Ok((dx, solution));
+            return Ok((dx, solution, factor));
         }
         current = Some((factor, dx0));
     }
@@ -658,28 +676,27 @@ mod tests {
         let mut timings = Timings::default();
         let touching = (0..rows.len()).filter(|&c| rows.u[c * D] < 1e-12).count();
         assert!(touching > 0 && touching < rows.len());
+        let mut step = |length, reuse| {
+            contact_step(
+                &mut assembler,
+                &rows,
+                &residual,
+                &warm,
+                length,
+                &settings,
+                reuse,
+                &mut timings,
+            )
+        };
         // a tiny model length: only the touching candidates are near at first
-        let (dx, local) = contact_step(
-            &mut assembler,
-            &rows,
-            &residual,
-            &warm,
-            1e-9,
-            &settings,
-            &mut timings,
-        )
-        .expect("local");
-        // a huge one: every candidate is near
-        let (dx_all, all) = contact_step(
-            &mut assembler,
-            &rows,
-            &residual,
-            &warm,
-            1e3,
-            &settings,
-            &mut timings,
-        )
-        .expect("all");
+        let (dx, local, local_factor) = step(1e-9, None).expect("local");
+        // a huge one: every candidate is near; the local factorization offered for reuse does
+        // not eliminate their equations last, so the matrix is factorized again
+        let (dx_all, all, all_factor) = step(1e3, Some(local_factor)).expect("all");
+        // reusing the factorization of the same matrix gives the same step
+        let (dx_reused, reused, _) = step(1e3, Some(all_factor)).expect("reused");
+        assert!((&dx_reused - &dx_all).amax() <= 1e-12 * dx_all.amax());
+        assert!((&reused.r - &all.r).amax() <= 1e-12 * all.r.amax());
         let carrying = (0..rows.len()).filter(|&c| local.r[c * D] > 0.0).count();
         assert!(carrying > touching, "{D}D: {carrying} carry force");
         assert!(

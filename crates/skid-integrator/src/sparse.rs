@@ -12,7 +12,7 @@
 //! inverse formula `(K^{-1})_CC = S^{-1} = L_CC^{-T} L_CC^{-1}`: a dense inverse of the size of
 //! `C`, instead of `|C|` sparse solves with the whole factor.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
@@ -146,6 +146,7 @@ impl SparsePattern {
             factor,
             trailing: Arc::clone(&self.trailing),
             n: self.n,
+            trailing_inverse: OnceLock::new(),
         })
     }
 }
@@ -221,6 +222,8 @@ pub struct Factorization {
     factor: Vec<f64>,
     trailing: Arc<[usize]>,
     n: usize,
+    /// [`Self::trailing_inverse`], computed on first use.
+    trailing_inverse: OnceLock<DMatrix<f64>>,
 }
 
 impl Factorization {
@@ -252,8 +255,13 @@ impl Factorization {
 
     /// `(K^{-1})_CC`, the block of the inverse on the trailing equations `C` (in the order of
     /// [`Self::trailing`]): `S^{-1} = L_CC^{-T} L_CC^{-1}` from the trailing diagonal block of the
-    /// factor (see the module documentation).
-    pub fn trailing_inverse(&self) -> DMatrix<f64> {
+    /// factor (see the module documentation). Computed once per factorization.
+    pub fn trailing_inverse(&self) -> &DMatrix<f64> {
+        self.trailing_inverse
+            .get_or_init(|| self.compute_trailing_inverse())
+    }
+
+    fn compute_trailing_inverse(&self) -> DMatrix<f64> {
         let c = self.trailing.len();
         let first = self.n - c;
         let mut l_cc = Mat::<f64>::zeros(c, c);
@@ -384,7 +392,7 @@ mod tests {
             inverse[(trailing[a], trailing[b])]
         });
         assert!(
-            (&block - &expected).amax() < 1e-12 * expected.amax(),
+            (block - &expected).amax() < 1e-12 * expected.amax(),
             "{block} vs {expected}"
         );
         // the solve is unaffected by the ordering
