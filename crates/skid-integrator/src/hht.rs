@@ -75,15 +75,16 @@ impl Hht {
         1.0 / (self.beta * h * h)
     }
 
-    /// Predictor `x_{n+1} = x_n + h v_n + h^2/2 a_n` (constant acceleration).
-    pub fn predict(
-        &self,
-        h: f64,
-        x: &DVector<f64>,
-        v: &DVector<f64>,
-        a: &DVector<f64>,
-    ) -> DVector<f64> {
-        x + v * h + a * (0.5 * h * h)
+    /// Predictor, Newton's first iterate: `x_{n+1} = x_n + h v_n` (constant velocity).
+    ///
+    /// The stored acceleration is the smooth one, without the contact forces (see
+    /// [`crate::increment`]); for a node held by contact it is the whole unbalanced elastic and
+    /// pressure force over the nodal mass, far from its true acceleration. Extrapolating it
+    /// (`+ h^2/2 a_n`) pushed loaded nodes into the drum by up to centimetres at millisecond
+    /// steps, which cost iterations and cutbacks and could carry an iterate over a drum's rim
+    /// onto another branch of the contact problem.
+    pub fn predict(&self, h: f64, x: &DVector<f64>, v: &DVector<f64>) -> DVector<f64> {
+        x + v * h
     }
 
     /// Factor `2 beta` that turns the increment's contact unknown `r` into the mean contact

@@ -140,7 +140,7 @@ pub fn solve_increment<const D: usize>(
     };
     let mut x = match kind {
         IncrementKind::Static { .. } => start.x.clone(),
-        IncrementKind::Dynamic { hht, h } => hht.predict(h, &start.x, &start.v, &start.a),
+        IncrementKind::Dynamic { hht, h } => hht.predict(h, &start.x, &start.v),
     };
     for (eq, &h) in held.iter().enumerate() {
         if h {
