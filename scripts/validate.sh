@@ -36,8 +36,8 @@ run 2d-analytic cases/drum/2d-analytic.json
 run 2d-analytic-dt-half cases/drum/2d-analytic.json 'steps[1].dt=5e-5'
 run 2d-analytic-density-x2 cases/drum/2d-analytic.json 'pad.density=2000'
 run 2d-analytic-conic cases/drum/2d-analytic.json 'solver.coulomb_method="conic"'
+run 3d-analytic cases/drum/3d-analytic.json
 for d in 2d 3d; do
-    [ "$d" = 3d ] && run 3d-analytic cases/drum/3d-analytic.json
     for scale in 0.5 2; do
         run "$d-analytic-hourglass-x$scale" "cases/drum/$d-analytic.json" "pad.hourglass_scale=$scale"
     done
