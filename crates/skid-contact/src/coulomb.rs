@@ -22,6 +22,7 @@
 //! of a dense solve on the closed contacts. The conic fixed point is the fallback, and Newton
 //! also refines each of its iterates.
 
+pub mod alart_curnier;
 mod cone;
 mod conic_program;
 mod newton;

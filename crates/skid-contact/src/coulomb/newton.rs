@@ -1,21 +1,10 @@
-//! Semismooth Newton on the Alart–Curnier function of the exact Coulomb law.
+//! Semismooth Newton on the Alart–Curnier function of the exact Coulomb law in Delassus form.
 //!
 //! With `u = W r + q` and a force-per-length weight `rho_i` per contact (the inverse mean
-//! compliance), the law holds exactly where `Phi(r) = 0`, contact by contact:
-//!
-//! * `tau = r_N - rho u_N`, `v = r_T - rho u_T`;
-//! * open (`tau <= 0`): `Phi = r`;
-//! * closed (`tau > 0`): `Phi_N = rho u_N` and `Phi_T = r_T - proj_{B(mu tau)}(v)`, i.e.
-//!   stick (`||v|| <= mu tau`): `Phi_T = rho u_T`; slide: `Phi_T = r_T - mu tau v / ||v||`.
-//!
-//! (Alart & Curnier, CMAME 92, 1991.) `Phi = 0` means `r_N >= 0`, `u_N >= 0`, `r_N u_N = 0` and,
-//! while closed, either `u_T = 0` with `||r_T|| <= mu r_N` or `r_T = -mu r_N u_T / ||u_T||`: the
-//! same solutions as the De Saxcé form, without dilation. `Phi` is piecewise smooth, so Newton
-//! with a generalized Jacobian converges quadratically near a solution; the step is damped by a
-//! backtracking (Armijo) line search on `||Phi||^2`. On the slide branch, with `d = v / ||v||`,
-//!
-//! `dPhi_T = dr_T - mu d dtau - (mu tau / ||v||) (I - d d^T) dv`,
-//! `dtau = dr_N - rho (W dr)_N`, `dv = dr_T - rho (W dr)_T`.
+//! compliance), the law holds exactly where `Phi(r) = 0`, contact by contact, with `Phi` the
+//! local function of [`super::alart_curnier`]. `Phi` is piecewise smooth, so Newton with the
+//! generalized Jacobian `dPhi/dr|_u + dPhi/du W` converges quadratically near a solution; the
+//! step is damped by a backtracking (Armijo) line search on `||Phi||^2`.
 //!
 //! Open contacts take the step `dr = -r` outright, so only the closed ones enter the dense
 //! linear solve.
@@ -24,6 +13,7 @@ use faer::Mat;
 use faer::linalg::solvers::Solve;
 use nalgebra::{DMatrix, DVector};
 
+use super::alart_curnier::{LocalBranch, LocalLaw};
 use super::polish::Candidate;
 use super::{FrictionProblem, inverse_mean_compliance, natural_map};
 
@@ -35,129 +25,63 @@ const ARMIJO: f64 = 1e-4;
 /// Halvings of the step before the line search gives up.
 const MAX_HALVINGS: usize = 30;
 
-/// Branch of `Phi` at one contact.
-enum Branch {
-    Open,
-    Stick,
-    /// Closed with a zero friction radius (`mu = 0`): `Phi_T = r_T`.
-    Frictionless,
-    /// Sliding: unit direction `d` of `v_T`, and the factor `mu tau / ||v||`.
-    Slide {
-        direction: [f64; 2],
-        factor: f64,
-    },
-}
-
-/// The Alart–Curnier function `Phi` at `(r, u)` and the branch of every contact.
+/// The Alart–Curnier function `Phi` at `(r, u)` and the local law of every contact.
 fn evaluate(
     problem: &FrictionProblem,
     rho: &[f64],
     r: &DVector<f64>,
     u: &DVector<f64>,
-) -> (DVector<f64>, Vec<Branch>) {
+) -> (DVector<f64>, Vec<LocalLaw>) {
     let dim = problem.dim;
     let mut phi = DVector::zeros(r.len());
-    let branches = problem
+    let laws = problem
         .mu
         .iter()
         .enumerate()
         .map(|(i, &mu)| {
-            let k = dim * i;
-            let tau = r[k] - rho[i] * u[k];
-            if tau <= 0.0 {
-                phi.rows_mut(k, dim).copy_from(&r.rows(k, dim));
-                return Branch::Open;
-            }
-            phi[k] = rho[i] * u[k];
-            let mut v = [0.0; 2];
-            for t in 1..dim {
-                v[t - 1] = r[k + t] - rho[i] * u[k + t];
-            }
-            let norm = v.iter().map(|c| c * c).sum::<f64>().sqrt();
-            let radius = mu * tau;
-            if radius == 0.0 {
-                phi.rows_mut(k + 1, dim - 1)
-                    .copy_from(&r.rows(k + 1, dim - 1));
-                Branch::Frictionless
-            } else if norm <= radius {
-                for t in 1..dim {
-                    phi[k + t] = rho[i] * u[k + t];
-                }
-                Branch::Stick
-            } else {
-                let direction = v.map(|c| c / norm);
-                for t in 1..dim {
-                    phi[k + t] = r[k + t] - radius * direction[t - 1];
-                }
-                Branch::Slide {
-                    direction,
-                    factor: radius / norm,
-                }
-            }
+            let range = dim * i..dim * (i + 1);
+            let law = LocalLaw::evaluate(
+                dim,
+                mu,
+                rho[i],
+                &r.as_slice()[range.clone()],
+                &u.as_slice()[range],
+            );
+            phi.rows_mut(dim * i, dim).copy_from_slice(&law.phi[..dim]);
+            law
         })
         .collect();
-    (phi, branches)
+    (phi, laws)
 }
 
-/// The generalized Jacobian `dPhi/dr` of the closed contacts, transposed (`m` rows, one column
-/// per closed-contact row of `Phi`, in contact order), with the indices of those rows. `W` is
-/// symmetric, so its rows are read as (contiguous) columns.
+/// The generalized Jacobian `dPhi/dr = dPhi/dr|_u + dPhi/du W` of the closed contacts,
+/// transposed (`m` rows, one column per closed-contact row of `Phi`, in contact order), with
+/// the indices of those rows. `W` is symmetric, so its rows are read as (contiguous) columns.
 fn closed_jacobian_transposed(
     problem: &FrictionProblem,
     w: &DMatrix<f64>,
-    rho: &[f64],
-    branches: &[Branch],
+    laws: &[LocalLaw],
 ) -> (DMatrix<f64>, Vec<usize>) {
     let dim = problem.dim;
-    let rows: Vec<usize> = branches
+    let closed = |law: &LocalLaw| law.branch != LocalBranch::Open;
+    let rows: Vec<usize> = laws
         .iter()
         .enumerate()
-        .filter(|(_, b)| !matches!(b, Branch::Open))
+        .filter(|(_, law)| closed(law))
         .flat_map(|(i, _)| dim * i..dim * (i + 1))
         .collect();
     let mut transposed = DMatrix::zeros(w.nrows(), rows.len());
     let mut a = 0;
-    for (i, branch) in branches.iter().enumerate() {
+    for (i, law) in laws.iter().enumerate().filter(|(_, law)| closed(law)) {
         let k = dim * i;
-        let rho = rho[i];
         // column a + t of the transpose is row k + t of the Jacobian
-        let mut column = |t: usize, terms: &[(usize, f64)], units: &[(usize, f64)]| {
+        for t in 0..dim {
             let mut target = transposed.column_mut(a + t);
-            for &(j, coefficient) in terms {
-                target.axpy(coefficient, &w.column(j), 1.0);
-            }
-            for &(j, value) in units {
-                target[j] += value;
-            }
-        };
-        match branch {
-            Branch::Open => continue,
-            Branch::Stick => {
-                for t in 0..dim {
-                    column(t, &[(k + t, rho)], &[]);
+            for s in 0..dim {
+                if law.d_u[t][s] != 0.0 {
+                    target.axpy(law.d_u[t][s], &w.column(k + s), 1.0);
                 }
-            }
-            Branch::Frictionless => {
-                column(0, &[(k, rho)], &[]);
-                for t in 1..dim {
-                    column(t, &[], &[(k + t, 1.0)]);
-                }
-            }
-            Branch::Slide { direction, factor } => {
-                column(0, &[(k, rho)], &[]);
-                let mu = problem.mu[i];
-                // e_T - mu d (e_N - rho W_N) - factor (I - d d^T) (e_T - rho W_T)
-                for t in 1..dim {
-                    let mut terms = vec![(k, rho * mu * direction[t - 1])];
-                    let mut units = vec![(k, -mu * direction[t - 1]), (k + t, 1.0)];
-                    for s in 1..dim {
-                        let projector =
-                            f64::from(u8::from(s == t)) - direction[t - 1] * direction[s - 1];
-                        terms.push((k + s, factor * rho * projector));
-                        units.push((k + s, -factor * projector));
-                    }
-                    column(t, &terms, &units);
-                }
+                target[k + s] += law.d_r[t][s];
             }
         }
         a += dim;
@@ -170,20 +94,19 @@ fn closed_jacobian_transposed(
 fn newton_step(
     problem: &FrictionProblem,
     w: &DMatrix<f64>,
-    rho: &[f64],
     r: &DVector<f64>,
     phi: &DVector<f64>,
-    branches: &[Branch],
+    laws: &[LocalLaw],
 ) -> Option<DVector<f64>> {
     let dim = problem.dim;
     let mut step = DVector::zeros(r.len());
-    for (i, branch) in branches.iter().enumerate() {
-        if matches!(branch, Branch::Open) {
+    for (i, law) in laws.iter().enumerate() {
+        if law.branch == LocalBranch::Open {
             step.rows_mut(dim * i, dim)
                 .copy_from(&(-r.rows(dim * i, dim)));
         }
     }
-    let (transposed, rows) = closed_jacobian_transposed(problem, w, rho, branches);
+    let (transposed, rows) = closed_jacobian_transposed(problem, w, laws);
     if rows.is_empty() {
         return Some(step);
     }
@@ -219,7 +142,7 @@ pub(crate) fn newton(
     let mut merit = phi.norm_squared();
     let mut steps = 0;
     while best.error > tolerance && steps < MAX_STEPS {
-        let Some(dr) = newton_step(problem, w, &rho, &r, &phi, &branches) else {
+        let Some(dr) = newton_step(problem, w, &r, &phi, &branches) else {
             break;
         };
         steps += 1;
@@ -294,17 +217,10 @@ mod tests {
             .map(|i| inverse_mean_compliance(&problem, i))
             .collect();
         let (_, branches) = evaluate(&problem, &rho, &r, &u);
-        let kinds: Vec<&str> = branches
-            .iter()
-            .map(|b| match b {
-                Branch::Open => "open",
-                Branch::Stick => "stick",
-                Branch::Frictionless => "frictionless",
-                Branch::Slide { .. } => "slide",
-            })
-            .collect();
-        assert_eq!(kinds, ["open", "stick", "slide", "frictionless"], "{dim}D");
-        let (transposed, rows) = closed_jacobian_transposed(&problem, &w, &rho, &branches);
+        let kinds: Vec<LocalBranch> = branches.iter().map(|law| law.branch).collect();
+        use LocalBranch::{Frictionless, Open, Slide, Stick};
+        assert_eq!(kinds, [Open, Stick, Slide, Frictionless], "{dim}D");
+        let (transposed, rows) = closed_jacobian_transposed(&problem, &w, &branches);
         let h = 1e-7;
         for j in 0..m {
             let phi_at = |sign: f64| {
