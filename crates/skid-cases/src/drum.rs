@@ -18,11 +18,14 @@ use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 use skid_fem::tetra::TetMesh;
-use skid_integrator::increment::NewtonSettings;
+use skid_integrator::increment::{ContactSolve, NewtonSettings};
 use skid_integrator::stepper::{CutbackSettings, Settings, Step, StepKind};
 use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, Tie};
 
-use crate::schema::{Case, ContactFormulation, DrumSurfaceSpec, MaterialSpec, StepSpec};
+use crate::schema::{
+    Case, ContactFormulation, ContactSolveSpec, CoulombMethodSpec, DrumSurfaceSpec, MaterialSpec,
+    StepSpec,
+};
 
 /// Index of the drum among the model's rigid bodies.
 pub const DRUM: usize = 0;
@@ -200,6 +203,11 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
             max_fixed_point_iterations: s.max_fixed_point_iterations,
             method: s.coulomb_method.into(),
             ..Default::default()
+        },
+        // the conic method solves the Coulomb problem on the Delassus operator: the reduced path
+        contact_solve: match (s.contact_solve, s.coulomb_method) {
+            (ContactSolveSpec::Global, CoulombMethodSpec::NewtonFirst) => ContactSolve::Global,
+            _ => ContactSolve::Reduced,
         },
         cutback: CutbackSettings {
             factor: s.cutback_factor,

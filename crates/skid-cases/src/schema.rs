@@ -264,6 +264,8 @@ pub struct SolverSpec {
     pub max_fixed_point_iterations: usize,
     /// Which algorithm leads the Coulomb solve.
     pub coulomb_method: CoulombMethodSpec,
+    /// How each Newton iteration obtains its contact forces.
+    pub contact_solve: ContactSolveSpec,
     /// Increment size factor after a failure.
     pub cutback_factor: f64,
     /// Consecutive cutbacks before the run stops.
@@ -282,6 +284,7 @@ impl Default for SolverSpec {
             coulomb_tolerance: coulomb.tolerance,
             max_fixed_point_iterations: coulomb.max_fixed_point_iterations,
             coulomb_method: CoulombMethodSpec::default(),
+            contact_solve: ContactSolveSpec::default(),
             cutback_factor: cutback.factor,
             max_cutbacks: cutback.max_cutbacks,
         }
@@ -307,6 +310,20 @@ impl From<CoulombMethodSpec> for skid_contact::coulomb::CoulombMethod {
             CoulombMethodSpec::Conic => Self::Conic,
         }
     }
+}
+
+/// How each Newton iteration obtains its contact forces (see
+/// `skid_integrator::increment::ContactSolve`).
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactSolveSpec {
+    /// Step and forces together on one sparse system (semismooth Newton on the Alart–Curnier
+    /// function); an increment it does not converge is solved again by `reduced`.
+    Global,
+    /// The exact Coulomb problem on the dense Delassus operator of the contact set, by
+    /// `coulomb_method` (which `conic` requires).
+    #[default]
+    Reduced,
 }
 
 /// Output settings; every field is optional.

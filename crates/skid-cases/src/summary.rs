@@ -49,6 +49,8 @@ pub struct Summary {
     pub fixed_point_iterations: usize,
     /// Semismooth Newton steps of the contact solves.
     pub contact_newton_steps: usize,
+    /// Increments the global contact solve did not converge and the reduced one solved.
+    pub contact_fallbacks: usize,
     /// Failed attempts answered by a cutback.
     pub cutbacks: usize,
     /// The failed attempts by cause (e.g. "newton not converged": 3).
@@ -222,6 +224,7 @@ pub fn summarize(
         contact_solves: stats.contact_solves,
         fixed_point_iterations: stats.fixed_point_iterations,
         contact_newton_steps: stats.contact_newton_steps,
+        contact_fallbacks: stats.contact_fallbacks,
         cutbacks: stats.cutbacks,
         cutback_causes: stats
             .cutback_causes

@@ -5,6 +5,7 @@
 //! effective tangent has the form `K_eff = c_K K_T + diag(c_M m)` (HHT: `c_K = 1 + alpha`,
 //! `c_M = 1/(beta h^2)`); equations held fixed in a step get an identity row and column.
 
+use faer::sparse::SparseColMat;
 use nalgebra::{DVector, SVector};
 use rayon::prelude::*;
 use skid_fem::error::FemError;
@@ -259,6 +260,14 @@ impl Assembler {
         self.pattern
             .eliminate_last(trailing)
             .map_err(IncrementFailure::LinearSolve)
+    }
+
+    /// The lower triangle of the current effective tangent, compressed.
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] for non-finite entries.
+    pub fn lower_triangle(&self) -> Result<SparseColMat<usize, f64>, IncrementFailure> {
+        self.pattern.lower_triangle(&self.values)
     }
 
     /// Factorizes the current effective tangent.

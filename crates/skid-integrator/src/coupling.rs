@@ -512,26 +512,7 @@ fn local_curvature<const D: usize>(kin: &ContactKinematics, comp: usize) -> DMat
 mod tests {
     use super::*;
     use crate::assembly::Assembler;
-    use crate::model::ContactPair;
-    use crate::test_support::{body, pad_block};
-    use skid_contact::surface::AnalyticCylinder;
-
-    /// A block above a drum of radius 0.2 that spins about z and may also translate in x.
-    fn block_on_drum<const D: usize>() -> Model<D> {
-        let part = pad_block::<D>([-0.05, 0.2, -0.05], [0.1, 0.05, 0.1], [4, 1, 2]);
-        let front = part.mesh.node_sets["ymin"].clone();
-        let mut free = [false; D];
-        free[0] = true;
-        let drum = body::<D>("drum", free, Some(Vector3::z()), 5.0, 0.175);
-        let pair = ContactPair {
-            name: "pad-drum".into(),
-            nodes: front,
-            body: 0,
-            surface: Box::new(AnalyticCylinder::new(0.2, Vector3::z()).expect("surface")),
-            mu: 0.15,
-        };
-        Model::new(part, vec![drum], vec![], vec![], vec![pair]).expect("model")
-    }
+    use crate::test_support::block_on_drum;
 
     /// `H dx` predicts the change of gaps and slips for a small motion of nodes and drum.
     fn rows_are_the_derivative_of_the_kinematics<const D: usize>() {

@@ -10,7 +10,10 @@
 //! - [`mixed`]: the element pressures of the mixed (u-p) tangent between Newton iterates;
 //! - [`hht`]: the HHT-alpha / Newmark relations between displacement, velocity and acceleration;
 //! - [`coupling`]: the contact rows H (gap and slip linearised in the global unknowns) and the
-//!   reduction of one Newton step to the exact-Coulomb problem in the contact forces;
+//!   reduction of one Newton step to the exact-Coulomb problem in the contact forces (the dense
+//!   reference path);
+//! - [`global_contact`]: one Newton step of unknowns and contact forces together, on a sparse
+//!   unsymmetric system (the default path);
 //! - [`increment`]: Newton-Raphson for one increment (static or dynamic);
 //! - [`stepper`]: steps, automatic cutback, and reporting of converged increments.
 //!
@@ -21,8 +24,10 @@ pub mod assembly;
 pub mod coupling;
 pub mod dof;
 pub mod error;
+pub mod global_contact;
 pub mod hht;
 pub mod increment;
+pub mod krylov;
 pub mod mixed;
 pub mod model;
 pub mod sparse;

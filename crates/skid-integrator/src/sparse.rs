@@ -109,6 +109,22 @@ impl SparsePattern {
         self.n
     }
 
+    /// The lower triangle of the matrix whose slot values are `values`, compressed (entries at
+    /// the same position summed).
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] for non-finite values.
+    pub fn lower_triangle(
+        &self,
+        values: &[f64],
+    ) -> Result<SparseColMat<usize, f64>, IncrementFailure> {
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(IncrementFailure::LinearSolve(NON_FINITE_TANGENT.into()));
+        }
+        SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
+            .map_err(|e| IncrementFailure::LinearSolve(format!("{e:?}")))
+    }
+
     /// Numeric Cholesky factorization `K = L L^T` of the matrix whose slot values are `values`,
     /// reusing the symbolic analysis.
     ///

@@ -16,9 +16,11 @@ use skid_contact::coulomb::CoulombSettings;
 use crate::assembly::{Assembler, external_forces};
 use crate::coupling::contact_rows;
 use crate::error::{IncrementFailure, RunError};
+use crate::global_contact::GlobalContactSolver;
 use crate::hht::Hht;
 use crate::increment::{
-    IncrementCounters, IncrementKind, NewtonSettings, Timings, solve_increment,
+    ContactSolve, IncrementCounters, IncrementKind, NewtonSettings, Timings, Workspace,
+    solve_increment,
 };
 use crate::model::Model;
 use crate::state::{ContactPointState, EnergyLedger, State};
@@ -90,6 +92,8 @@ pub struct Settings {
     pub newton: NewtonSettings,
     /// Exact-Coulomb solver settings.
     pub coulomb: CoulombSettings,
+    /// How each Newton iteration obtains its contact forces.
+    pub contact_solve: ContactSolve,
     /// Cutback settings.
     pub cutback: CutbackSettings,
 }
@@ -137,6 +141,9 @@ pub struct RunStatistics {
     pub fixed_point_iterations: usize,
     /// Semismooth Newton steps of the contact solves of converged increments.
     pub contact_newton_steps: usize,
+    /// Converged increments whose global contact solve failed and that the reduced one solved
+    /// (see [`crate::increment::solve_increment`]).
+    pub contact_fallbacks: usize,
     /// Failed attempts answered by a cutback.
     pub cutbacks: usize,
     /// The failed attempts by kind of failure ([`IncrementFailure::kind`]).
@@ -296,7 +303,10 @@ fn run_steps<const D: usize>(
     };
     let mut state =
         initial_state(model, if starts_static { 0.0 } else { 1.0 }).map_err(fail_initial)?;
-    let mut assembler = Assembler::new(model).map_err(|e| RunError::Invalid(e.to_string()))?;
+    let mut workspace = Workspace {
+        assembler: Assembler::new(model).map_err(|e| RunError::Invalid(e.to_string()))?,
+        global: GlobalContactSolver::default(),
+    };
     let none = IncrementCounters::default();
     observer.on_increment(
         model,
@@ -349,7 +359,7 @@ fn run_steps<const D: usize>(
             };
             match solve_increment(
                 model,
-                &mut assembler,
+                &mut workspace,
                 &state,
                 kind,
                 &held,
@@ -369,6 +379,7 @@ fn run_steps<const D: usize>(
                     stats.contact_solves += counters.contact_solves;
                     stats.fixed_point_iterations += counters.fixed_point_iterations;
                     stats.contact_newton_steps += counters.contact_newton_steps;
+                    stats.contact_fallbacks += counters.contact_fallbacks;
                     observer.on_increment(
                         model,
                         &IncrementReport {

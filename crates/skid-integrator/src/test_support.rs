@@ -5,7 +5,9 @@ use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 
-use crate::model::SolidPart;
+use skid_contact::surface::AnalyticCylinder;
+
+use crate::model::{ContactPair, Model, SolidPart};
 
 /// A structured block of the benchmark pad material (first D entries of each array are used).
 pub(crate) fn pad_block<const D: usize>(
@@ -46,4 +48,21 @@ pub(crate) fn body<const D: usize>(
         initial_velocity: SVector::zeros(),
         initial_angular_velocity: 0.0,
     }
+}
+
+/// A block above a drum of radius 0.2 that spins about z and may also translate in x.
+pub(crate) fn block_on_drum<const D: usize>() -> Model<D> {
+    let part = pad_block::<D>([-0.05, 0.2, -0.05], [0.1, 0.05, 0.1], [4, 1, 2]);
+    let front = part.mesh.node_sets["ymin"].clone();
+    let mut free = [false; D];
+    free[0] = true;
+    let drum = body::<D>("drum", free, Some(Vector3::z()), 5.0, 0.175);
+    let pair = ContactPair {
+        name: "pad-drum".into(),
+        nodes: front,
+        body: 0,
+        surface: Box::new(AnalyticCylinder::new(0.2, Vector3::z()).expect("surface")),
+        mu: 0.15,
+    };
+    Model::new(part, vec![drum], vec![], vec![], vec![pair]).expect("model")
 }

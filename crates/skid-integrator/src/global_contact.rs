@@ -1,0 +1,558 @@
+//! One Newton iteration of the contact-coupled problem in global form: the step of the unknowns
+//! and the new contact forces from one sparse unsymmetric system, with no dense operator on the
+//! contact set.
+//!
+//! The increment solves, for the unknowns `x` and the contact forces `r` (`dim` per candidate),
+//!
+//! `R(x) - H(x)^T r = 0`,  `Phi_c(u_c(x), r_c) = 0` for every candidate `c`,
+//!
+//! with `R` the residual without contact, `u_c` the candidate's gap and slip and `Phi_c` the
+//! Alart–Curnier function of the exact Coulomb law ([`skid_contact::coulomb::alart_curnier`]).
+//! Semismooth Newton at `(x, r)` with the generalized derivatives `Phi_u`, `Phi_r` of every
+//! candidate's branch gives, for the step `dx` and the new forces `r' = r + dr`,
+//!
+//! ```text
+//! [ K          -H^T  ] [dx]   [ -R             ]
+//! [ Phi_u H    Phi_r ] [r' ] = [ -Phi + Phi_r r ]
+//! ```
+//!
+//! where `K` is the effective tangent with the curvature stiffness of the forces `r` (see
+//! [`crate::coupling::ContactRows::curvature_stiffness`]), so that the first block row is the
+//! exact linearisation of `R - H^T r`. An open candidate has `Phi_r = I`, `Phi_u = 0` (its new
+//! force is zero), a sticking one `H_c dx = -u_c`, a sliding one `u_N = 0` with its friction on
+//! the cone's edge. Nothing requires `K` to be positive definite, and sliding rows make the
+//! matrix unsymmetric: it is factorized by sparse LU with partial pivoting.
+//!
+//! Each candidate's forces enter scaled by its weight `rho_c`, the unknown being
+//! `y_c = r'_c / rho_c` (a length), so that every block of the matrix is a stiffness and the
+//! pivoting compares like with like. `rho_c` is the inverse of the diagonal approximation
+//! `sum_j H_kj^2 / K_jj` of the candidate's compliance (averaged over its rows).
+//!
+//! The pattern only depends on which equations each candidate involves, so its symbolic
+//! analysis (column ordering and elimination structure) is computed once and reused for as
+//! long as that does not change.
+
+use std::sync::Arc;
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::lu::{
+    LuRef, LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu,
+};
+use faer::sparse::{Argsort, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat};
+use faer::{Conj, Mat};
+use nalgebra::DVector;
+use skid_contact::coulomb::alart_curnier::{LocalBranch, LocalLaw};
+
+use crate::coupling::{ContactRows, contact_coordinates};
+use crate::error::IncrementFailure;
+use crate::krylov::gmres;
+use crate::model::Model;
+
+/// Relative residual `||b - A z|| / ||b||` to which a system is solved iteratively on an
+/// earlier factorization; far below what Newton's quadratic convergence needs.
+const KRYLOV_TOLERANCE: f64 = 1e-12;
+/// BiCGSTAB iterations on an earlier factorization before the matrix is factorized afresh.
+const KRYLOV_MAX_ITERATIONS: usize = 8;
+
+/// The symbolic analysis of the last pattern, kept while the pattern stays the same.
+#[derive(Debug)]
+struct Analysed {
+    pairs: Vec<Pair<usize, usize>>,
+    symbolic: SymbolicSparseColMat<usize>,
+    argsort: Argsort<usize>,
+    lu: Arc<SymbolicLu<usize>>,
+}
+
+/// A numeric LU factorization of an earlier matrix of the current pattern, applied as `A^{-1}`.
+#[derive(Debug)]
+struct Factors {
+    symbolic: Arc<SymbolicLu<usize>>,
+    numeric: NumericLu<usize, f64>,
+}
+
+impl Factors {
+    /// Writes `A^{-1} b` into `out`.
+    fn solve(&self, b: &DVector<f64>, out: &mut DVector<f64>) {
+        let par = faer::get_global_parallelism();
+        let mut scratch = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, par));
+        let mut column = Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
+        LuRef::new_unchecked(&self.symbolic, &self.numeric).solve_in_place_with_conj(
+            Conj::No,
+            column.as_mut(),
+            par,
+            MemStack::new(&mut scratch),
+        );
+        for (o, c) in out.iter_mut().zip(column.col(0).iter()) {
+            *o = *c;
+        }
+    }
+}
+
+/// `out = A x` for a sparse `A`.
+fn sparse_times(a: SparseColMatRef<'_, usize, f64>, x: &DVector<f64>, out: &mut DVector<f64>) {
+    out.fill(0.0);
+    for j in 0..a.ncols() {
+        let xj = x[j];
+        for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+            out[i] += v * xj;
+        }
+    }
+}
+
+/// The global contact step, with the symbolic analysis and the factorization it reuses across
+/// Newton iterations and increments.
+///
+/// Each system is first solved by GMRES (see [`crate::krylov`]) preconditioned with the last factorization (exact
+/// for the matrix it was computed from; the matrix of the next iteration or increment differs
+/// by the change of the state and, where a candidate changed branch, by a low-rank term, so a
+/// few iterations suffice). The result is accepted only if its true residual is below
+/// [`KRYLOV_TOLERANCE`]; otherwise, or after [`KRYLOV_MAX_ITERATIONS`], the matrix is factorized
+/// and solved directly, and that factorization serves from then on.
+#[derive(Debug, Default)]
+pub struct GlobalContactSolver {
+    analysed: Option<Analysed>,
+    factors: Option<Factors>,
+    /// Numeric LU factorizations performed.
+    pub factorizations: usize,
+    /// Systems solved iteratively on an earlier factorization.
+    pub iterative_solves: usize,
+    /// Symbolic analyses performed.
+    pub analyses: usize,
+}
+
+/// The result of [`GlobalContactSolver::step`].
+#[derive(Clone, Debug)]
+pub struct GlobalStep {
+    /// Step of the unknowns.
+    pub dx: DVector<f64>,
+    /// New contact forces `r'` (one per contact row).
+    pub r: DVector<f64>,
+}
+
+impl GlobalContactSolver {
+    /// Solves the linearised system of the module documentation at the current iterate: `k` is
+    /// the lower triangle of the effective tangent (with the contact curvature of `r` and the
+    /// held equations replaced by identity rows), `rows` the contact rows at the iterate,
+    /// `residual` the residual without contact (zero on held equations), `r` the current
+    /// forces and `rho` the candidates' weights (see [`contact_weights`]).
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] if the system is singular or not finite.
+    #[allow(clippy::too_many_arguments)] // the data of one Newton iteration, each used once
+    pub fn step<const D: usize>(
+        &mut self,
+        model: &Model<D>,
+        k: SparseColMatRef<'_, usize, f64>,
+        rows: &ContactRows,
+        residual: &DVector<f64>,
+        r: &DVector<f64>,
+        rho: &[f64],
+        held: &[bool],
+    ) -> Result<GlobalStep, IncrementFailure> {
+        let n = residual.len();
+        let d = rows.components;
+        let m = rows.rows.len();
+        let mut pairs: Vec<Pair<usize, usize>> = Vec::new();
+        let mut values: Vec<f64> = Vec::new();
+        let mut push = |i: usize, j: usize, v: f64| {
+            pairs.push(Pair::new(i, j));
+            values.push(v);
+        };
+        for j in 0..n {
+            for (&i, &v) in k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
+                push(i, j, v);
+                if i != j {
+                    push(j, i, v);
+                }
+            }
+        }
+        let mut rhs = DVector::<f64>::zeros(n + m);
+        for i in 0..n {
+            rhs[i] = -residual[i];
+        }
+        let candidates = model
+            .contacts()
+            .iter()
+            .enumerate()
+            .flat_map(|(p, pair)| pair.nodes.iter().map(move |&node| (p, node)));
+        for (c, (pair, node)) in candidates.enumerate().take(rows.len()) {
+            let equations: Vec<usize> = contact_coordinates(model, pair, node)
+                .into_iter()
+                .flatten()
+                .filter(|&eq| !held[eq])
+                .collect();
+            let coefficient = |row: usize, eq: usize| -> f64 {
+                rows.rows[row]
+                    .iter()
+                    .filter(|&&(e, _)| e == eq)
+                    .map(|&(_, v)| v)
+                    .sum()
+            };
+            let block = c * d..(c + 1) * d;
+            // a candidate exactly at the kink (touching, no force yet) is taken as closing:
+            // as open, the step would let it pass through the surface unresisted
+            let law = LocalLaw::evaluate_at_kink(
+                d,
+                rows.mu[c],
+                rho[c],
+                &r.as_slice()[block.clone()],
+                &rows.u.as_slice()[block.clone()],
+                LocalBranch::Frictionless,
+            );
+            for t in 0..d {
+                let row = n + c * d + t;
+                for &eq in &equations {
+                    push(eq, row, -rho[c] * coefficient(c * d + t, eq));
+                    let du: f64 = (0..d)
+                        .map(|s| law.d_u[t][s] * coefficient(c * d + s, eq))
+                        .sum();
+                    push(row, eq, du);
+                }
+                let mut right = -law.phi[t];
+                for s in 0..d {
+                    push(row, n + c * d + s, law.d_r[t][s] * rho[c]);
+                    right += law.d_r[t][s] * r[c * d + s];
+                }
+                rhs[row] = right;
+            }
+        }
+        let matrix = self.assemble(n + m, pairs, &values)?;
+        let solution = match self.iterate(matrix.as_ref(), &rhs) {
+            Some(solution) => {
+                self.iterative_solves += 1;
+                solution
+            }
+            None => {
+                self.factorize(matrix.as_ref())?;
+                let factors = self.factors.as_ref().ok_or_else(|| {
+                    IncrementFailure::LinearSolve("contact system not factorized".into())
+                })?;
+                let mut solution = DVector::zeros(n + m);
+                factors.solve(&rhs, &mut solution);
+                solution
+            }
+        };
+        let dx = DVector::from_fn(n, |i, _| solution[i]);
+        let forces = DVector::from_fn(m, |k, _| rho[k / d] * solution[n + k]);
+        if dx.iter().chain(forces.iter()).any(|v| !v.is_finite()) {
+            return Err(IncrementFailure::LinearSolve(
+                "the contact system is singular (non-finite step)".into(),
+            ));
+        }
+        Ok(GlobalStep { dx, r: forces })
+    }
+
+    /// GMRES on `matrix z = rhs`, right-preconditioned by the last factorization; `Some(z)` if
+    /// its true relative residual reaches [`KRYLOV_TOLERANCE`] within [`KRYLOV_MAX_ITERATIONS`].
+    fn iterate(
+        &self,
+        matrix: SparseColMatRef<'_, usize, f64>,
+        rhs: &DVector<f64>,
+    ) -> Option<DVector<f64>> {
+        let factors = self.factors.as_ref()?;
+        let apply = |x: &DVector<f64>, out: &mut DVector<f64>| sparse_times(matrix, x, out);
+        let precondition = |x: &DVector<f64>, out: &mut DVector<f64>| factors.solve(x, out);
+        let (z, _) = gmres(
+            apply,
+            precondition,
+            rhs,
+            0.1 * KRYLOV_TOLERANCE,
+            KRYLOV_MAX_ITERATIONS,
+        )?;
+        let mut residual = DVector::zeros(rhs.len());
+        sparse_times(matrix, &z, &mut residual);
+        residual -= rhs;
+        (residual.norm() <= KRYLOV_TOLERANCE * rhs.norm()).then_some(z)
+    }
+
+    /// Factorizes `matrix` (of the analysed pattern) into the factors kept for later systems.
+    fn factorize(
+        &mut self,
+        matrix: SparseColMatRef<'_, usize, f64>,
+    ) -> Result<(), IncrementFailure> {
+        let fail = |e: &dyn std::fmt::Debug| {
+            IncrementFailure::LinearSolve(format!("contact system: {e:?}"))
+        };
+        let symbolic = Arc::clone(
+            &self
+                .analysed
+                .as_ref()
+                .ok_or_else(|| fail(&"no symbolic analysis"))?
+                .lu,
+        );
+        let mut numeric = self
+            .factors
+            .take()
+            .map_or_else(NumericLu::new, |factors| factors.numeric);
+        let par = faer::get_global_parallelism();
+        let mut scratch = MemBuffer::try_new(
+            symbolic.factorize_numeric_lu_scratch::<f64>(par, Default::default()),
+        )
+        .map_err(|e| fail(&e))?;
+        symbolic
+            .factorize_numeric_lu(
+                &mut numeric,
+                matrix,
+                par,
+                MemStack::new(&mut scratch),
+                Default::default(),
+            )
+            .map_err(|e| fail(&e))?;
+        self.factorizations += 1;
+        self.factors = Some(Factors { symbolic, numeric });
+        Ok(())
+    }
+
+    /// The matrix of the entries `pairs` (duplicates summed) with `values`, analysing the
+    /// pattern unless it is the last one.
+    fn assemble(
+        &mut self,
+        dim: usize,
+        pairs: Vec<Pair<usize, usize>>,
+        values: &[f64],
+    ) -> Result<SparseColMat<usize, f64>, IncrementFailure> {
+        let fail = |what: &str, e: &dyn std::fmt::Debug| {
+            IncrementFailure::LinearSolve(format!("contact system {what}: {e:?}"))
+        };
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(IncrementFailure::LinearSolve(
+                "non-finite entries in the contact system".into(),
+            ));
+        }
+        let same = self.analysed.as_ref().is_some_and(|a| a.pairs == pairs);
+        if !same {
+            let (symbolic, argsort) = SymbolicSparseColMat::try_new_from_indices(dim, dim, &pairs)
+                .map_err(|e| fail("pattern", &e))?;
+            let params = LuSymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            };
+            let lu = factorize_symbolic_lu(symbolic.as_ref(), params)
+                .map_err(|e| fail("analysis", &e))?;
+            self.analyses += 1;
+            self.factors = None;
+            self.analysed = Some(Analysed {
+                pairs,
+                symbolic,
+                argsort,
+                lu: Arc::new(lu),
+            });
+        }
+        let analysed = self
+            .analysed
+            .as_ref()
+            .ok_or_else(|| fail("analysis", &"missing"))?;
+        SparseColMat::new_from_argsort(analysed.symbolic.clone(), &analysed.argsort, values)
+            .map_err(|e| fail("values", &e))
+    }
+}
+
+/// The weight `rho_c = 1 / w_c` of every candidate, `w_c` the mean over its rows `k` of
+/// `sum_j H_kj^2 / |K_jj|`: the compliance the candidate would have if the tangent `k` (lower
+/// triangle) were diagonal. A candidate whose rows involve no equation gets the mean weight of
+/// the others (1 if there are none).
+pub fn contact_weights(k: SparseColMatRef<'_, usize, f64>, rows: &ContactRows) -> Vec<f64> {
+    let mut diagonal = vec![0.0; k.ncols()];
+    for (j, entry) in diagonal.iter_mut().enumerate() {
+        for (&i, &v) in k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
+            if i == j {
+                *entry += v;
+            }
+        }
+    }
+    let d = rows.components;
+    let compliance: Vec<f64> = (0..rows.len())
+        .map(|c| {
+            (c * d..(c + 1) * d)
+                .flat_map(|row| rows.rows[row].iter())
+                .map(|&(eq, h)| h * h / diagonal[eq].abs())
+                .sum::<f64>()
+                / d as f64
+        })
+        .collect();
+    let valid = |w: &f64| w.is_finite() && *w > 0.0;
+    let weights: Vec<f64> = compliance
+        .iter()
+        .filter(|w| valid(w))
+        .map(|w| 1.0 / w)
+        .collect();
+    let fallback = if weights.is_empty() {
+        1.0
+    } else {
+        weights.iter().sum::<f64>() / weights.len() as f64
+    };
+    compliance
+        .iter()
+        .map(|w| if valid(w) { 1.0 / w } else { fallback })
+        .collect()
+}
+
+/// `max_c ||Phi_c(u_c, r_c)||_inf / rho_c`: how far, as a length, the contact state `(u, r)`
+/// is from the exact Coulomb law (a penetration, a slip while sticking, a force off the cone
+/// or on an open contact, each converted by the candidate's weight).
+pub fn law_residual(rows: &ContactRows, r: &DVector<f64>, rho: &[f64]) -> f64 {
+    let d = rows.components;
+    (0..rows.len())
+        .map(|c| {
+            let block = c * d..(c + 1) * d;
+            let law = LocalLaw::evaluate(
+                d,
+                rows.mu[c],
+                rho[c],
+                &r.as_slice()[block.clone()],
+                &rows.u.as_slice()[block],
+            );
+            law.phi[..d].iter().fold(0.0_f64, |a, p| a.max(p.abs())) / rho[c]
+        })
+        .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::Assembler;
+    use crate::coupling::{contact_rows, contact_step};
+    use crate::increment::Timings;
+    use crate::test_support::block_on_drum;
+    use nalgebra::Vector2;
+    use skid_contact::coulomb::CoulombSettings;
+
+    /// `K v` from the lower triangle of a symmetric `K`.
+    fn symmetric_times(k: SparseColMatRef<'_, usize, f64>, v: &DVector<f64>) -> DVector<f64> {
+        let mut out = DVector::zeros(v.len());
+        for j in 0..k.ncols() {
+            for (&i, &a) in k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
+                out[i] += a * v[j];
+                if i != j {
+                    out[j] += a * v[i];
+                }
+            }
+        }
+        out
+    }
+
+    /// On one linearisation (`K`, `H` fixed), semismooth Newton on the global system converges
+    /// to the solution of the reduced (Delassus) path: the same forces to 1e-8 relative and the
+    /// same step, with open, sticking and sliding candidates among them. Its last steps
+    /// converge quadratically.
+    fn global_iteration_solves_the_reduced_problem<const D: usize>() {
+        let model = block_on_drum::<D>();
+        let n = model.dofs().len();
+        let x = DVector::zeros(n);
+        let mut assembler = Assembler::new(&model).expect("assembler");
+        assembler.internal(&model, &x, Some(1.0)).expect("internal");
+        assembler.add_diagonal(&(model.mass() * 1e8));
+        // the drum held, as in a preload
+        let mut held = vec![false; n];
+        for eq in model.dofs().body_equations(0) {
+            held[eq] = true;
+        }
+        assembler.hold(&held);
+        // slips counted from the nodes' current positions on the drum
+        let origin = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
+        let start = contact_rows(&model, &x, None, &origin, &held)
+            .expect("rows")
+            .coords;
+        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
+        // push the pad down into the drum, less towards x = -0.05 (where it may stay open),
+        // and sideways, more towards x = -0.05 (where it slides; it sticks towards x = +0.05)
+        let mut residual = DVector::zeros(n);
+        for (node, p) in model.part().mesh.nodes.iter().enumerate() {
+            let [Some(ex), Some(ey)] = [model.dofs().node(node)[0], model.dofs().node(node)[1]]
+            else {
+                continue;
+            };
+            let scale = model.mass()[ey] * 1e8;
+            residual[ey] = 1e-2 * scale * (0.5 + 10.0 * p[0]).max(0.0);
+            residual[ex] = -2e-4 * scale * (1.0 - 18.0 * p[0]);
+        }
+        let settings = CoulombSettings::default();
+        let mut timings = Timings::default();
+        let warm = DVector::zeros(rows.rows.len());
+        let (dx_reduced, reduced, _) = contact_step(
+            &mut assembler,
+            &rows,
+            &residual,
+            &warm,
+            1e3,
+            &settings,
+            None,
+            &mut timings,
+        )
+        .expect("reduced");
+
+        let k = assembler.lower_triangle().expect("lower");
+        let rho = contact_weights(k.as_ref(), &rows);
+        let mut solver = GlobalContactSolver::default();
+        let (mut dx, mut r) = (DVector::zeros(n), DVector::zeros(rows.rows.len()));
+        let mut sizes = Vec::new();
+        for _ in 0..30 {
+            let mut linear = rows.clone();
+            linear.u = &rows.u + rows.times(&dx);
+            let linear_residual = &residual + symmetric_times(k.as_ref(), &dx);
+            let step = solver
+                .step(
+                    &model,
+                    k.as_ref(),
+                    &linear,
+                    &linear_residual,
+                    &r,
+                    &rho,
+                    &held,
+                )
+                .expect("global step");
+            dx += &step.dx;
+            sizes.push(step.dx.amax() / dx.amax());
+            r = step.r;
+            if sizes.last().is_some_and(|&s| s < 1e-14) {
+                break;
+            }
+        }
+        assert_eq!(
+            solver.analyses, 1,
+            "{D}D: one symbolic analysis serves every step"
+        );
+        let mut linear = rows.clone();
+        linear.u = &rows.u + rows.times(&dx);
+        assert!(law_residual(&linear, &r, &rho) < 1e-14, "{D}D: {sizes:?}");
+        let branches: Vec<LocalBranch> = (0..rows.len())
+            .map(|c| {
+                let block = c * D..(c + 1) * D;
+                LocalLaw::evaluate(
+                    D,
+                    rows.mu[c],
+                    rho[c],
+                    &r.as_slice()[block.clone()],
+                    &linear.u.as_slice()[block],
+                )
+                .branch
+            })
+            .collect();
+        for wanted in [LocalBranch::Open, LocalBranch::Stick, LocalBranch::Slide] {
+            assert!(branches.contains(&wanted), "{D}D: {branches:?}");
+        }
+        assert!(
+            (&r - &reduced.r).amax() <= 1e-8 * reduced.r.amax(),
+            "{D}D: {r} vs {}",
+            reduced.r
+        );
+        assert!((&dx - &dx_reduced).amax() <= 1e-8 * dx_reduced.amax());
+        // quadratic at the end: each of the last steps at most about the square of the one before
+        let last = &sizes[sizes.len().saturating_sub(3)..];
+        assert!(
+            last.windows(2).all(|w| w[1] <= 10.0 * w[0] * w[0] + 1e-14),
+            "{D}D: {sizes:?}"
+        );
+    }
+
+    #[test]
+    fn global_iteration_solves_the_reduced_problem_2d() {
+        global_iteration_solves_the_reduced_problem::<2>();
+    }
+
+    #[test]
+    fn global_iteration_solves_the_reduced_problem_3d() {
+        global_iteration_solves_the_reduced_problem::<3>();
+    }
+}
