@@ -10,10 +10,12 @@
 //! - [`fields`]: ParaView field output (VTU frames and a PVD collection);
 //! - [`runner`]: running one case into an output directory;
 //! - [`batch`]: running many cases in parallel;
+//! - [`bench`]: the cost of a case beside its error over a ladder of time steps;
 //! - [`report`]: the validation report: the benchmark runs, the hard cases, the convergence
 //!   study.
 
 pub mod batch;
+pub mod bench;
 pub mod csv_out;
 pub mod drum;
 pub mod fields;

@@ -1,8 +1,10 @@
 //! `skid`: run braking-drum cases from the command line.
 //!
-//! One module per command, each documenting its exit codes: [`run`], [`batch`], [`report`].
+//! One module per command, each documenting its exit codes: [`run`], [`batch`], [`report`],
+//! [`bench`].
 
 mod batch;
+mod bench;
 mod report;
 mod run;
 
@@ -11,6 +13,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use skid_cases::ReportSources;
+use skid_cases::bench::BenchSettings;
+use skid_cases::schema::ContactSolveSpec;
 
 #[derive(Parser)]
 #[command(
@@ -71,6 +75,32 @@ enum Command {
         #[arg(long, default_value = "validation/report.md")]
         out: PathBuf,
     },
+    /// Cost against error: each case at a ladder of time steps (coarser than the case, the
+    /// case, then finer) with each contact solve, errors against the finest level; writes
+    /// <out>/bench.json, <out>/bench.md and <out>/work-precision.svg.
+    Bench {
+        /// Case files (JSON).
+        #[arg(required = true)]
+        cases: Vec<PathBuf>,
+        /// Output directory (the runs go to <out>/runs/).
+        #[arg(long, default_value = "out/bench")]
+        out: PathBuf,
+        /// Time-step levels per case and contact solve (at least 2).
+        #[arg(long, default_value_t = 5)]
+        levels: usize,
+        /// Ratio of successive time steps.
+        #[arg(long, default_value_t = 2.0)]
+        ratio: f64,
+        /// Levels coarser than the case's own time step.
+        #[arg(long, default_value_t = 2)]
+        coarser: usize,
+        /// Timed repetitions of runs shorter than 2 s (after one warm-up).
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Contact solves to compare: reduced, global (comma-separated).
+        #[arg(long, value_delimiter = ',', default_value = "reduced,global")]
+        methods: Vec<String>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -103,5 +133,34 @@ fn main() -> ExitCode {
             out,
             overrides,
         } => run::run(&case, &overrides, out.as_deref()),
+        Command::Bench {
+            cases,
+            out,
+            levels,
+            ratio,
+            coarser,
+            repeats,
+            methods,
+        } => {
+            let mut solves = Vec::new();
+            for method in &methods {
+                solves.push(match method.as_str() {
+                    "reduced" => ContactSolveSpec::Reduced,
+                    "global" => ContactSolveSpec::Global,
+                    other => {
+                        eprintln!("skid: --methods: expected reduced or global, got {other:?}");
+                        return ExitCode::from(2);
+                    }
+                });
+            }
+            let settings = BenchSettings {
+                levels,
+                ratio,
+                coarser,
+                repeats,
+                methods: solves,
+            };
+            bench::run(&cases, &settings, &out)
+        }
     }
 }

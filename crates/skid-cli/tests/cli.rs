@@ -148,3 +148,23 @@ fn a_run_that_cannot_converge_exits_1_and_says_where() {
         "results so far are kept"
     );
 }
+
+#[test]
+fn bench_rejects_an_unknown_contact_solve_and_a_ladder_without_reference() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = skid()
+        .args(["bench", CASE, "--methods", "dense", "--out"])
+        .arg(dir.path())
+        .output()
+        .expect("runs");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("expected reduced or global"));
+    let out = skid()
+        .args(["bench", CASE, "--levels", "1", "--coarser", "0", "--out"])
+        .arg(dir.path())
+        .output()
+        .expect("runs");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("at least 2 levels"));
+    assert!(!dir.path().join("bench.json").exists());
+}

@@ -288,6 +288,66 @@ pub fn plot_newton(histories: &[(String, Vec<f64>)], path: &Path) -> Result<(), 
     })
 }
 
+/// File name of the work-precision plot of `skid bench`.
+pub const WORK_PRECISION_SVG: &str = "work-precision.svg";
+
+/// The range of the positive finite `values`, widened by a factor 2 each way, for a log axis.
+fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if lo <= hi {
+        lo / 2.0..hi * 2.0
+    } else {
+        1e-3..1.0
+    }
+}
+
+/// `work-precision.svg`: error against wall time, both on log scales, one curve of points per
+/// `(label, [(wall time, error)])` (points with a non-positive value are left out).
+///
+/// # Errors
+/// [`ReportError`] if the plot cannot be drawn or written.
+pub fn plot_work_precision(
+    series: &[(String, Vec<(f64, f64)>)],
+    (x_label, y_label): (&str, &str),
+    path: &Path,
+) -> Result<(), ReportError> {
+    let positive = |p: &&(f64, f64)| p.0 > 0.0 && p.1 > 0.0 && p.0.is_finite() && p.1.is_finite();
+    let all = || series.iter().flat_map(|(_, p)| p.iter()).filter(positive);
+    let x = log_range(all().map(|p| p.0));
+    let y = log_range(all().map(|p| p.1));
+    write_svg(path, |root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption("Work-precision", ("sans-serif", 22))
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(72)
+            .build_cartesian_2d(x.log_scale(), y.log_scale())
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .x_label_formatter(&|v| format!("{v:.0e}"))
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        for (k, (label, points)) in series.iter().enumerate() {
+            let color = Palette99::pick(k).to_rgba();
+            let points: Vec<(f64, f64)> = points.iter().filter(positive).copied().collect();
+            chart
+                .draw_series(LineSeries::new(points, color.stroke_width(2)).point_size(4))
+                .map_err(|e| e.to_string())?
+                .label(label.as_str())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color));
+        }
+        draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,443 @@
+//! `skid bench`: the cost of a case beside its error, over a ladder of time steps and the
+//! contact solves.
+//!
+//! Each case is run, for every contact solve asked for (`solver.contact_solve`), at the time
+//! steps `dt_k = dt ratio^(coarser - k)`, `k = 0 .. levels` (every dynamic step's `dt` scaled
+//! alike: `coarser` levels coarser than the case, the case itself, then finer). The finest level of a case
+//! and solve is its converged reference, and each level's error is measured against it in the
+//! quantities that converge (DRUM.md 2.2, 3):
+//!
+//! - the deceleration (least-squares slope of omega over `[0.1, 0.9] t_stop`), relative;
+//! - `e_slide = max |omega - omega_ref| / omega0` over `t <= 0.9 t_stop`;
+//! - `t_stop`, relative, which the pad vibration left at the stop moves by up to 1 %: a
+//!   difference inside that band is not a discretisation error.
+//!
+//! A run shorter than [`REPEAT_BELOW_S`] is run once more as a warm-up and then `repeats`
+//! times, and its wall time is the median (the solver's own wall time, without process start
+//! or output of the report). The record keeps every measured time and the split of the median
+//! run into assembly, linear solves and contact solves.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::report::{ReportError, e_slide, load_run};
+use crate::runner::{run_case, write_atomic};
+use crate::schema::{Case, ContactSolveSpec, StepSpec};
+use crate::validate::CaseError;
+
+/// Runs shorter than this (s) are repeated and their median taken.
+pub const REPEAT_BELOW_S: f64 = 2.0;
+
+/// File name of the bench records in the output directory.
+pub const BENCH_JSON: &str = "bench.json";
+
+/// What to run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchSettings {
+    /// Time-step levels per case and contact solve (at least 2).
+    pub levels: usize,
+    /// Ratio between successive time steps (> 1).
+    pub ratio: f64,
+    /// Levels coarser than the case's own time step (fewer than `levels`).
+    pub coarser: usize,
+    /// Timed repetitions of a short run (at least 1).
+    pub repeats: usize,
+    /// The contact solves to compare.
+    pub methods: Vec<ContactSolveSpec>,
+}
+
+impl Default for BenchSettings {
+    fn default() -> Self {
+        Self {
+            levels: 5,
+            ratio: 2.0,
+            coarser: 2,
+            repeats: 5,
+            methods: vec![ContactSolveSpec::Reduced, ContactSolveSpec::Global],
+        }
+    }
+}
+
+/// One level of one case and contact solve.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BenchRecord {
+    /// Case name.
+    pub case: String,
+    /// Contact solve (`"reduced"` or `"global"`).
+    pub method: String,
+    /// Time step of the dynamic steps, s.
+    pub dt: f64,
+    /// `"completed"` or `"failed"`.
+    pub status: String,
+    /// Median wall time, s.
+    pub wall_time_s: f64,
+    /// Every timed run's wall time, s.
+    pub wall_times_s: Vec<f64>,
+    /// Of the median run: assembly, s.
+    pub assembly_s: f64,
+    /// Of the median run: factorizations and solves, s.
+    pub linear_solve_s: f64,
+    /// Of the median run: conic and dense Coulomb solves, s.
+    pub contact_solve_s: f64,
+    /// Converged increments.
+    pub increments: usize,
+    /// Newton iterations.
+    pub newton_iterations: usize,
+    /// Increments the global contact solve handed to the reduced one.
+    pub contact_fallbacks: usize,
+    /// Stop time, s.
+    pub t_stop: Option<f64>,
+    /// Sliding deceleration, rad/s^2.
+    pub deceleration: Option<f64>,
+    /// `|decel - decel_ref| / |decel_ref|` against the finest level.
+    pub deceleration_error: Option<f64>,
+    /// `e_slide` against the finest level.
+    pub e_slide: Option<f64>,
+    /// `|t_stop - t_stop_ref| / t_stop_ref` against the finest level.
+    pub t_stop_difference: Option<f64>,
+    /// Whether this level is the reference of its case and method.
+    pub reference: bool,
+}
+
+/// Why a bench could not be completed.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// A case could not be run.
+    #[error(transparent)]
+    Case(#[from] CaseError),
+    /// A run's outputs could not be read back.
+    #[error(transparent)]
+    Report(#[from] ReportError),
+    /// Settings out of range.
+    #[error("bench settings: {0}")]
+    Settings(String),
+    /// The records could not be written.
+    #[error("cannot write {path}: {source}")]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+}
+
+/// The case with every dynamic step's time step multiplied by `factor` and the contact solve
+/// `method`.
+pub fn level_case(case: &Case, factor: f64, method: ContactSolveSpec) -> Case {
+    let mut case = case.clone();
+    for step in &mut case.steps {
+        if let StepSpec::Dynamic { dt, .. } = step {
+            *dt *= factor;
+        }
+    }
+    case.solver.contact_solve = method;
+    case
+}
+
+/// The median of `values` (the mean of the middle two for an even count); `NaN` if empty.
+pub fn median(values: &[f64]) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len();
+    match n {
+        0 => f64::NAN,
+        _ if n % 2 == 1 => sorted[n / 2],
+        _ => 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
+    }
+}
+
+/// The smallest dynamic time step of a case (the one the ladder's factors apply to).
+fn base_dt(case: &Case) -> Option<f64> {
+    case.steps
+        .iter()
+        .filter_map(|s| match s {
+            StepSpec::Dynamic { dt, .. } => Some(*dt),
+            StepSpec::Static { .. } => None,
+        })
+        .reduce(f64::min)
+}
+
+/// Runs the ladder of every case (`(case, source file)`) into `out/runs/<case>/<method>/<k>`,
+/// calling `progress` with a line per level, and writes `out/bench.json`.
+///
+/// # Errors
+/// [`BenchError`] for bad settings, a case that cannot be built or outputs that cannot be
+/// written or read back. A run that stops early is a record with status `"failed"`.
+pub fn run_bench(
+    cases: &[(Case, PathBuf)],
+    settings: &BenchSettings,
+    out: &Path,
+    mut progress: impl FnMut(&BenchRecord),
+) -> Result<Vec<BenchRecord>, BenchError> {
+    let ratio_ok = settings.ratio.partial_cmp(&1.0) == Some(std::cmp::Ordering::Greater)
+        && settings.ratio.is_finite();
+    if settings.levels < 2 || !ratio_ok || settings.coarser >= settings.levels {
+        return Err(BenchError::Settings(format!(
+            "expected at least 2 levels, a finite ratio above 1 and fewer coarser levels than \
+             levels, got {} levels, ratio {}, {} coarser",
+            settings.levels, settings.ratio, settings.coarser
+        )));
+    }
+    if settings.repeats == 0 || settings.methods.is_empty() {
+        return Err(BenchError::Settings(
+            "expected at least one repeat and one contact solve".into(),
+        ));
+    }
+    let mut records = Vec::new();
+    for (case, source) in cases {
+        let Some(dt) = base_dt(case) else {
+            return Err(BenchError::Settings(format!(
+                "{}: the case has no dynamic step to refine",
+                source.display()
+            )));
+        };
+        for &method in &settings.methods {
+            let label = method_label(method);
+            let mut runs = Vec::new();
+            for k in 0..settings.levels {
+                let exponent = i32::try_from(settings.coarser).unwrap_or(i32::MAX)
+                    - i32::try_from(k).unwrap_or(i32::MAX);
+                let factor = settings.ratio.powi(exponent);
+                let level = level_case(case, factor, method);
+                let dir = out
+                    .join("runs")
+                    .join(&case.name)
+                    .join(label)
+                    .join(k.to_string());
+                let mut summary = run_case(&level, source, &dir)?;
+                let mut times = vec![summary.wall_time_s];
+                if summary.wall_time_s < REPEAT_BELOW_S {
+                    times.clear();
+                    let mut timed = Vec::new();
+                    for _ in 0..settings.repeats {
+                        let s = run_case(&level, source, &dir)?;
+                        times.push(s.wall_time_s);
+                        timed.push(s);
+                    }
+                    let middle = median(&times);
+                    if let Some(closest) = timed.into_iter().min_by(|a, b| {
+                        (a.wall_time_s - middle)
+                            .abs()
+                            .total_cmp(&(b.wall_time_s - middle).abs())
+                    }) {
+                        summary = closest;
+                    }
+                }
+                let record = BenchRecord {
+                    case: case.name.clone(),
+                    method: label.into(),
+                    dt: dt * factor,
+                    status: summary.status.clone(),
+                    wall_time_s: median(&times),
+                    wall_times_s: times,
+                    assembly_s: summary.assembly_s,
+                    linear_solve_s: summary.linear_solve_s,
+                    contact_solve_s: summary.contact_solve_s,
+                    increments: summary.increments,
+                    newton_iterations: summary.newton_iterations,
+                    contact_fallbacks: summary.contact_fallbacks,
+                    t_stop: summary.t_stop,
+                    deceleration: summary.deceleration,
+                    deceleration_error: None,
+                    e_slide: None,
+                    t_stop_difference: None,
+                    reference: k + 1 == settings.levels,
+                };
+                progress(&record);
+                runs.push((record, dir));
+            }
+            measure_against_finest(&mut runs)?;
+            records.extend(runs.into_iter().map(|(r, _)| r));
+        }
+    }
+    let path = out.join(BENCH_JSON);
+    let text = serde_json::to_string_pretty(&records).unwrap_or_default();
+    std::fs::create_dir_all(out)
+        .and_then(|()| write_atomic(&path, &text))
+        .map_err(|source| BenchError::Write { path, source })?;
+    Ok(records)
+}
+
+/// Fills the errors of every level against the last (finest) one.
+fn measure_against_finest(runs: &mut [(BenchRecord, PathBuf)]) -> Result<(), BenchError> {
+    let Some((reference, reference_dir)) = runs.last().cloned() else {
+        return Ok(());
+    };
+    let reference_run = load_run(&reference_dir)?;
+    for (record, dir) in runs.iter_mut() {
+        let relative = |a: Option<f64>, b: Option<f64>| match (a, b) {
+            (Some(a), Some(b)) if b != 0.0 => Some((a - b).abs() / b.abs()),
+            _ => None,
+        };
+        record.deceleration_error = relative(record.deceleration, reference.deceleration);
+        record.t_stop_difference = relative(record.t_stop, reference.t_stop);
+        let run = load_run(dir)?;
+        let omega0 = run.summary.omega0;
+        record.e_slide = record
+            .t_stop
+            .and_then(|t| e_slide(&run.history, t, omega0, &reference_run.history));
+    }
+    Ok(())
+}
+
+/// File name of the bench report in the output directory.
+pub const BENCH_MD: &str = "bench.md";
+
+/// Writes `bench.md` (the table of every level) and `work-precision.svg` (the deceleration
+/// error and e_slide against the median wall time, one curve each per case and contact solve)
+/// into `out`.
+///
+/// # Errors
+/// [`BenchError`] if a file cannot be written.
+pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), BenchError> {
+    use crate::report::format::{percent, show};
+    use std::fmt::Write as _;
+    let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for r in records.iter().filter(|r| !r.reference) {
+        for (quantity, error) in [
+            ("deceleration", r.deceleration_error),
+            ("e_slide", r.e_slide),
+        ] {
+            let label = format!("{} ({}): {quantity}", r.case, r.method);
+            let point = (r.wall_time_s, error.unwrap_or(f64::NAN));
+            match series.iter_mut().find(|(l, _)| *l == label) {
+                Some((_, points)) => points.push(point),
+                None => series.push((label, vec![point])),
+            }
+        }
+    }
+    crate::report::plot::plot_work_precision(
+        &series,
+        (
+            "median wall time [s]",
+            "error against the finest level (deceleration: relative; e_slide)",
+        ),
+        &out.join(crate::report::plot::WORK_PRECISION_SVG),
+    )?;
+    let mut md = String::from("# Work against error (`skid bench`)\n\n");
+    md.push_str(
+        "Each case at a ladder of time steps (every dynamic step's dt scaled alike) with each \
+         contact solve; the finest level of a case and solve is its reference. Wall time: the \
+         solver's, median of the timed runs (runs under 2 s: one warm-up, then the repeats). \
+         Errors against the reference: the deceleration (relative), e_slide (max |omega - \
+         omega_ref| / omega0 over t <= 0.9 t_stop) and t_stop (relative; the pad vibration \
+         left at the stop moves it by up to 1 %, DRUM.md 2.2, so differences inside that band \
+         are not discretisation errors).\n\n",
+    );
+    let _ = writeln!(
+        md,
+        "![deceleration error and e_slide against wall time]({})\n",
+        crate::report::plot::WORK_PRECISION_SVG
+    );
+    md.push_str(
+        "| case | contact solve | dt [s] | status | wall [s] | runs | assembly / linear / contact [s] | increments | Newton iterations | fallbacks | deceleration [rad/s^2] | deceleration error [%] | e_slide [%] | t_stop [s] | t_stop difference [%] |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in records {
+        let reference = if r.reference { " (reference)" } else { "" };
+        let _ = writeln!(
+            md,
+            "| {} | {} | {}{reference} | {} | {:.4} | {} | {:.3} / {:.3} / {:.3} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            r.case,
+            r.method,
+            show(Some(r.dt)),
+            r.status,
+            r.wall_time_s,
+            r.wall_times_s.len(),
+            r.assembly_s,
+            r.linear_solve_s,
+            r.contact_solve_s,
+            r.increments,
+            r.newton_iterations,
+            r.contact_fallbacks,
+            show(r.deceleration),
+            percent(r.deceleration_error),
+            percent(r.e_slide),
+            show(r.t_stop),
+            percent(r.t_stop_difference),
+        );
+    }
+    let path = out.join(BENCH_MD);
+    write_atomic(&path, &md).map_err(|source| BenchError::Write { path, source })
+}
+
+/// The name a contact solve has in case files and records.
+pub fn method_label(method: ContactSolveSpec) -> &'static str {
+    match method {
+        ContactSolveSpec::Reduced => "reduced",
+        ContactSolveSpec::Global => "global",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_odd_and_even_counts() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert!(median(&[]).is_nan());
+    }
+
+    /// A short 2D spin-down on two levels and one solve: the finest level is the reference
+    /// with zero errors; the coarser one has a positive deceleration error; every run is
+    /// timed `repeats` times; the records are written.
+    #[test]
+    fn ladder_measures_against_its_finest_level() {
+        let text = include_str!("../../../cases/drum/2d-analytic.json");
+        let overrides = ["steps[1].duration=0.01".to_string()];
+        let file = PathBuf::from("2d-analytic.json");
+        let case = crate::validate::parse_case(text, &file, &overrides).expect("case");
+        let dir = tempfile::tempdir().expect("tempdir");
+        let settings = BenchSettings {
+            levels: 2,
+            ratio: 4.0,
+            coarser: 1,
+            repeats: 3,
+            methods: vec![ContactSolveSpec::Reduced],
+        };
+        let mut lines = 0;
+        let records =
+            run_bench(&[(case, file)], &settings, dir.path(), |_| lines += 1).expect("bench");
+        assert_eq!((records.len(), lines), (2, 2));
+        let (coarse, fine) = (&records[0], &records[1]);
+        assert!(fine.reference && !coarse.reference);
+        assert!((coarse.dt / fine.dt - 4.0).abs() < 1e-12);
+        assert!(
+            (coarse.dt / 4e-4 - 1.0).abs() < 1e-12,
+            "one level coarser than the case"
+        );
+        assert_eq!(fine.deceleration_error, Some(0.0));
+        assert!(coarse.deceleration_error.is_some_and(|e| e > 0.0));
+        assert!(coarse.wall_times_s.len() == 3 && coarse.wall_time_s > 0.0);
+        write_bench_report(&records, dir.path()).expect("report");
+        let md = std::fs::read_to_string(dir.path().join(BENCH_MD)).expect("bench.md");
+        assert_eq!(
+            md.lines()
+                .filter(|l| l.starts_with("| 2d-analytic"))
+                .count(),
+            2
+        );
+        assert!(
+            dir.path()
+                .join(crate::report::plot::WORK_PRECISION_SVG)
+                .is_file()
+        );
+        let written: Vec<BenchRecord> = serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join(BENCH_JSON)).expect("bench.json"),
+        )
+        .expect("records");
+        assert_eq!(written, records);
+        // a ladder of one level has no reference to measure against
+        let bad = BenchSettings {
+            levels: 1,
+            ..settings
+        };
+        assert!(matches!(
+            run_bench(&[], &bad, dir.path(), |_| ()),
+            Err(BenchError::Settings(_))
+        ));
+    }
+}

@@ -1,0 +1,67 @@
+//! `skid bench`: the cost of each case beside its error over a ladder of time steps and the
+//! contact solves (see `skid_cases::bench`).
+//!
+//! Exit codes: 0 every run completed; 1 some run stopped early; 2 a case file or the settings
+//! are invalid; 3 results could not be written or read back.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use skid_cases::bench::{BenchError, BenchSettings, run_bench, write_bench_report};
+use skid_cases::load_case;
+
+/// Runs the bench of `cases` into `out` with `settings`; a line per level on stderr when it is
+/// a terminal.
+pub fn run(cases: &[PathBuf], settings: &BenchSettings, out: &Path) -> ExitCode {
+    let mut loaded = Vec::new();
+    for path in cases {
+        match load_case(path, &[]) {
+            Ok(case) => loaded.push((case, path.clone())),
+            Err(e) => {
+                eprintln!("skid: {e}");
+                return ExitCode::from(2);
+            }
+        }
+    }
+    let terminal = std::io::stderr().is_terminal();
+    let total = loaded.len() * settings.levels * settings.methods.len();
+    let mut done = 0;
+    let progress = |r: &skid_cases::bench::BenchRecord| {
+        done += 1;
+        if terminal {
+            eprintln!(
+                "[{done}/{total}] {} {} dt {:.3e}: {} in {:.3} s ({} runs)",
+                r.case,
+                r.method,
+                r.dt,
+                r.status,
+                r.wall_time_s,
+                r.wall_times_s.len()
+            );
+        }
+    };
+    let records = match run_bench(&loaded, settings, out, progress)
+        .and_then(|records| write_bench_report(&records, out).map(|()| records))
+    {
+        Ok(records) => records,
+        Err(e) => {
+            eprintln!("skid: {e}");
+            return ExitCode::from(match e {
+                BenchError::Settings(_) | BenchError::Case(_) => 2,
+                BenchError::Report(_) | BenchError::Write { .. } => 3,
+            });
+        }
+    };
+    println!(
+        "{} levels benchmarked; see {}",
+        records.len(),
+        out.join(skid_cases::bench::BENCH_MD).display()
+    );
+    if records.iter().all(|r| r.status == "completed") {
+        ExitCode::SUCCESS
+    } else {
+        eprintln!("skid: some runs stopped early (status \"failed\" in bench.json)");
+        ExitCode::from(1)
+    }
+}
