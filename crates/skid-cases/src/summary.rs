@@ -39,6 +39,10 @@ pub struct Summary {
     pub mean_normal_force_sliding: Option<f64>,
     /// Time reached, s.
     pub final_time: f64,
+    /// Equations (unknowns) of the model.
+    pub equations: usize,
+    /// Contact candidates (slave nodes over all pairs).
+    pub contact_candidates: usize,
     /// Converged increments.
     pub increments: usize,
     /// Newton iterations.
@@ -219,6 +223,8 @@ pub fn summarize(
         post_stop_max_angle_change: post_angle,
         mean_normal_force_sliding: mean_normal,
         final_time: samples.last().map_or(0.0, |s| s.time),
+        equations: stats.equations,
+        contact_candidates: stats.contact_candidates,
         increments: stats.increments,
         newton_iterations: stats.newton_iterations,
         contact_solves: stats.contact_solves,

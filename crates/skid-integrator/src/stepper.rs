@@ -131,6 +131,10 @@ pub trait Observer<const D: usize> {
 /// Totals of a run.
 #[derive(Clone, Debug, Default)]
 pub struct RunStatistics {
+    /// Equations (unknowns) of the model.
+    pub equations: usize,
+    /// Contact candidates (slave nodes over all pairs).
+    pub contact_candidates: usize,
     /// Converged increments.
     pub increments: usize,
     /// Newton iterations of converged increments.
@@ -275,7 +279,11 @@ pub fn run<const D: usize>(
     observer: &mut dyn Observer<D>,
 ) -> (RunStatistics, Result<State, RunError>) {
     let clock = Instant::now();
-    let mut stats = RunStatistics::default();
+    let mut stats = RunStatistics {
+        equations: model.dofs().len(),
+        contact_candidates: model.contacts().iter().map(|p| p.nodes.len()).sum(),
+        ..RunStatistics::default()
+    };
     let result = run_steps(model, steps, settings, observer, &mut stats);
     stats.wall_time = clock.elapsed();
     (stats, result)
