@@ -112,10 +112,11 @@ pub struct IncrementCounters {
 /// How each Newton iteration obtains its contact forces.
 ///
 /// Both give the same converged increments (the same forces to the Coulomb tolerance); they
-/// differ in cost. Measured on 2 cores (release): the global path's sparse LU costs about ten
-/// Cholesky factorizations of the same tangent at 1e4 equations (0.4 s against 0.04 s on
-/// `3d-refined`), more than the reduced path's dense block there, so the reduced path stays the
-/// default until the global system has a cheaper factorization.
+/// differ in cost. Measured on 2 cores (release), on `3d-refined`'s 9,965-equation system: a
+/// dynamic iteration of the global path takes 0.10-0.15 s with its quasi-definite
+/// preconditioner (0.55-0.75 s with the LU alone), about what the reduced path's dense block
+/// costs there, and the global path needs more iterations per increment; so the reduced path
+/// stays the default for now.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ContactSolve {
     /// Displacement step and forces together from one sparse system (see

@@ -30,6 +30,7 @@ pub mod increment;
 pub mod krylov;
 pub mod mixed;
 pub mod model;
+pub mod quasi_definite;
 pub mod sparse;
 pub mod state;
 pub mod stepper;

@@ -1,0 +1,211 @@
+//! A symmetric quasi-definite approximation of the global contact system (see
+//! [`crate::global_contact`]), factorized by sparse `L D L^T` as the preconditioner of GMRES on
+//! the exact, unsymmetric system.
+//!
+//! With the contact rows negated, the global system of a Newton iteration is symmetric except
+//! for the friction of sliding candidates. Keeping the constraint rows (the normal row of a
+//! closed candidate, the tangential rows of a sticking one) and decoupling the others (open
+//! candidates, and the tangential rows of sliding or frictionless ones, whose unknowns then
+//! only see their diagonal) gives
+//!
+//! ```text
+//! S = [ K      -G   ]      G = rho H_C^T  (the constraint rows' columns)
+//!     [ -G^T   -E   ]      E = eps rho on constraint rows, rho on decoupled ones
+//! ```
+//!
+//! which is quasi-definite where `K` is positive definite, so `L D L^T` exists for any
+//! symmetric ordering; faer's supernodal factorization costs about one Cholesky factorization
+//! of `K`. The exact matrix `A` equals `diag(I, -I) S` but for the friction coupling of sliding
+//! candidates (of the order of `mu`), their tangential columns in the first block row and the
+//! small `eps`, so `M^{-1} v = S^{-1} diag(I, -I) v` is a close preconditioner of `A`.
+//! No pivot is regularised: where `K` is indefinite (a compressed pad in a static step) the
+//! factorization may still exist with pivots of either sign, or fail; GMRES checks the result,
+//! and the caller factorizes `A` itself where it does not converge. (faer's dynamic
+//! regularisation by expected pivot signs gave wrong factors of these matrices in 0.24: a test
+//! of a 24-equation case came back 375 times off.)
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, LdltRef, SymbolicCholesky, SymmetricOrdering,
+    factorize_symbolic_cholesky,
+};
+use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
+use faer::{Conj, Mat, Side};
+use nalgebra::DVector;
+
+use crate::error::IncrementFailure;
+
+/// Relative weight `eps` of the constraint rows' diagonal (see the module documentation). The
+/// `L D L^T` factors lose accuracy as `eps` shrinks, since a constraint row eliminated before
+/// its nodes leaves a pivot of `-eps rho`: in the unit test 1e-6 still inverts `S` to 1e-9,
+/// 1e-8 does not (an error of 375 on entries of order 1). GMRES absorbs the `eps` that `S`
+/// adds on the constraint rows.
+pub const CONSTRAINT_REGULARIZATION: f64 = 1e-5;
+
+/// The analysed pattern of `S` (lower triangle) and its last factorization.
+#[derive(Debug, Default)]
+pub struct QuasiDefinite {
+    analysed: Option<Analysed>,
+    /// Symbolic analyses performed.
+    pub analyses: usize,
+}
+
+#[derive(Debug)]
+struct Analysed {
+    pairs: Vec<Pair<usize, usize>>,
+    symbolic: SymbolicSparseColMat<usize>,
+    argsort: Argsort<usize>,
+    analysis: SymbolicCholesky<usize>,
+    factor: Vec<f64>,
+    /// Equations of the first block: rows from here on are contact rows.
+    unknowns: usize,
+}
+
+impl QuasiDefinite {
+    /// Factorizes the `dim x dim` matrix of the lower-triangle entries `pairs` (`i >= j`,
+    /// duplicates summed) with `values`, whose first `unknowns` rows are the positive block.
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] if the pattern cannot be analysed or the values are
+    /// not finite.
+    pub fn factorize(
+        &mut self,
+        dim: usize,
+        unknowns: usize,
+        pairs: Vec<Pair<usize, usize>>,
+        values: &[f64],
+    ) -> Result<(), IncrementFailure> {
+        let fail = |what: &str, e: &dyn std::fmt::Debug| {
+            IncrementFailure::LinearSolve(format!("quasi-definite system {what}: {e:?}"))
+        };
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(fail("values", &"not finite"));
+        }
+        let same = self
+            .analysed
+            .as_ref()
+            .is_some_and(|a| a.pairs == pairs && a.unknowns == unknowns);
+        if !same {
+            let (symbolic, argsort) = SymbolicSparseColMat::try_new_from_indices(dim, dim, &pairs)
+                .map_err(|e| fail("pattern", &e))?;
+            let analysis = factorize_symbolic_cholesky(
+                symbolic.as_ref(),
+                Side::Lower,
+                SymmetricOrdering::Amd,
+                CholeskySymbolicParams::default(),
+            )
+            .map_err(|e| fail("analysis", &e))?;
+            self.analyses += 1;
+            let factor = vec![0.0; analysis.len_val()];
+            self.analysed = Some(Analysed {
+                pairs,
+                symbolic,
+                argsort,
+                analysis,
+                factor,
+                unknowns,
+            });
+        }
+        let a = self
+            .analysed
+            .as_mut()
+            .ok_or_else(|| fail("analysis", &"missing"))?;
+        let matrix = SparseColMat::new_from_argsort(a.symbolic.clone(), &a.argsort, values)
+            .map_err(|e| fail("values", &e))?;
+        let par = faer::get_global_parallelism();
+        let mut scratch = MemBuffer::try_new(
+            a.analysis
+                .factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
+        )
+        .map_err(|e| fail("memory", &e))?;
+        a.analysis
+            .factorize_numeric_ldlt(
+                &mut a.factor,
+                matrix.as_ref(),
+                Side::Lower,
+                LdltRegularization::default(),
+                par,
+                MemStack::new(&mut scratch),
+                Default::default(),
+            )
+            .map_err(|e| fail("factorization", &e))?;
+        Ok(())
+    }
+
+    /// Writes `M^{-1} v = S^{-1} diag(I, -I) v` into `out` (nothing if not factorized).
+    pub fn precondition(&self, v: &DVector<f64>, out: &mut DVector<f64>) {
+        let Some(a) = self.analysed.as_ref() else {
+            return;
+        };
+        let par = faer::get_global_parallelism();
+        let mut scratch = MemBuffer::new(a.analysis.solve_in_place_scratch::<f64>(1, par));
+        let mut column =
+            Mat::<f64>::from_fn(v.len(), 1, |i, _| if i < a.unknowns { v[i] } else { -v[i] });
+        LdltRef::new(&a.analysis, &a.factor).solve_in_place_with_conj(
+            Conj::No,
+            column.as_mut(),
+            par,
+            MemStack::new(&mut scratch),
+        );
+        for (o, c) in out.iter_mut().zip(column.col(0).iter()) {
+            *o = *c;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::DMatrix;
+
+    /// `S` of a spring chain with three constraint rows and one decoupled row: the
+    /// preconditioner inverts `A = diag(I, -I) S` to round-off, whatever order the fill-reducing
+    /// ordering gives the constraint rows; a second factorization reuses the analysis.
+    #[test]
+    fn preconditioner_inverts_the_sign_flipped_quasi_definite_matrix() {
+        let (n, m) = (20, 4);
+        let dim = n + m;
+        let mut entries: Vec<(usize, usize, f64)> = Vec::new();
+        for i in 0..n {
+            entries.push((i, i, 2.5 + (i as f64 * 0.3).sin()));
+            if i + 1 < n {
+                entries.push((i + 1, i, -1.0));
+            }
+        }
+        let rho = 3.0;
+        for (c, nodes) in [[2, 3], [9, 10], [15, 16]].iter().enumerate() {
+            let row = n + c;
+            entries.push((row, nodes[0], -rho));
+            entries.push((row, nodes[1], 0.5 * rho));
+            entries.push((row, row, -CONSTRAINT_REGULARIZATION * rho));
+        }
+        entries.push((n + 3, n + 3, -rho));
+        let pairs: Vec<Pair<usize, usize>> =
+            entries.iter().map(|&(i, j, _)| Pair::new(i, j)).collect();
+        let values: Vec<f64> = entries.iter().map(|e| e.2).collect();
+        let mut s = DMatrix::<f64>::zeros(dim, dim);
+        for &(i, j, v) in &entries {
+            s[(i, j)] += v;
+            if i != j {
+                s[(j, i)] += v;
+            }
+        }
+        let flip = DMatrix::from_fn(dim, dim, |i, j| match (i == j, i < n) {
+            (true, true) => 1.0,
+            (true, false) => -1.0,
+            _ => 0.0,
+        });
+        let a = &flip * &s;
+        let mut qd = QuasiDefinite::default();
+        for _ in 0..2 {
+            qd.factorize(dim, n, pairs.clone(), &values)
+                .expect("factorize");
+            let x = DVector::from_fn(dim, |i, _| (i as f64 * 0.7).cos());
+            let mut back = DVector::zeros(dim);
+            qd.precondition(&(&a * &x), &mut back);
+            assert!((&back - &x).amax() < 1e-9, "{back} vs {x}");
+        }
+        assert_eq!(qd.analyses, 1);
+    }
+}
