@@ -98,6 +98,23 @@ impl Factors {
     }
 }
 
+/// GMRES on `matrix z = rhs` with the preconditioner `m_inv` and at most `max_iterations`;
+/// `Some(z)` only if the true residual `||rhs - matrix z||` is below [`KRYLOV_TOLERANCE`]
+/// `||rhs||` (GMRES's own estimate is not trusted alone).
+fn checked_gmres(
+    matrix: SparseColMatRef<'_, usize, f64>,
+    rhs: &DVector<f64>,
+    m_inv: impl FnMut(&DVector<f64>, &mut DVector<f64>),
+    max_iterations: usize,
+) -> Option<DVector<f64>> {
+    let apply = |x: &DVector<f64>, out: &mut DVector<f64>| sparse_times(matrix, x, out);
+    let (z, _) = gmres(apply, m_inv, rhs, 0.1 * KRYLOV_TOLERANCE, max_iterations)?;
+    let mut residual = DVector::zeros(rhs.len());
+    sparse_times(matrix, &z, &mut residual);
+    residual -= rhs;
+    (residual.norm() <= KRYLOV_TOLERANCE * rhs.norm()).then_some(z)
+}
+
 /// `out = A x` for a sparse `A`.
 fn sparse_times(a: SparseColMatRef<'_, usize, f64>, x: &DVector<f64>, out: &mut DVector<f64>) {
     out.fill(0.0);
@@ -311,19 +328,12 @@ impl GlobalContactSolver {
             return None;
         }
         let factors = self.factors.as_ref()?;
-        let apply = |x: &DVector<f64>, out: &mut DVector<f64>| sparse_times(matrix, x, out);
-        let precondition = |x: &DVector<f64>, out: &mut DVector<f64>| factors.solve(x, out);
-        let (z, _) = gmres(
-            apply,
-            precondition,
+        checked_gmres(
+            matrix,
             rhs,
-            0.1 * KRYLOV_TOLERANCE,
+            |x, out| factors.solve(x, out),
             KRYLOV_MAX_ITERATIONS,
-        )?;
-        let mut residual = DVector::zeros(rhs.len());
-        sparse_times(matrix, &z, &mut residual);
-        residual -= rhs;
-        (residual.norm() <= KRYLOV_TOLERANCE * rhs.norm()).then_some(z)
+        )
     }
 
     /// [`Self::iterate_on_factors`], marking the factors stale when it fails: once they no
@@ -354,20 +364,12 @@ impl GlobalContactSolver {
             .factorize(rhs.len(), unknowns, pairs, values)
             .ok()?;
         let preconditioner = &self.quasi_definite;
-        let apply = |x: &DVector<f64>, out: &mut DVector<f64>| sparse_times(matrix, x, out);
-        let precondition =
-            |x: &DVector<f64>, out: &mut DVector<f64>| preconditioner.precondition(x, out);
-        let (z, _) = gmres(
-            apply,
-            precondition,
+        checked_gmres(
+            matrix,
             rhs,
-            0.1 * KRYLOV_TOLERANCE,
+            |x, out| preconditioner.precondition(x, out),
             QUASI_DEFINITE_MAX_ITERATIONS,
-        )?;
-        let mut residual = DVector::zeros(rhs.len());
-        sparse_times(matrix, &z, &mut residual);
-        residual -= rhs;
-        (residual.norm() <= KRYLOV_TOLERANCE * rhs.norm()).then_some(z)
+        )
     }
 
     /// Factorizes `matrix` (of the analysed pattern) into the factors kept for later systems.
