@@ -149,12 +149,8 @@ pub fn median(values: &[f64]) -> f64 {
 
 /// The smallest dynamic time step of a case (the one the ladder's factors apply to).
 fn base_dt(case: &Case) -> Option<f64> {
-    case.steps
-        .iter()
-        .filter_map(|s| match s {
-            StepSpec::Dynamic { dt, .. } => Some(*dt),
-            StepSpec::Static { .. } => None,
-        })
+    crate::report::convergence::time_steps(case)
+        .into_iter()
         .reduce(f64::min)
 }
 

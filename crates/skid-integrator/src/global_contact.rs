@@ -21,7 +21,11 @@
 //! exact linearisation of `R - H^T r`. An open candidate has `Phi_r = I`, `Phi_u = 0` (its new
 //! force is zero), a sticking one `H_c dx = -u_c`, a sliding one `u_N = 0` with its friction on
 //! the cone's edge. Nothing requires `K` to be positive definite, and sliding rows make the
-//! matrix unsymmetric: it is factorized by sparse LU with partial pivoting.
+//! matrix unsymmetric. Each system is solved, in this order, by GMRES on the LU factors of an
+//! earlier one while they serve, by GMRES preconditioned with the quasi-definite approximation
+//! of [`crate::quasi_definite`] (systems of [`QUASI_DEFINITE_FROM`] equations or more), or by a
+//! new sparse LU factorization with partial pivoting; an iterative result counts only if its
+//! true residual is below [`KRYLOV_TOLERANCE`].
 //!
 //! Each candidate's forces enter scaled by its weight `rho_c`, the unknown being
 //! `y_c = r'_c / rho_c` (a length), so that every block of the matrix is a stiffness and the
@@ -39,8 +43,9 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::lu::{
     LuRef, LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu,
 };
+use faer::sparse::linalg::matmul::sparse_dense_matmul;
 use faer::sparse::{Argsort, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat};
-use faer::{Conj, Mat};
+use faer::{Accum, Conj, MatRef};
 use nalgebra::DVector;
 use skid_contact::coulomb::alart_curnier::{LocalBranch, LocalLaw};
 
@@ -49,9 +54,11 @@ use crate::error::IncrementFailure;
 use crate::krylov::gmres;
 use crate::model::Model;
 use crate::quasi_definite::{CONSTRAINT_REGULARIZATION, QuasiDefinite};
+use crate::sparse::column_mut;
 
-/// Relative residual `||b - A z|| / ||b||` to which a system is solved iteratively on an
-/// earlier factorization; far below what Newton's quadratic convergence needs.
+/// Relative residual `||b - A z|| / ||b||` to which a system is solved iteratively (on earlier
+/// LU factors or the quasi-definite preconditioner); far below what Newton's quadratic
+/// convergence needs.
 const KRYLOV_TOLERANCE: f64 = 1e-12;
 /// GMRES iterations on an earlier factorization before the next preconditioner is tried.
 const KRYLOV_MAX_ITERATIONS: usize = 8;
@@ -63,6 +70,9 @@ const KRYLOV_MAX_ITERATIONS: usize = 8;
 const QUASI_DEFINITE_FROM: usize = 2000;
 /// GMRES iterations on the quasi-definite preconditioner before the matrix is factorized.
 const QUASI_DEFINITE_MAX_ITERATIONS: usize = 30;
+
+/// Lower-triangle entries (`i >= j`) of a symmetric matrix and their values.
+type LowerTriangle = (Vec<Pair<usize, usize>>, Vec<f64>);
 
 /// The symbolic analysis of the last pattern, kept while the pattern stays the same.
 #[derive(Debug)]
@@ -85,16 +95,13 @@ impl Factors {
     fn solve(&self, b: &DVector<f64>, out: &mut DVector<f64>) {
         let par = faer::get_global_parallelism();
         let mut scratch = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, par));
-        let mut column = Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
+        out.copy_from(b);
         LuRef::new_unchecked(&self.symbolic, &self.numeric).solve_in_place_with_conj(
             Conj::No,
-            column.as_mut(),
+            column_mut(out),
             par,
             MemStack::new(&mut scratch),
         );
-        for (o, c) in out.iter_mut().zip(column.col(0).iter()) {
-            *o = *c;
-        }
     }
 }
 
@@ -117,36 +124,26 @@ fn checked_gmres(
 
 /// `out = A x` for a sparse `A`.
 fn sparse_times(a: SparseColMatRef<'_, usize, f64>, x: &DVector<f64>, out: &mut DVector<f64>) {
-    out.fill(0.0);
-    for j in 0..a.ncols() {
-        let xj = x[j];
-        for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
-            out[i] += v * xj;
-        }
-    }
+    let n = x.len();
+    sparse_dense_matmul(
+        column_mut(out),
+        Accum::Replace,
+        a,
+        MatRef::from_column_major_slice(x.as_slice(), n, 1),
+        1.0,
+        faer::get_global_parallelism(),
+    );
 }
 
-/// The global contact step, with the symbolic analysis and the factorization it reuses across
-/// Newton iterations and increments.
-///
-/// Each system is first solved by GMRES (see [`crate::krylov`]) preconditioned with the last factorization (exact
-/// for the matrix it was computed from; the matrix of the next iteration or increment differs
-/// by the change of the state and, where a candidate changed branch, by a low-rank term, so a
-/// few iterations suffice). The result is accepted only if its true residual is below
-/// [`KRYLOV_TOLERANCE`]; otherwise, or after [`KRYLOV_MAX_ITERATIONS`], the matrix is factorized
-/// and solved directly, and that factorization serves from then on.
+/// The global contact step, with what it reuses across Newton iterations and increments: the
+/// symbolic analysis of the pattern, the last LU factors and the quasi-definite preconditioner
+/// (see [`GlobalContactSolver::step`] for the order in which they are tried).
 #[derive(Debug, Default)]
 pub struct GlobalContactSolver {
     analysed: Option<Analysed>,
     factors: Option<Factors>,
     /// The last GMRES on `factors` failed: skip them until the next factorization.
     factors_stale: bool,
-    /// Numeric LU factorizations performed.
-    pub factorizations: usize,
-    /// Systems solved iteratively on an earlier factorization.
-    pub iterative_solves: usize,
-    /// Systems solved iteratively on the quasi-definite preconditioner.
-    pub quasi_definite_solves: usize,
     /// The quasi-definite preconditioner.
     quasi_definite: QuasiDefinite,
     /// Symbolic analyses performed.
@@ -191,12 +188,16 @@ impl GlobalContactSolver {
             pairs.push(Pair::new(i, j));
             values.push(v);
         };
-        // the symmetric approximation S (lower triangle) of the preconditioner
+        // the symmetric approximation S (lower triangle) of the preconditioner, for systems
+        // large enough to use it
+        let symmetric = n + m >= QUASI_DEFINITE_FROM;
         let mut s_pairs: Vec<Pair<usize, usize>> = Vec::new();
         let mut s_values: Vec<f64> = Vec::new();
         let mut s_push = |i: usize, j: usize, v: f64| {
-            s_pairs.push(Pair::new(i, j));
-            s_values.push(v);
+            if symmetric {
+                s_pairs.push(Pair::new(i, j));
+                s_values.push(v);
+            }
         };
         for j in 0..n {
             for (&i, &v) in k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
@@ -271,7 +272,8 @@ impl GlobalContactSolver {
             }
         }
         let matrix = self.assemble(n + m, pairs, &values)?;
-        let solution = self.solve_system(matrix.as_ref(), &rhs, n, s_pairs, &s_values)?;
+        let s = symmetric.then_some((s_pairs, s_values));
+        let solution = self.solve_system(matrix.as_ref(), &rhs, n, s)?;
         let dx = DVector::from_fn(n, |i, _| solution[i]);
         let forces = DVector::from_fn(m, |k, _| rho[k / d] * solution[n + k]);
         if dx.iter().chain(forces.iter()).any(|v| !v.is_finite()) {
@@ -282,9 +284,9 @@ impl GlobalContactSolver {
         Ok(GlobalStep { dx, r: forces })
     }
 
-    /// Solves `matrix z = rhs`: by GMRES on the last LU factors while they serve, then (for
-    /// systems of at least [`QUASI_DEFINITE_FROM`] equations) by GMRES on the quasi-definite
-    /// approximation `S` (lower-triangle `s_pairs`, `s_values`), else by a new LU factorization.
+    /// Solves `matrix z = rhs`: by GMRES on the last LU factors while they serve, then by
+    /// GMRES on the quasi-definite approximation `S` if `symmetric` gives it (lower-triangle
+    /// entries and values; first `unknowns` rows positive), else by a new LU factorization.
     ///
     /// # Errors
     /// [`IncrementFailure::LinearSolve`] if the LU factorization fails.
@@ -293,17 +295,14 @@ impl GlobalContactSolver {
         matrix: SparseColMatRef<'_, usize, f64>,
         rhs: &DVector<f64>,
         unknowns: usize,
-        s_pairs: Vec<Pair<usize, usize>>,
-        s_values: &[f64],
+        symmetric: Option<LowerTriangle>,
     ) -> Result<DVector<f64>, IncrementFailure> {
         if let Some(z) = self.iterate(matrix, rhs) {
-            self.iterative_solves += 1;
             return Ok(z);
         }
-        if rhs.len() >= QUASI_DEFINITE_FROM
-            && let Some(z) = self.iterate_quasi_definite(matrix, rhs, unknowns, s_pairs, s_values)
+        if let Some((s_pairs, s_values)) = symmetric
+            && let Some(z) = self.iterate_quasi_definite(matrix, rhs, unknowns, s_pairs, &s_values)
         {
-            self.quasi_definite_solves += 1;
             return Ok(z);
         }
         self.factorize(matrix)?;
@@ -405,7 +404,6 @@ impl GlobalContactSolver {
                 Default::default(),
             )
             .map_err(|e| fail(&e))?;
-        self.factorizations += 1;
         self.factors = Some(Factors { symbolic, numeric });
         self.factors_stale = false;
         Ok(())

@@ -31,10 +31,11 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky,
 };
 use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
-use faer::{Conj, Mat, Side};
+use faer::{Conj, Side};
 use nalgebra::DVector;
 
 use crate::error::IncrementFailure;
+use crate::sparse::column_mut;
 
 /// Relative weight `eps` of the constraint rows' diagonal (see the module documentation). The
 /// `L D L^T` factors lose accuracy as `eps` shrinks, since a constraint row eliminated before
@@ -140,17 +141,15 @@ impl QuasiDefinite {
         };
         let par = faer::get_global_parallelism();
         let mut scratch = MemBuffer::new(a.analysis.solve_in_place_scratch::<f64>(1, par));
-        let mut column =
-            Mat::<f64>::from_fn(v.len(), 1, |i, _| if i < a.unknowns { v[i] } else { -v[i] });
+        for (i, (o, vi)) in out.iter_mut().zip(v.iter()).enumerate() {
+            *o = if i < a.unknowns { *vi } else { -vi };
+        }
         LdltRef::new(&a.analysis, &a.factor).solve_in_place_with_conj(
             Conj::No,
-            column.as_mut(),
+            column_mut(out),
             par,
             MemStack::new(&mut scratch),
         );
-        for (o, c) in out.iter_mut().zip(column.col(0).iter()) {
-            *o = *c;
-        }
     }
 }
 

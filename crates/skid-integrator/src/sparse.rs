@@ -31,6 +31,13 @@ use crate::error::IncrementFailure;
 /// Message of [`SparsePattern::factorize`] for a matrix with NaN or infinite entries.
 pub const NON_FINITE_TANGENT: &str = "non-finite entries in the effective tangent";
 
+/// `v` as a one-column faer matrix, for faer's solves and products in
+/// place.
+pub(crate) fn column_mut(v: &mut DVector<f64>) -> MatMut<'_, f64> {
+    let n = v.len();
+    MatMut::from_column_major_slice_mut(v.as_mut_slice(), n, 1)
+}
+
 /// Collects the (row, column) positions of the lower triangle in the order values will be
 /// written, and hands out the slot of each.
 #[derive(Debug, Default)]

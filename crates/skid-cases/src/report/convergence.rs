@@ -124,7 +124,8 @@ fn invariant_part(case: &Case) -> Value {
     v
 }
 
-fn time_steps(case: &Case) -> Vec<f64> {
+/// The time steps of the case's dynamic steps, in order.
+pub(crate) fn time_steps(case: &Case) -> Vec<f64> {
     case.steps
         .iter()
         .filter_map(|s| match s {
