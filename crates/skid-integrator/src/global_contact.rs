@@ -315,11 +315,12 @@ impl GlobalContactSolver {
         Ok(z)
     }
 
-    /// GMRES on `matrix z = rhs`, right-preconditioned by the last factorization unless it is
+    /// GMRES on `matrix z = rhs`, right-preconditioned by the last LU factors unless they are
     /// stale; `Some(z)` if its true relative residual reaches [`KRYLOV_TOLERANCE`] within
-    /// [`KRYLOV_MAX_ITERATIONS`].
-    fn iterate_on_factors(
-        &self,
+    /// [`KRYLOV_MAX_ITERATIONS`]. A failure marks the factors stale: once they no longer serve,
+    /// they are not tried again until the next factorization.
+    fn iterate(
+        &mut self,
         matrix: SparseColMatRef<'_, usize, f64>,
         rhs: &DVector<f64>,
     ) -> Option<DVector<f64>> {
@@ -327,22 +328,12 @@ impl GlobalContactSolver {
             return None;
         }
         let factors = self.factors.as_ref()?;
-        checked_gmres(
+        let solution = checked_gmres(
             matrix,
             rhs,
             |x, out| factors.solve(x, out),
             KRYLOV_MAX_ITERATIONS,
-        )
-    }
-
-    /// [`Self::iterate_on_factors`], marking the factors stale when it fails: once they no
-    /// longer serve, they are not tried again until the next factorization.
-    fn iterate(
-        &mut self,
-        matrix: SparseColMatRef<'_, usize, f64>,
-        rhs: &DVector<f64>,
-    ) -> Option<DVector<f64>> {
-        let solution = self.iterate_on_factors(matrix, rhs);
+        );
         self.factors_stale = solution.is_none();
         solution
     }
