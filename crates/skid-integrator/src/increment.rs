@@ -220,8 +220,9 @@ fn solve_increment_with<const D: usize>(
     assembler.start_mixed_pressures(model, &start.x)?;
     let mut counters = IncrementCounters::default();
     let mut warm = start.warm_forces.clone();
-    // Contact forces and linearised kinematics of the last conic solve.
-    let mut last: Option<(DVector<f64>, DVector<f64>)> = None;
+    // The contact forces of the last step and what the next iterate's contact state is
+    // checked against.
+    let mut last: Option<LastForces> = None;
     // The last step (at first the predictor's) and how often it has been halved (see below).
     let mut last_step: Option<DVector<f64>> = match kind {
         IncrementKind::Static { .. } => None,
@@ -288,7 +289,8 @@ fn solve_increment_with<const D: usize>(
         assembler.hold(held);
         timings.assembly += clock.elapsed();
 
-        if let Some((r, u_lin)) = &last {
+        if let Some(forces) = &last {
+            let r = forces.r();
             let contact_force = rows.transpose_times(r, n);
             let full = &residual - &contact_force;
             let force_residual = scaled_force_residual(
@@ -297,10 +299,10 @@ fn solve_increment_with<const D: usize>(
                 &[&internal.force, &f_ext, &inertia, &contact_force],
                 length,
             );
-            let contact_residual = match (&weights, rows.is_empty()) {
-                (_, true) => 0.0,
-                (Some(rho), false) => law_residual(&rows, r, rho) / length,
-                (None, false) => (&rows.u - u_lin).amax() / length,
+            let contact_residual = match forces {
+                _ if rows.is_empty() => 0.0,
+                LastForces::Linearised { u, .. } => (&rows.u - u).amax() / length,
+                LastForces::Law { r, rho } => law_residual(&rows, r, rho) / length,
             };
             counters.residuals.push((force_residual, contact_residual));
             if !force_residual.is_finite() || !contact_residual.is_finite() {
@@ -338,7 +340,10 @@ fn solve_increment_with<const D: usize>(
             let (factor, _) = assembler.with_mass_shift(mass, m_factor, held, |a| a.factorize())?;
             let dx = factor.solve(&(-&residual));
             timings.linear_solve += clock.elapsed();
-            last = Some((DVector::zeros(0), DVector::zeros(0)));
+            last = Some(LastForces::Linearised {
+                r: DVector::zeros(0),
+                u: DVector::zeros(0),
+            });
             dx
         } else if method == ContactSolve::Global {
             let clock = Instant::now();
@@ -351,7 +356,10 @@ fn solve_increment_with<const D: usize>(
             timings.linear_solve += clock.elapsed();
             let step = step?;
             warm.clone_from(&step.r);
-            last = Some((step.r, DVector::zeros(0)));
+            last = Some(LastForces::Law {
+                r: step.r,
+                rho: rho.clone(),
+            });
             step.dx
         } else {
             // Once the forces balance and only the contact kinematics is left to converge
@@ -381,7 +389,10 @@ fn solve_increment_with<const D: usize>(
             counters.fixed_point_iterations += solution.fixed_point_iterations;
             counters.contact_newton_steps += solution.newton_steps;
             warm.clone_from(&solution.r);
-            last = Some((solution.r, solution.u));
+            last = Some(LastForces::Linearised {
+                r: solution.r,
+                u: solution.u,
+            });
             dx
         };
         counters.newton_iterations += 1;
@@ -399,6 +410,25 @@ fn solve_increment_with<const D: usize>(
         force_residual: f64::NAN,
         contact_residual: f64::NAN,
     })
+}
+
+/// The contact forces of a Newton step and how the next iterate's contact state is judged.
+enum LastForces {
+    /// A reduced step: the forces `r` satisfy the Coulomb law with the linearised local
+    /// quantities `u`; the contact residual is how far the actual ones are from `u`.
+    Linearised { r: DVector<f64>, u: DVector<f64> },
+    /// A global step: the contact residual is the law's own residual at the new kinematics
+    /// with the forces `r` and the increment's weights `rho`.
+    Law { r: DVector<f64>, rho: Vec<f64> },
+}
+
+impl LastForces {
+    /// The forces, one per contact row.
+    fn r(&self) -> &DVector<f64> {
+        match self {
+            Self::Linearised { r, .. } | Self::Law { r, .. } => r,
+        }
+    }
 }
 
 /// Newton iterations the global contact solve gets before the increment is handed to the
