@@ -217,6 +217,7 @@ impl GlobalContactSolver {
             .iter()
             .enumerate()
             .flat_map(|(p, pair)| pair.nodes.iter().map(move |&node| (p, node)));
+        let mut open = vec![false; rows.len()];
         for (c, (pair, node)) in candidates.enumerate().take(rows.len()) {
             let equations: Vec<usize> = contact_coordinates(model, pair, node)
                 .into_iter()
@@ -241,6 +242,7 @@ impl GlobalContactSolver {
                 &rows.u.as_slice()[block.clone()],
                 LocalBranch::Frictionless,
             );
+            open[c] = law.branch == LocalBranch::Open;
             for t in 0..d {
                 let row = n + c * d + t;
                 let constraint = match law.branch {
@@ -275,7 +277,14 @@ impl GlobalContactSolver {
         let s = symmetric.then_some((s_pairs, s_values));
         let solution = self.solve_system(matrix.as_ref(), &rhs, n, s)?;
         let dx = DVector::from_fn(n, |i, _| solution[i]);
-        let forces = DVector::from_fn(m, |k, _| rho[k / d] * solution[n + k]);
+        // An open candidate's rows say `r = 0`: exactly zero, not the linear solve's round-off.
+        let forces = DVector::from_fn(m, |k, _| {
+            if open[k / d] {
+                0.0
+            } else {
+                rho[k / d] * solution[n + k]
+            }
+        });
         if dx.iter().chain(forces.iter()).any(|v| !v.is_finite()) {
             return Err(IncrementFailure::LinearSolve(
                 "the contact system is singular (non-finite step)".into(),
