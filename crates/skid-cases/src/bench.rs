@@ -1,7 +1,8 @@
-//! `skid bench`: the cost of a case beside its error, over a ladder of time steps and the
-//! contact solves.
+//! `skid bench`: the cost of a case beside its error, over a ladder of time steps and methods.
 //!
-//! Each case is run, for every contact solve asked for (`solver.contact_solve`), at the time
+//! A method ([`BenchMethod`]) is a contact solve, optionally on the case with its pad
+//! quasi-static (no inertia, DRUM.md's pad modelled only as far as the spin-down needs it).
+//! Each case is run, for every method asked for, at the time
 //! steps `dt_k = dt ratio^(coarser - k)`, `k = 0 .. levels` (every dynamic step's `dt` scaled
 //! alike: `coarser` levels coarser than the case, the case itself, then finer). The finest level of a case
 //! and solve is its converged reference, and each level's error is measured against it in the
@@ -43,8 +44,8 @@ pub struct BenchSettings {
     pub coarser: usize,
     /// Timed repetitions of a short run (at least 1).
     pub repeats: usize,
-    /// The contact solves to compare.
-    pub methods: Vec<ContactSolveSpec>,
+    /// The methods to compare.
+    pub methods: Vec<BenchMethod>,
 }
 
 impl Default for BenchSettings {
@@ -54,7 +55,61 @@ impl Default for BenchSettings {
             ratio: 2.0,
             coarser: 2,
             repeats: 5,
-            methods: vec![ContactSolveSpec::Reduced, ContactSolveSpec::Global],
+            methods: vec![BenchMethod::Reduced, BenchMethod::Global],
+        }
+    }
+}
+
+/// How a case is run in the bench.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BenchMethod {
+    /// The case as it is, reduced contact solve.
+    Reduced,
+    /// The case as it is, global contact solve.
+    Global,
+    /// The pad quasi-static (`pad.quasi_static`), global contact solve.
+    QuasiStatic,
+}
+
+impl BenchMethod {
+    /// Every method, in the order of the report.
+    pub const ALL: [Self; 3] = [Self::Reduced, Self::Global, Self::QuasiStatic];
+
+    /// The name the method has on the command line and in the records.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Reduced => "reduced",
+            Self::Global => "global",
+            Self::QuasiStatic => "quasi-static",
+        }
+    }
+
+    /// The method of a label.
+    ///
+    /// # Errors
+    /// A message listing the labels.
+    pub fn parse(label: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.label() == label)
+            .ok_or_else(|| {
+                let names: Vec<_> = Self::ALL.iter().map(|m| m.label()).collect();
+                format!("expected one of {}, got {label:?}", names.join(", "))
+            })
+    }
+
+    /// Sets the case up to run by this method.
+    fn apply(self, case: &mut Case) {
+        let (solve, quasi_static) = match self {
+            Self::Reduced => (ContactSolveSpec::Reduced, case.pad.quasi_static),
+            Self::Global => (ContactSolveSpec::Global, case.pad.quasi_static),
+            Self::QuasiStatic => (ContactSolveSpec::Global, true),
+        };
+        case.solver.contact_solve = solve;
+        case.pad.quasi_static = quasi_static;
+        if quasi_static {
+            // the plate moves with the pad and has no inertia of its own either
+            case.back_plate.mass = 0.0;
         }
     }
 }
@@ -64,7 +119,7 @@ impl Default for BenchSettings {
 pub struct BenchRecord {
     /// Case name.
     pub case: String,
-    /// Contact solve (`"reduced"` or `"global"`).
+    /// Method ([`BenchMethod::label`]).
     pub method: String,
     /// Time step of the dynamic steps, s.
     pub dt: f64,
@@ -122,16 +177,15 @@ pub enum BenchError {
     },
 }
 
-/// The case with every dynamic step's time step multiplied by `factor` and the contact solve
-/// `method`.
-pub fn level_case(case: &Case, factor: f64, method: ContactSolveSpec) -> Case {
+/// The case with every dynamic step's time step multiplied by `factor`, set up for `method`.
+pub fn level_case(case: &Case, factor: f64, method: BenchMethod) -> Case {
     let mut case = case.clone();
     for step in &mut case.steps {
         if let StepSpec::Dynamic { dt, .. } = step {
             *dt *= factor;
         }
     }
-    case.solver.contact_solve = method;
+    method.apply(&mut case);
     case
 }
 
@@ -189,7 +243,7 @@ pub fn run_bench(
             )));
         };
         for &method in &settings.methods {
-            let label = method_label(method);
+            let label = method.label();
             let mut runs = Vec::new();
             for k in 0..settings.levels {
                 let exponent = i32::try_from(settings.coarser).unwrap_or(i32::MAX)
@@ -314,7 +368,9 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
     let mut md = String::from("# Work against error (`skid bench`)\n\n");
     md.push_str(
         "Each case at a ladder of time steps (every dynamic step's dt scaled alike) with each \
-         contact solve; the finest level of a case and solve is its reference. Wall time: the \
+         method (`reduced` and `global`: the contact solves on the case as it is; \
+         `quasi-static`: the pad without inertia, global solve); the finest level of a case \
+         and method is its reference. Wall time: the \
          solver's, median of the timed runs (runs under 2 s: one warm-up, then the repeats). \
          Errors against the reference: the deceleration (relative), e_slide (max |omega - \
          omega_ref| / omega0 over t <= 0.9 t_stop) and t_stop (relative; the pad vibration \
@@ -327,7 +383,7 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
         crate::report::plot::WORK_PRECISION_SVG
     );
     md.push_str(
-        "| case | contact solve | dt [s] | status | wall [s] | runs | assembly / linear / contact [s] | increments | Newton iterations | fallbacks | deceleration [rad/s^2] | deceleration error [%] | e_slide [%] | t_stop [s] | t_stop difference [%] |\n\
+        "| case | method | dt [s] | status | wall [s] | runs | assembly / linear / contact [s] | increments | Newton iterations | fallbacks | deceleration [rad/s^2] | deceleration error [%] | e_slide [%] | t_stop [s] | t_stop difference [%] |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in records {
@@ -354,16 +410,52 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
             percent(r.t_stop_difference),
         );
     }
+    md.push_str(&model_change(records));
     let path = out.join(BENCH_MD);
     write_atomic(&path, &md).map_err(|source| BenchError::Write { path, source })
 }
 
-/// The name a contact solve has in case files and records.
-pub fn method_label(method: ContactSolveSpec) -> &'static str {
-    match method {
-        ContactSolveSpec::Reduced => "reduced",
-        ContactSolveSpec::Global => "global",
+/// What the quasi-static pad changes in the answer: for every case with both, the quasi-static
+/// reference against the dynamic one (the `reduced` reference, else the `global` one).
+fn model_change(records: &[BenchRecord]) -> String {
+    use crate::report::format::percent;
+    use std::fmt::Write as _;
+    let reference = |case: &str, method: BenchMethod| {
+        records
+            .iter()
+            .find(|r| r.reference && r.case == case && r.method == method.label())
+    };
+    let mut md = String::new();
+    let mut cases: Vec<&str> = records.iter().map(|r| r.case.as_str()).collect();
+    cases.dedup();
+    for case in cases {
+        let Some(qs) = reference(case, BenchMethod::QuasiStatic) else {
+            continue;
+        };
+        let Some(dynamic) =
+            reference(case, BenchMethod::Reduced).or(reference(case, BenchMethod::Global))
+        else {
+            continue;
+        };
+        let relative = |a: Option<f64>, b: Option<f64>| match (a, b) {
+            (Some(a), Some(b)) if b != 0.0 => percent(Some((a - b) / b)),
+            _ => "n/a".into(),
+        };
+        if md.is_empty() {
+            md.push_str(
+                "\n## What the quasi-static pad changes\n\nEach case's quasi-static reference \
+                 against its dynamic one (finest levels, signed):\n\n\
+                 | case | deceleration [%] | t_stop [%] |\n|---|---|---|\n",
+            );
+        }
+        let _ = writeln!(
+            md,
+            "| {case} | {} | {} |",
+            relative(qs.deceleration, dynamic.deceleration),
+            relative(qs.t_stop, dynamic.t_stop)
+        );
     }
+    md
 }
 
 #[cfg(test)]
@@ -392,7 +484,7 @@ mod tests {
             ratio: 4.0,
             coarser: 1,
             repeats: 3,
-            methods: vec![ContactSolveSpec::Reduced],
+            methods: vec![BenchMethod::Reduced],
         };
         let mut lines = 0;
         let records =

@@ -125,6 +125,7 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
         density: pad.density,
         thickness: if D == 2 { pad.width } else { 1.0 },
         hourglass_scale: pad.hourglass_scale,
+        quasi_static: pad.quasi_static,
     };
     let model = Model::new(
         part,
@@ -206,8 +207,9 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
         },
         // the conic method solves the Coulomb problem on the Delassus operator: the reduced path
         contact_solve: match (s.contact_solve, s.coulomb_method) {
-            (ContactSolveSpec::Global, CoulombMethodSpec::NewtonFirst) => ContactSolve::Global,
-            _ => ContactSolve::Reduced,
+            (_, CoulombMethodSpec::Conic) | (ContactSolveSpec::Reduced, _) => ContactSolve::Reduced,
+            (ContactSolveSpec::Auto, _) if !case.pad.quasi_static => ContactSolve::Reduced,
+            _ => ContactSolve::Global,
         },
         cutback: CutbackSettings {
             factor: s.cutback_factor,

@@ -129,6 +129,11 @@ pub struct PadSpec {
     /// Factor on the hourglass stabilisation stiffness.
     #[serde(default = "one")]
     pub hourglass_scale: f64,
+    /// The pad has no inertia: in the spin-down it is in equilibrium with the mean contact
+    /// force of each increment (`density` then only regularises the static Newton steps). The
+    /// back plate tied to it must then be massless too.
+    #[serde(default)]
+    pub quasi_static: bool,
 }
 
 fn one() -> f64 {
@@ -317,12 +322,17 @@ impl From<CoulombMethodSpec> for skid_contact::coulomb::CoulombMethod {
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum ContactSolveSpec {
+    /// `global` for a quasi-static pad, `reduced` otherwise. A quasi-static pad is held only by
+    /// its contacts: without them its stiffness is singular (the pad and plate translate
+    /// freely), and the reduced path, which needs its inverse, regularises it by a mass shift
+    /// that slows Newton down; the global system holds the contacts and needs none.
+    #[default]
+    Auto,
     /// Step and forces together on one sparse system (semismooth Newton on the Alart–Curnier
     /// function); an increment it does not converge is solved again by `reduced`.
     Global,
     /// The exact Coulomb problem on the dense Delassus operator of the contact set, by
     /// `coulomb_method` (which `conic` requires).
-    #[default]
     Reduced,
 }
 

@@ -292,6 +292,16 @@ pub fn validate(case: &Case) -> Result<(), Problem> {
     }
     non_negative("back_plate.pressure", case.back_plate.pressure)?;
     non_negative("back_plate.mass", case.back_plate.mass)?;
+    if p.quasi_static && case.back_plate.mass > 0.0 {
+        return Err((
+            "back_plate.mass".into(),
+            format!(
+                "expected 0 with a quasi-static pad (the plate is tied to it and moves with \
+                 it), got {}",
+                case.back_plate.mass
+            ),
+        ));
+    }
     non_negative("contact.mu", case.contact.mu)?;
     if let ContactFormulation::General { search_distance } = case.contact.formulation {
         positive("contact.formulation.search_distance", search_distance)?;

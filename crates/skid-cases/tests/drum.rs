@@ -222,3 +222,29 @@ fn a_preloaded_pad_stays_put_on_a_resting_drum_at_millisecond_steps() {
     }
     assert!(s.max_gap_violation_m < 1e-6);
 }
+
+/// A quasi-static pad (no inertia) spins the drum down within the benchmark's band, with a
+/// deceleration that no longer depends on the time step: the pad vibration that moves the
+/// dynamic pad's deceleration with dt and density is gone.
+#[test]
+fn a_quasi_static_pad_gives_a_deceleration_independent_of_the_time_step() {
+    let (fine, _d1) = run(&["pad.quasi_static=true", "steps[1].dt=4e-4"]);
+    let (coarse, _d2) = run(&["pad.quasi_static=true", "steps[1].dt=1.6e-3"]);
+    for s in [&fine, &coarse] {
+        assert_benchmark_spin_down(s);
+        assert_all_energy_goes_into_friction(s);
+    }
+    let d = relative(fine.deceleration, coarse.deceleration);
+    assert!(d < 1e-7, "deceleration moves by {d} between 0.4 and 1.6 ms");
+    let err = parse_case(
+        CASE_2D,
+        Path::new("case.json"),
+        &["pad.quasi_static=true".into(), "back_plate.mass=2".into()],
+    )
+    .expect_err("a massive plate on a quasi-static pad");
+    let msg = err.to_string();
+    assert!(
+        msg.contains("back_plate.mass") && msg.contains("quasi-static"),
+        "{msg}"
+    );
+}

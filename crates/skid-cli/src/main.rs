@@ -13,8 +13,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use skid_cases::ReportSources;
-use skid_cases::bench::BenchSettings;
-use skid_cases::schema::ContactSolveSpec;
+use skid_cases::bench::{BenchMethod, BenchSettings};
 
 #[derive(Parser)]
 #[command(
@@ -97,7 +96,8 @@ enum Command {
         /// Timed repetitions of runs shorter than 2 s (after one warm-up).
         #[arg(long, default_value_t = 5)]
         repeats: usize,
-        /// Contact solves to compare: reduced, global (comma-separated).
+        /// Methods to compare (comma-separated): reduced, global (the contact solves), quasi-static
+        /// (the pad without inertia, global solve).
         #[arg(long, value_delimiter = ',', default_value = "reduced,global")]
         methods: Vec<String>,
     },
@@ -144,14 +144,13 @@ fn main() -> ExitCode {
         } => {
             let mut solves = Vec::new();
             for method in &methods {
-                solves.push(match method.as_str() {
-                    "reduced" => ContactSolveSpec::Reduced,
-                    "global" => ContactSolveSpec::Global,
-                    other => {
-                        eprintln!("skid: --methods: expected reduced or global, got {other:?}");
+                match BenchMethod::parse(method) {
+                    Ok(method) => solves.push(method),
+                    Err(message) => {
+                        eprintln!("skid: --methods: {message}");
                         return ExitCode::from(2);
                     }
-                });
+                }
             }
             let settings = BenchSettings {
                 levels,

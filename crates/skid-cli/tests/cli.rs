@@ -150,7 +150,7 @@ fn a_run_that_cannot_converge_exits_1_and_says_where() {
 }
 
 #[test]
-fn bench_rejects_an_unknown_contact_solve_and_a_ladder_without_reference() {
+fn bench_rejects_an_unknown_method_and_a_ladder_without_reference() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = skid()
         .args(["bench", CASE, "--methods", "dense", "--out"])
@@ -158,7 +158,11 @@ fn bench_rejects_an_unknown_contact_solve_and_a_ladder_without_reference() {
         .output()
         .expect("runs");
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("expected reduced or global"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("expected one of reduced, global, quasi-static, got \"dense\""),
+        "{stderr}"
+    );
     let out = skid()
         .args(["bench", CASE, "--levels", "1", "--coarser", "0", "--out"])
         .arg(dir.path())

@@ -93,6 +93,12 @@ impl Hht {
         2.0 * self.beta
     }
 
+    /// Factor `1/(2 beta)` on the force rows of equations without inertia, so that the contact
+    /// unknown `r` balances them as the mean force `p = 2 beta r` (see [`crate::increment`]).
+    pub fn quasi_static_factor(&self) -> f64 {
+        1.0 / self.impulse_force_factor()
+    }
+
     /// End-of-increment smooth acceleration and velocity when the contact forces act as an
     /// impulse. `a_total` is the Newmark acceleration of the converged positions (which contains
     /// the contact term) and `contact = M^{-1} H^T r` the acceleration the contact unknown gives:

@@ -26,6 +26,11 @@ pub struct SolidPart<const D: usize> {
     pub thickness: f64,
     /// Factor on the hourglass stabilisation stiffness (1 = default).
     pub hourglass_scale: f64,
+    /// Whether the solid is quasi-static: its nodes carry no inertia, so in a dynamic step they
+    /// are in equilibrium with the mean contact forces of each increment (see
+    /// [`crate::increment`]). `density` then serves only the regularisation of static Newton
+    /// steps.
+    pub quasi_static: bool,
 }
 
 /// Nodes tied to a rigid body: they translate with its reference node.
@@ -76,6 +81,8 @@ pub struct Model<const D: usize> {
     elements: Vec<OnePointSolid<D>>,
     dofs: DofMap<D>,
     mass: DVector<f64>,
+    regularization_mass: DVector<f64>,
+    quasi_static: Vec<bool>,
     length_scale: f64,
 }
 
@@ -191,26 +198,28 @@ impl<const D: usize> Model<D> {
         let free_rotation: Vec<bool> = bodies.iter().map(|b| b.rotation_axis.is_some()).collect();
         let dofs = DofMap::new(n_nodes, &tied_to, &free_translations, &free_rotation);
 
-        let mut mass = DVector::zeros(dofs.len());
+        let mut solid_mass = DVector::zeros(dofs.len());
         for (element, conn) in elements.iter().zip(&part.mesh.elements) {
             let m = element.lumped_node_mass(part.density);
             for &n in conn {
                 for eq in dofs.node(n).iter().flatten() {
-                    mass[*eq] += m;
+                    solid_mass[*eq] += m;
                 }
             }
         }
+        let mut body_mass = DVector::zeros(dofs.len());
         for (b, body) in bodies.iter().enumerate() {
             for eq in dofs.body_translation(b).iter().flatten() {
-                mass[*eq] += body.mass;
+                body_mass[*eq] += body.mass;
             }
             if let Some(eq) = dofs.body_rotation(b) {
-                mass[eq] += body.rotary_inertia;
+                body_mass[eq] += body.rotary_inertia;
             }
         }
+        let regularization_mass = &solid_mass + &body_mass;
         for (b, body) in bodies.iter().enumerate() {
             for eq in dofs.body_equations(b) {
-                if mass[eq] <= 0.0 {
+                if regularization_mass[eq] <= 0.0 {
                     return invalid(format!(
                         "rigid body '{}' has a free motion without inertia (give it mass, \
                          rotary inertia, or tie nodes to it)",
@@ -219,6 +228,26 @@ impl<const D: usize> Model<D> {
                 }
             }
         }
+        // A quasi-static solid's equations (its nodes and the bodies tied to it) have no
+        // inertia. They may not carry a body's own mass: an equation with inertia coupled by
+        // stiffness to one without would need rows of the tangent scaled differently (see
+        // `crate::increment`), which breaks its symmetry.
+        let (mass, quasi_static) = if part.quasi_static {
+            for tie in &ties {
+                let body = &bodies[tie.body];
+                if body.mass > 0.0 {
+                    return invalid(format!(
+                        "rigid body '{}' is tied to the quasi-static solid and must be massless \
+                         too (its mass is {} kg)",
+                        body.name, body.mass
+                    ));
+                }
+            }
+            let quasi_static: Vec<bool> = solid_mass.iter().map(|&m| m > 0.0).collect();
+            (body_mass, quasi_static)
+        } else {
+            (regularization_mass.clone(), vec![false; dofs.len()])
+        };
 
         let mut lo = SVector::<f64, D>::repeat(f64::INFINITY);
         let mut hi = SVector::<f64, D>::repeat(f64::NEG_INFINITY);
@@ -242,6 +271,8 @@ impl<const D: usize> Model<D> {
             elements,
             dofs,
             mass,
+            regularization_mass,
+            quasi_static,
             length_scale,
         })
     }
@@ -274,9 +305,21 @@ impl<const D: usize> Model<D> {
     pub fn dofs(&self) -> &DofMap<D> {
         &self.dofs
     }
-    /// Lumped mass (or rotary inertia) of each equation.
+    /// Lumped mass (or rotary inertia) of each equation: its inertia, zero for the equations
+    /// of a quasi-static solid.
     pub fn mass(&self) -> &DVector<f64> {
         &self.mass
+    }
+    /// Lumped mass of each equation counting the solid's density even where it is
+    /// quasi-static: the mass term `M/h_s^2` by which Newton steps are regularised, never an
+    /// inertia.
+    pub fn regularization_mass(&self) -> &DVector<f64> {
+        &self.regularization_mass
+    }
+    /// Whether each equation belongs to a quasi-static solid (no inertia, see
+    /// [`SolidPart::quasi_static`]).
+    pub fn quasi_static(&self) -> &[bool] {
+        &self.quasi_static
     }
     /// `M^{-1} f` for the lumped mass matrix; equations without mass (which carry no force)
     /// get 0.

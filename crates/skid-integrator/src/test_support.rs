@@ -27,6 +27,7 @@ pub(crate) fn pad_block<const D: usize>(
         density: 1000.0,
         thickness: 0.1,
         hourglass_scale: 1.0,
+        quasi_static: false,
     }
 }
 

@@ -46,6 +46,7 @@ fn block(side_force: f64) -> (Model<2>, f64) {
         density: 1000.0,
         thickness: THICKNESS,
         hourglass_scale: 1.0,
+        quasi_static: false,
     };
     let body = common::translating_body;
     let model = Model::new(

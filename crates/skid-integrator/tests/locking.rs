@@ -42,6 +42,7 @@ fn tip_deflection(k_over_mu: f64) -> f64 {
         density: 1000.0,
         thickness: THICKNESS,
         hourglass_scale: 1.0,
+        quasi_static: false,
     };
     let wall = RigidBody::<2> {
         name: "wall".into(),

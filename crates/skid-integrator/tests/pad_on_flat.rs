@@ -50,6 +50,7 @@ fn pad(pressure: f64, d1: f64) -> Model<2> {
         density: 1000.0,
         thickness: WIDTH,
         hourglass_scale: 1.0,
+        quasi_static: false,
     };
     let body = common::translating_body;
     Model::new(
