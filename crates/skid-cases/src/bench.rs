@@ -24,7 +24,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::report::{ReportError, e_slide, load_run};
 use crate::runner::{run_case, write_atomic};
-use crate::schema::{Case, ContactSolveSpec, StepSpec};
+use crate::schema::{AdaptiveSpec, Case, ContactSolveSpec, StepSpec};
 use crate::validate::CaseError;
 
 /// Runs shorter than this (s) are repeated and their median taken.
@@ -69,11 +69,20 @@ pub enum BenchMethod {
     Global,
     /// The pad quasi-static (`pad.quasi_static`), global contact solve.
     QuasiStatic,
+    /// As [`Self::QuasiStatic`], with adaptive increments in the dynamic steps (see
+    /// [`adapt`]); measured against the finest `quasi-static` level where the bench runs it,
+    /// since both solve the same model.
+    QuasiStaticAdaptive,
 }
 
 impl BenchMethod {
     /// Every method, in the order of the report.
-    pub const ALL: [Self; 3] = [Self::Reduced, Self::Global, Self::QuasiStatic];
+    pub const ALL: [Self; 4] = [
+        Self::Reduced,
+        Self::Global,
+        Self::QuasiStatic,
+        Self::QuasiStaticAdaptive,
+    ];
 
     /// The name the method has on the command line and in the records.
     pub fn label(self) -> &'static str {
@@ -81,6 +90,7 @@ impl BenchMethod {
             Self::Reduced => "reduced",
             Self::Global => "global",
             Self::QuasiStatic => "quasi-static",
+            Self::QuasiStaticAdaptive => "quasi-static-adaptive",
         }
     }
 
@@ -98,12 +108,21 @@ impl BenchMethod {
             })
     }
 
+    /// The fixed-step method that solves the same model, whose finest level is this method's
+    /// reference.
+    fn fixed_counterpart(self) -> Option<Self> {
+        match self {
+            Self::QuasiStaticAdaptive => Some(Self::QuasiStatic),
+            _ => None,
+        }
+    }
+
     /// Sets the case up to run by this method.
     fn apply(self, case: &mut Case) {
         let (solve, quasi_static) = match self {
             Self::Reduced => (ContactSolveSpec::Reduced, case.pad.quasi_static),
             Self::Global => (ContactSolveSpec::Global, case.pad.quasi_static),
-            Self::QuasiStatic => (ContactSolveSpec::Global, true),
+            Self::QuasiStatic | Self::QuasiStaticAdaptive => (ContactSolveSpec::Global, true),
         };
         case.solver.contact_solve = solve;
         case.pad.quasi_static = quasi_static;
@@ -177,12 +196,35 @@ pub enum BenchError {
     },
 }
 
+/// Local error tolerance of an adaptive method's level at `factor` 1.
+pub const ADAPTIVE_TOLERANCE: f64 = 1e-6;
+
+/// The adaptive increments of a level at `factor`, in a dynamic step whose (scaled) time step is
+/// `dt`: `dt` first, tolerance `ADAPTIVE_TOLERANCE factor^2` (the estimate is of order `h^2`
+/// in the change of acceleration), increments from `dt / 1000` to `50 dt` (at most the step).
+pub fn adapt(dt: f64, duration: f64, factor: f64) -> AdaptiveSpec {
+    AdaptiveSpec {
+        tolerance: ADAPTIVE_TOLERANCE * factor * factor,
+        min_dt: dt * 1e-3,
+        max_dt: (50.0 * dt).min(duration),
+    }
+}
+
 /// The case with every dynamic step's time step multiplied by `factor`, set up for `method`.
 pub fn level_case(case: &Case, factor: f64, method: BenchMethod) -> Case {
     let mut case = case.clone();
     for step in &mut case.steps {
-        if let StepSpec::Dynamic { dt, .. } = step {
+        if let StepSpec::Dynamic {
+            dt,
+            duration,
+            adaptive,
+            ..
+        } = step
+        {
             *dt *= factor;
+            if method == BenchMethod::QuasiStaticAdaptive {
+                *adaptive = Some(adapt(*dt, *duration, factor));
+            }
         }
     }
     method.apply(&mut case);
@@ -242,6 +284,7 @@ pub fn run_bench(
                 source.display()
             )));
         };
+        let mut finest: Vec<(BenchMethod, PathBuf, BenchRecord)> = Vec::new();
         for &method in &settings.methods {
             let label = method.label();
             let mut runs = Vec::new();
@@ -297,7 +340,20 @@ pub fn run_bench(
                 progress(&record);
                 runs.push((record, dir));
             }
-            measure_against_finest(&mut runs)?;
+            let counterpart = method
+                .fixed_counterpart()
+                .and_then(|c| finest.iter().find(|(m, _, _)| *m == c));
+            if let Some((_, dir, record)) = counterpart {
+                for (r, _) in &mut runs {
+                    r.reference = false;
+                }
+                measure_against(&mut runs, record, dir)?;
+            } else if let Some((record, dir)) = runs.last().cloned() {
+                measure_against(&mut runs, &record, &dir)?;
+            }
+            if let Some((record, dir)) = runs.last() {
+                finest.push((method, dir.clone(), record.clone()));
+            }
             records.extend(runs.into_iter().map(|(r, _)| r));
         }
     }
@@ -309,12 +365,13 @@ pub fn run_bench(
     Ok(records)
 }
 
-/// Fills the errors of every level against the last (finest) one.
-fn measure_against_finest(runs: &mut [(BenchRecord, PathBuf)]) -> Result<(), BenchError> {
-    let Some((reference, reference_dir)) = runs.last().cloned() else {
-        return Ok(());
-    };
-    let reference_run = load_run(&reference_dir)?;
+/// Fills the errors of every level against the reference run (its record and directory).
+fn measure_against(
+    runs: &mut [(BenchRecord, PathBuf)],
+    reference: &BenchRecord,
+    reference_dir: &Path,
+) -> Result<(), BenchError> {
+    let reference_run = load_run(reference_dir)?;
     for (record, dir) in runs.iter_mut() {
         let relative = |a: Option<f64>, b: Option<f64>| match (a, b) {
             (Some(a), Some(b)) if b != 0.0 => Some((a - b).abs() / b.abs()),
@@ -369,8 +426,11 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
     md.push_str(
         "Each case at a ladder of time steps (every dynamic step's dt scaled alike) with each \
          method (`reduced` and `global`: the contact solves on the case as it is; \
-         `quasi-static`: the pad without inertia, global solve); the finest level of a case \
-         and method is its reference. Wall time: the \
+         `quasi-static`: the pad without inertia, global solve; `quasi-static-adaptive`: the \
+         same with adaptive increments, dt being the first one and the tolerance 1e-6 times \
+         the square of the level's dt ratio to the case's); the finest level of a case and \
+         method is its reference, and the adaptive method is measured against the finest \
+         `quasi-static` level where the bench runs it. Wall time: the \
          solver's, median of the timed runs (runs under 2 s: one warm-up, then the repeats). \
          Errors against the reference: the deceleration (relative), e_slide (max |omega - \
          omega_ref| / omega0 over t <= 0.9 t_stop) and t_stop (relative; the pad vibration \

@@ -19,7 +19,7 @@ use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 use skid_fem::tetra::TetMesh;
 use skid_integrator::increment::{ContactSolve, NewtonSettings};
-use skid_integrator::stepper::{CutbackSettings, Settings, Step, StepKind};
+use skid_integrator::stepper::{Adaptive, CutbackSettings, Settings, Step, StepKind};
 use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, Tie};
 
 use crate::schema::{
@@ -181,12 +181,18 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
                 dt,
                 alpha,
                 hold,
+                adaptive,
             } => Ok(Step {
                 name: name.clone(),
                 kind: StepKind::Dynamic {
                     duration: *duration,
                     dt: *dt,
                     alpha: *alpha,
+                    adaptive: adaptive.map(|a| Adaptive {
+                        tolerance: a.tolerance,
+                        min_dt: a.min_dt,
+                        max_dt: a.max_dt,
+                    }),
                 },
                 held_bodies: held(hold)?,
             }),

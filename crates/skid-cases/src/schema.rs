@@ -242,7 +242,25 @@ pub enum StepSpec {
         /// Rigid bodies held fixed.
         #[serde(default)]
         hold: Vec<String>,
+        /// Increments chosen by the local error, `dt` being the first (absent: `dt`
+        /// throughout).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        adaptive: Option<AdaptiveSpec>,
     },
+}
+
+/// Error-controlled increments of a dynamic step (see `skid_integrator::stepper::Adaptive`):
+/// an increment whose estimated local error exceeds `tolerance` is taken again shorter, the
+/// next size follows from the error, and an increment ends where the drum would stop.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AdaptiveSpec {
+    /// Local error tolerance, relative to the model size (translations) or 1 rad (rotations).
+    pub tolerance: f64,
+    /// Smallest increment, s.
+    pub min_dt: f64,
+    /// Largest increment, s.
+    pub max_dt: f64,
 }
 
 fn default_regularization_time() -> f64 {

@@ -57,6 +57,9 @@ pub struct Summary {
     pub contact_fallbacks: usize,
     /// Failed attempts answered by a cutback.
     pub cutbacks: usize,
+    /// Converged increments of adaptive steps taken again shorter for their local error.
+    #[serde(default)]
+    pub error_rejections: usize,
     /// The failed attempts by cause (e.g. "newton not converged": 3).
     pub cutback_causes: std::collections::BTreeMap<String, usize>,
     /// Wall time of the run, s.
@@ -232,6 +235,7 @@ pub fn summarize(
         contact_newton_steps: stats.contact_newton_steps,
         contact_fallbacks: stats.contact_fallbacks,
         cutbacks: stats.cutbacks,
+        error_rejections: stats.error_rejections,
         cutback_causes: stats
             .cutback_causes
             .iter()

@@ -333,6 +333,7 @@ pub fn validate(case: &Case) -> Result<(), Problem> {
                 dt,
                 alpha,
                 hold,
+                adaptive,
             } => {
                 if name.is_empty() {
                     return Err((f("name"), "expected a non-empty name".into()));
@@ -341,6 +342,23 @@ pub fn validate(case: &Case) -> Result<(), Problem> {
                 positive(&f("dt"), *dt)?;
                 if dt > duration {
                     return Err((f("dt"), format!("expected dt <= duration ({duration})")));
+                }
+                if let Some(a) = adaptive {
+                    positive(&f("adaptive.tolerance"), a.tolerance)?;
+                    positive(&f("adaptive.min_dt"), a.min_dt)?;
+                    positive(&f("adaptive.max_dt"), a.max_dt)?;
+                    if a.min_dt > *dt {
+                        return Err((
+                            f("adaptive.min_dt"),
+                            format!("expected min_dt <= dt ({dt})"),
+                        ));
+                    }
+                    if a.max_dt < *dt || a.max_dt > *duration {
+                        return Err((
+                            f("adaptive.max_dt"),
+                            format!("expected dt ({dt}) <= max_dt <= duration ({duration})"),
+                        ));
+                    }
                 }
                 // The integrator owns the admissible range; its message names it.
                 skid_integrator::hht::Hht::new(*alpha).map_err(|message| (f("alpha"), message))?;

@@ -106,6 +106,34 @@ fn non_physical_values_are_rejected_with_the_expected_range() {
             }),
             "contact.formulation.search_distance",
         ),
+        (
+            with(|v| {
+                v["steps"][1]["adaptive"] =
+                    serde_json::json!({"tolerance": 0.0, "min_dt": 1e-7, "max_dt": 5e-3})
+            }),
+            "steps[1].adaptive.tolerance",
+        ),
+        (
+            with(|v| {
+                v["steps"][1]["adaptive"] =
+                    serde_json::json!({"tolerance": 1e-6, "min_dt": 1e-3, "max_dt": 5e-3})
+            }),
+            "steps[1].adaptive.min_dt",
+        ),
+        (
+            with(|v| {
+                v["steps"][1]["adaptive"] =
+                    serde_json::json!({"tolerance": 1e-6, "min_dt": 1e-7, "max_dt": 1.0})
+            }),
+            "steps[1].adaptive.max_dt",
+        ),
+        (
+            with(|v| {
+                v["pad"]["quasi_static"] = true.into();
+                v["back_plate"]["mass"] = 2.0.into();
+            }),
+            "back_plate.mass",
+        ),
     ] {
         let (field, message) = error(&edit);
         assert_eq!(field, expected_field, "{message}");

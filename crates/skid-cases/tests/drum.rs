@@ -236,15 +236,37 @@ fn a_quasi_static_pad_gives_a_deceleration_independent_of_the_time_step() {
     }
     let d = relative(fine.deceleration, coarse.deceleration);
     assert!(d < 1e-7, "deceleration moves by {d} between 0.4 and 1.6 ms");
-    let err = parse_case(
-        CASE_2D,
-        Path::new("case.json"),
-        &["pad.quasi_static=true".into(), "back_plate.mass=2".into()],
-    )
-    .expect_err("a massive plate on a quasi-static pad");
-    let msg = err.to_string();
+}
+
+/// Adaptive increments on the quasi-static pad: a fraction of the fixed steps' increments for
+/// the same deceleration, and an increment that ends where the drum stops (omega = 0 there
+/// to round-off), so the stop time is not an interpolation across a sticking increment.
+#[test]
+fn adaptive_increments_land_on_the_stop_with_the_fixed_steps_answer() {
+    let adaptive = r#"steps[1].adaptive={"tolerance":1e-4,"min_dt":1e-7,"max_dt":5e-3}"#;
+    let (fixed, _d1) = run(&["pad.quasi_static=true"]);
+    let (s, dir) = run(&["pad.quasi_static=true", adaptive]);
+    assert_benchmark_spin_down(&s);
     assert!(
-        msg.contains("back_plate.mass") && msg.contains("quasi-static"),
-        "{msg}"
+        s.increments * 10 < fixed.increments,
+        "{} adaptive increments against {} fixed",
+        s.increments,
+        fixed.increments
     );
+    let d = relative(s.deceleration, fixed.deceleration);
+    assert!(d < 1e-7, "deceleration differs by {d}");
+    let t = relative(s.t_stop, fixed.t_stop);
+    assert!(t < 5e-4, "t_stop differs by {t}");
+    let history = std::fs::read_to_string(dir.path().join("history.csv")).expect("history");
+    let mut lines = history.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).expect("column");
+    let (time, omega) = (col("time"), col("drum_omega"));
+    let t_stop = s.t_stop.expect("stops");
+    let landed = lines.map(|l| l.split(',').collect::<Vec<_>>()).any(|f| {
+        let t: f64 = f[time].parse().expect("time");
+        let w: f64 = f[omega].parse().expect("omega");
+        (t - t_stop).abs() < 1e-9 && w.abs() < 1e-9 * 60.0
+    });
+    assert!(landed, "no increment ends at the stop {t_stop}");
 }

@@ -97,7 +97,8 @@ enum Command {
         #[arg(long, default_value_t = 5)]
         repeats: usize,
         /// Methods to compare (comma-separated): reduced, global (the contact solves), quasi-static
-        /// (the pad without inertia, global solve).
+        /// (the pad without inertia, global solve), quasi-static-adaptive (the same with adaptive
+        /// increments, tolerance 1e-6 scaled by the square of the level's factor).
         #[arg(long, value_delimiter = ',', default_value = "reduced,global")]
         methods: Vec<String>,
     },

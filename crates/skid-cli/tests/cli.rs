@@ -160,7 +160,9 @@ fn bench_rejects_an_unknown_method_and_a_ladder_without_reference() {
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("expected one of reduced, global, quasi-static, got \"dense\""),
+        stderr.contains(
+            "expected one of reduced, global, quasi-static, quasi-static-adaptive, got \"dense\""
+        ),
         "{stderr}"
     );
     let out = skid()

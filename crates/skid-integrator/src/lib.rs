@@ -40,4 +40,6 @@ mod test_support;
 pub use error::{IncrementFailure, ModelError, RunError};
 pub use model::{ContactPair, Model, PressureLoad, SolidPart, Tie};
 pub use state::State;
-pub use stepper::{IncrementReport, Observer, RunStatistics, Settings, Step, StepKind, run};
+pub use stepper::{
+    Adaptive, IncrementReport, Observer, RunStatistics, Settings, Step, StepKind, run,
+};

@@ -100,6 +100,7 @@ fn simulate(
             duration: 2e-3,
             dt: 2e-5,
             alpha,
+            adaptive: None,
         },
         held_bodies: vec![],
     }];

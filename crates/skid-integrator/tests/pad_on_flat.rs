@@ -96,6 +96,7 @@ fn load(model: &Model<2>, regularization_time: f64, settle: usize) -> State {
                 duration: 1e-4 * settle as f64,
                 dt: 1e-4,
                 alpha: -0.3,
+                adaptive: None,
             },
             held_bodies: vec![],
         });

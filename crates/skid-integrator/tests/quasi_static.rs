@@ -106,6 +106,7 @@ fn slide(dt: f64, method: ContactSolve) -> Vec<State> {
                 duration: 4e-3,
                 dt,
                 alpha: -0.3,
+                adaptive: None,
             },
             held_bodies: vec![],
         },
