@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Cost against error: runs `skid bench` on the benchmark's analytical-drum cases (2D and 3D) at
-# seven time steps (16x the case's down to a quarter of it) with both contact solves, then
+# seven time steps (16x the case's down to a quarter of it) with both contact solves, the
+# quasi-static pad and the quasi-static pad with adaptive increments, then
 # copies bench.md, bench.json and work-precision.svg into validation/. The runs stay in
 # out/bench/runs/. Exit status: that of skid bench.
 #
@@ -13,7 +14,8 @@ skid=${CARGO_TARGET_DIR:-target}/release/skid
 cases=(${BENCH_CASES:-cases/drum/2d-analytic.json cases/drum/3d-analytic.json})
 rm -rf out/bench
 status=0
-"$skid" bench "${cases[@]}" --out out/bench --levels 7 --coarser 4 || status=$?
+"$skid" bench "${cases[@]}" --out out/bench --levels 7 --coarser 4 \
+    --methods reduced,global,quasi-static,quasi-static-adaptive || status=$?
 for f in bench.md bench.json work-precision.svg; do
     [[ -f out/bench/$f ]] && cp "out/bench/$f" "validation/$f"
 done
