@@ -438,7 +438,12 @@ mod tests {
             ),
             (
                 ExpectedFailure::ContactSolve,
-                IncrementFailure::Contact("no solution".into()),
+                IncrementFailure::Contact(
+                    skid_contact::error::ContactError::FixedPointNotConverged {
+                        iterations: 50,
+                        error: 1e-3,
+                    },
+                ),
             ),
         ];
         for (expected, failure) in pairs {

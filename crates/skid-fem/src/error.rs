@@ -6,6 +6,12 @@ use thiserror::Error;
 #[non_exhaustive]
 #[derive(Debug, Error)]
 pub enum FemError {
+    /// An input holds NaN or infinite values.
+    #[error("non-finite {what}")]
+    NonFinite {
+        /// Which input.
+        what: &'static str,
+    },
     /// A material constant is out of its admissible range.
     #[error("invalid material constant {field} = {value}: expected {expected}")]
     InvalidMaterial {

@@ -227,8 +227,8 @@ impl<const D: usize> OnePointSolid<D> {
     ///
     /// # Errors
     /// [`FemError::LengthMismatch`] if `u` does not hold one vector per node,
-    /// [`FemError::InvertedElement`] if `J <= 0` at the centre or at a corner, or `F` is not
-    /// finite (`det_f` is the offending volume ratio).
+    /// [`FemError::NonFinite`] if `u` is not finite, [`FemError::InvertedElement`] if `J <= 0`
+    /// at the centre or at a corner (`det_f` is the offending volume ratio).
     pub fn respond(
         &self,
         material: &dyn Hyperelastic,
@@ -241,6 +241,11 @@ impl<const D: usize> OnePointSolid<D> {
                 what: "nodal displacements",
                 expected: n,
                 found: u.len(),
+            });
+        }
+        if u.iter().any(|v| !v.iter().all(|c| c.is_finite())) {
+            return Err(FemError::NonFinite {
+                what: "nodal displacements",
             });
         }
         let f = self.deformation_gradient(u);
@@ -860,9 +865,10 @@ mod tests {
         assert!(quad.evaluate(&m, &fold(0.4), false).is_ok());
         let mut nan = vec![V3::zeros(); 8];
         nan[3].x = f64::NAN;
+        // a NaN displacement is not an inverted element
         assert!(matches!(
             hex.evaluate(&m, &nan, false),
-            Err(FemError::InvertedElement { .. })
+            Err(FemError::NonFinite { .. })
         ));
         assert!(matches!(
             hex.evaluate(&m, &nan[..7], false),

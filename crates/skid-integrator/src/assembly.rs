@@ -13,10 +13,10 @@ use skid_fem::pressure::pressure_face_forces;
 use skid_fem::solid::{ElementResponse, Tangent};
 
 use crate::coupling::{ContactRows, contact_coordinates};
-use crate::error::{IncrementFailure, ModelError};
+use crate::error::{IncrementFailure, LinearFailure, ModelError};
 use crate::mixed::MixedPressures;
 use crate::model::Model;
-use crate::sparse::{Factorization, NON_FINITE_TANGENT, PatternBuilder, SparsePattern};
+use crate::sparse::{Factorization, PatternBuilder, SparsePattern};
 
 /// Below this many elements the element loop runs sequentially (threads cost more than they
 /// save on tiny meshes).
@@ -259,7 +259,7 @@ impl Assembler {
     pub fn eliminate_last(&mut self, trailing: &[usize]) -> Result<(), IncrementFailure> {
         self.pattern
             .eliminate_last(trailing)
-            .map_err(IncrementFailure::LinearSolve)
+            .map_err(|e| IncrementFailure::linear("effective tangent", LinearFailure::Structure(e)))
     }
 
     /// The lower triangle of the current effective tangent, compressed.
@@ -308,11 +308,10 @@ impl Assembler {
         loop {
             match solve(self) {
                 Ok(result) => return Ok((result, c)),
-                Err(IncrementFailure::LinearSolve(message))
-                    if decades < MAX_SHIFT_DECADES
-                        && c > 0.0
-                        && !message.starts_with(NON_FINITE_TANGENT) =>
-                {
+                Err(IncrementFailure::LinearSolve {
+                    failure: LinearFailure::NotPositiveDefinite | LinearFailure::Singular,
+                    ..
+                }) if decades < MAX_SHIFT_DECADES && c > 0.0 => {
                     self.add_diagonal(&(mass * (9.0 * c)));
                     self.hold(held);
                     c *= 10.0;

@@ -28,7 +28,7 @@ use skid_contact::kinematics::{
     ContactKinematics, RotatingFrame, evaluate, gap_discrete_gradient, slip_increment,
 };
 
-use crate::error::IncrementFailure;
+use crate::error::{IncrementFailure, LinearFailure};
 use skid_fem::cell::embed;
 
 use std::time::Instant;
@@ -153,9 +153,13 @@ impl ContactRows {
             })
             .collect::<Option<_>>()
             .ok_or_else(|| {
-                IncrementFailure::LinearSolve(
-                    "a contact row involves an equation the factorization does not eliminate last"
-                        .into(),
+                IncrementFailure::linear(
+                    "Delassus operator",
+                    LinearFailure::Structure(
+                        "a contact row involves an equation the factorization does not \
+                         eliminate last"
+                            .into(),
+                    ),
                 )
             })?;
         let inverse = factor.trailing_inverse();
@@ -266,7 +270,7 @@ pub fn contact_step(
         let solution = solve_contact_forces(&problem, &warm_near, settings);
         // Failed solves cost time too: count it before reporting the failure.
         timings.contact_solve += clock.elapsed();
-        let solution = solution.map_err(|e| IncrementFailure::Contact(e.to_string()))?;
+        let solution = solution.map_err(IncrementFailure::Contact)?;
         conic_solves += solution.conic_solves;
         fixed_point_iterations += solution.fixed_point_iterations;
         newton_steps += solution.newton_steps;
@@ -631,7 +635,10 @@ mod tests {
         let all: Vec<usize> = (0..rows.len()).collect();
         assert!(matches!(
             rows.delassus(&factor, &all),
-            Err(IncrementFailure::LinearSolve(_))
+            Err(IncrementFailure::LinearSolve {
+                failure: LinearFailure::Structure(_),
+                ..
+            })
         ));
     }
 

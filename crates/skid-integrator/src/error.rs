@@ -64,12 +64,18 @@ pub enum IncrementFailure {
     /// A load could not be evaluated on the current geometry.
     #[error("load: {0}")]
     Load(String),
-    /// The effective tangent could not be factorized (not positive definite).
-    #[error("linear solve failed: {0}")]
-    LinearSolve(String),
-    /// The frictional contact problem was not solved.
+    /// A linear system could not be solved.
+    #[error("linear solve of the {system} failed: {failure}")]
+    LinearSolve {
+        /// Which system: the effective tangent, the global contact system, ...
+        system: &'static str,
+        /// What went wrong.
+        failure: LinearFailure,
+    },
+    /// The frictional contact problem was not solved (see
+    /// [`skid_contact::error::ContactError::calls_for_cutback`]).
     #[error("contact solve failed: {0}")]
-    Contact(String),
+    Contact(skid_contact::error::ContactError),
     /// A contact node left the region where its surface projection is defined.
     #[error("node {node} has no projection on contact surface of pair {pair}")]
     NoProjection {
@@ -80,7 +86,46 @@ pub enum IncrementFailure {
     },
 }
 
+/// Why a linear system could not be solved.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum LinearFailure {
+    /// The matrix has NaN or infinite entries.
+    #[error("non-finite matrix entries")]
+    NonFinite,
+    /// The Cholesky factorization broke down: the matrix is not positive definite.
+    #[error("the matrix is not positive definite")]
+    NotPositiveDefinite,
+    /// The solution came out non-finite: the matrix is singular.
+    #[error("the matrix is singular (non-finite solution)")]
+    Singular,
+    /// The system is built inconsistently (a programming error, not a numerical one).
+    #[error("inconsistent system: {0}")]
+    Structure(String),
+    /// The sparse solver could not run (its message: out of memory, ...).
+    #[error("sparse solver: {0}")]
+    Solver(String),
+}
+
 impl IncrementFailure {
+    /// A failure of the linear solve of `system`.
+    pub fn linear(system: &'static str, failure: LinearFailure) -> Self {
+        Self::LinearSolve { system, failure }
+    }
+
+    /// Whether a shorter increment may succeed: false for a contact problem that is invalid
+    /// rather than unsolved, and for an inconsistently built linear system.
+    pub fn calls_for_cutback(&self) -> bool {
+        match self {
+            Self::Contact(e) => e.calls_for_cutback(),
+            Self::LinearSolve {
+                failure: LinearFailure::Structure(_),
+                ..
+            } => false,
+            _ => true,
+        }
+    }
+
     /// A short name of the kind of failure, for counting cutbacks by cause.
     pub fn kind(&self) -> &'static str {
         match self {
@@ -89,7 +134,12 @@ impl IncrementFailure {
             Self::InvertedElement { .. } => "inverted element",
             Self::Element { .. } => "element evaluation",
             Self::Load(_) => "load evaluation",
-            Self::LinearSolve(_) => "tangent not positive definite",
+            Self::LinearSolve { failure, .. } => match failure {
+                LinearFailure::NonFinite => "non-finite matrix",
+                LinearFailure::NotPositiveDefinite => "tangent not positive definite",
+                LinearFailure::Singular => "singular system",
+                LinearFailure::Structure(_) | LinearFailure::Solver(_) => "linear solver",
+            },
             Self::Contact(_) => "contact solve",
             Self::NoProjection { .. } => "no contact projection",
         }
@@ -136,5 +186,30 @@ impl RunError {
             Self::Output(_) => "output",
             Self::Invalid(_) => "invalid",
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use skid_contact::error::ContactError;
+
+    use super::*;
+
+    #[test]
+    fn only_failures_a_shorter_increment_may_cure_call_for_a_cutback() {
+        let unsolved = IncrementFailure::Contact(ContactError::FixedPointNotConverged {
+            iterations: 50,
+            error: 1e-3,
+        });
+        let invalid = IncrementFailure::Contact(ContactError::InvalidProblem("mu < 0".into()));
+        let indefinite = IncrementFailure::linear("tangent", LinearFailure::NotPositiveDefinite);
+        let broken = IncrementFailure::linear("tangent", LinearFailure::Structure("x".into()));
+        assert!(unsolved.calls_for_cutback() && indefinite.calls_for_cutback());
+        assert!(!invalid.calls_for_cutback() && !broken.calls_for_cutback());
+        assert_eq!(indefinite.kind(), "tangent not positive definite");
+        assert_eq!(
+            indefinite.to_string(),
+            "linear solve of the tangent failed: the matrix is not positive definite"
+        );
     }
 }

@@ -50,11 +50,14 @@ use nalgebra::DVector;
 use skid_contact::coulomb::alart_curnier::{LocalBranch, LocalLaw};
 
 use crate::coupling::{ContactRows, contact_coordinates};
-use crate::error::IncrementFailure;
+use crate::error::{IncrementFailure, LinearFailure};
 use crate::krylov::gmres;
 use crate::model::Model;
 use crate::quasi_definite::{CONSTRAINT_REGULARIZATION, QuasiDefinite};
 use crate::sparse::column_mut;
+
+/// The system this module's failures name.
+const SYSTEM: &str = "global contact system";
 
 /// Relative residual `||b - A z|| / ||b||` to which a system is solved iteratively (on earlier
 /// LU factors or the quasi-definite preconditioner); far below what Newton's quadratic
@@ -286,9 +289,7 @@ impl GlobalContactSolver {
             }
         });
         if dx.iter().chain(forces.iter()).any(|v| !v.is_finite()) {
-            return Err(IncrementFailure::LinearSolve(
-                "the contact system is singular (non-finite step)".into(),
-            ));
+            return Err(IncrementFailure::linear(SYSTEM, LinearFailure::Singular));
         }
         Ok(GlobalStep { dx, r: forces })
     }
@@ -315,10 +316,9 @@ impl GlobalContactSolver {
             return Ok(z);
         }
         self.factorize(matrix)?;
-        let factors = self
-            .factors
-            .as_ref()
-            .ok_or_else(|| IncrementFailure::LinearSolve("contact system not factorized".into()))?;
+        let factors = self.factors.as_ref().ok_or_else(|| {
+            IncrementFailure::linear(SYSTEM, LinearFailure::Structure("not factorized".into()))
+        })?;
         let mut z = DVector::zeros(rhs.len());
         factors.solve(rhs, &mut z);
         Ok(z)
@@ -377,7 +377,7 @@ impl GlobalContactSolver {
         matrix: SparseColMatRef<'_, usize, f64>,
     ) -> Result<(), IncrementFailure> {
         let fail = |e: &dyn std::fmt::Debug| {
-            IncrementFailure::LinearSolve(format!("contact system: {e:?}"))
+            IncrementFailure::linear(SYSTEM, LinearFailure::Solver(format!("{e:?}")))
         };
         let symbolic = Arc::clone(
             &self
@@ -418,12 +418,10 @@ impl GlobalContactSolver {
         values: &[f64],
     ) -> Result<SparseColMat<usize, f64>, IncrementFailure> {
         let fail = |what: &str, e: &dyn std::fmt::Debug| {
-            IncrementFailure::LinearSolve(format!("contact system {what}: {e:?}"))
+            IncrementFailure::linear(SYSTEM, LinearFailure::Structure(format!("{what}: {e:?}")))
         };
         if values.iter().any(|v| !v.is_finite()) {
-            return Err(IncrementFailure::LinearSolve(
-                "non-finite entries in the contact system".into(),
-            ));
+            return Err(IncrementFailure::linear(SYSTEM, LinearFailure::NonFinite));
         }
         let same = self.analysed.as_ref().is_some_and(|a| a.pairs == pairs);
         if !same {

@@ -256,6 +256,9 @@ fn solve_increment_with<const D: usize>(
     let mut weights: Option<Vec<f64>> = None;
 
     for iteration in 0..=max_iterations {
+        if x.iter().any(|v| !v.is_finite()) {
+            return Err(IncrementFailure::NonFinite { iteration });
+        }
         let clock = Instant::now();
         let (v, a) = match kind {
             IncrementKind::Static { .. } => (start.v.clone(), DVector::zeros(n)),

@@ -37,7 +37,7 @@ pub mod stepper;
 #[cfg(test)]
 mod test_support;
 
-pub use error::{IncrementFailure, ModelError, RunError};
+pub use error::{IncrementFailure, LinearFailure, ModelError, RunError};
 pub use model::{ContactPair, Model, PressureLoad, SolidPart, Tie};
 pub use state::State;
 pub use stepper::{

@@ -34,7 +34,7 @@ use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, Side};
 use nalgebra::DVector;
 
-use crate::error::IncrementFailure;
+use crate::error::{IncrementFailure, LinearFailure};
 use crate::sparse::column_mut;
 
 /// Relative weight `eps` of the constraint rows' diagonal (see the module documentation). The
@@ -78,7 +78,10 @@ impl QuasiDefinite {
         values: &[f64],
     ) -> Result<(), IncrementFailure> {
         let fail = |what: &str, e: &dyn std::fmt::Debug| {
-            IncrementFailure::LinearSolve(format!("quasi-definite system {what}: {e:?}"))
+            IncrementFailure::linear(
+                "quasi-definite preconditioner",
+                LinearFailure::Structure(format!("{what}: {e:?}")),
+            )
         };
         if values.iter().any(|v| !v.is_finite()) {
             return Err(fail("values", &"not finite"));

@@ -26,10 +26,10 @@ use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat, SymbolicSp
 use faer::{Conj, Mat, MatMut, Side};
 use nalgebra::{DMatrix, DVector};
 
-use crate::error::IncrementFailure;
+use crate::error::{IncrementFailure, LinearFailure};
 
-/// Message of [`SparsePattern::factorize`] for a matrix with NaN or infinite entries.
-pub const NON_FINITE_TANGENT: &str = "non-finite entries in the effective tangent";
+/// The system [`SparsePattern`]'s failures name.
+const TANGENT: &str = "effective tangent";
 
 /// `v` as a one-column faer matrix, for faer's solves and products in
 /// place.
@@ -126,10 +126,11 @@ impl SparsePattern {
         values: &[f64],
     ) -> Result<SparseColMat<usize, f64>, IncrementFailure> {
         if values.iter().any(|v| !v.is_finite()) {
-            return Err(IncrementFailure::LinearSolve(NON_FINITE_TANGENT.into()));
+            return Err(IncrementFailure::linear(TANGENT, LinearFailure::NonFinite));
         }
-        SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
-            .map_err(|e| IncrementFailure::LinearSolve(format!("{e:?}")))
+        SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values).map_err(|e| {
+            IncrementFailure::linear(TANGENT, LinearFailure::Structure(format!("{e:?}")))
+        })
     }
 
     /// Numeric Cholesky factorization `K = L L^T` of the matrix whose slot values are `values`,
@@ -138,11 +139,7 @@ impl SparsePattern {
     /// # Errors
     /// [`IncrementFailure::LinearSolve`] if the matrix is not positive definite or not finite.
     pub fn factorize(&self, values: &[f64]) -> Result<Factorization, IncrementFailure> {
-        if values.iter().any(|v| !v.is_finite()) {
-            return Err(IncrementFailure::LinearSolve(NON_FINITE_TANGENT.into()));
-        }
-        let matrix = SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values)
-            .map_err(|e| IncrementFailure::LinearSolve(format!("{e:?}")))?;
+        let matrix = self.lower_triangle(values)?;
         let par = faer::get_global_parallelism();
         let mut factor = vec![0.0; self.analysis.len_val()];
         let mut scratch = MemBuffer::new(
@@ -159,11 +156,7 @@ impl SparsePattern {
                 MemStack::new(&mut scratch),
                 Default::default(),
             )
-            .map_err(|e| {
-                IncrementFailure::LinearSolve(format!(
-                    "effective tangent is not positive definite ({e:?})"
-                ))
-            })?;
+            .map_err(|_| IncrementFailure::linear(TANGENT, LinearFailure::NotPositiveDefinite))?;
         Ok(Factorization {
             analysis: Arc::clone(&self.analysis),
             factor,
@@ -436,7 +429,10 @@ mod tests {
         values[b] = -1.0;
         assert!(matches!(
             pattern.factorize(&values),
-            Err(IncrementFailure::LinearSolve(_))
+            Err(IncrementFailure::LinearSolve {
+                failure: LinearFailure::NotPositiveDefinite,
+                ..
+            })
         ));
         values[b] = f64::NAN;
         assert!(pattern.factorize(&values).is_err());

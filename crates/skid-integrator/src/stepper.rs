@@ -569,11 +569,12 @@ fn run_steps<const D: usize>(
                     consecutive_failures += 1;
                     successes = 0;
                     let cut = dp * settings.cutback.factor;
-                    let exhausted = match adaptive {
-                        // an adaptive step cuts back to its smallest increment, then gives up
-                        Some(_) => dp <= smallest * (1.0 + 1e-9),
-                        None => cut < smallest,
-                    };
+                    let exhausted = !cause.calls_for_cutback()
+                        || match adaptive {
+                            // an adaptive step cuts back to its smallest increment, then gives up
+                            Some(_) => dp <= smallest * (1.0 + 1e-9),
+                            None => cut < smallest,
+                        };
                     if consecutive_failures > settings.cutback.max_cutbacks || exhausted {
                         return Err(RunError::StepFailed {
                             step: step.name.clone(),
