@@ -21,8 +21,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::atomic::write_atomic;
 use crate::report::{ReportError, e_slide, load_run};
-use crate::runner::{run_case, write_atomic};
+use crate::runner::run_case;
 use crate::schema::{Case, ContactSolveSpec, StepSpec};
 use crate::validate::CaseError;
 

@@ -6,6 +6,8 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+use crate::atomic::partial_path;
+
 /// A CSV file being written under its temporary name.
 pub struct PartialCsv {
     writer: BufWriter<File>,
@@ -19,9 +21,7 @@ impl PartialCsv {
     /// # Errors
     /// I/O errors.
     pub fn create(path: &Path, columns: &[&str]) -> std::io::Result<Self> {
-        let mut partial = path.as_os_str().to_owned();
-        partial.push(".partial");
-        let partial = PathBuf::from(partial);
+        let partial = partial_path(path);
         let mut writer = BufWriter::new(File::create(&partial)?);
         writeln!(writer, "{}", columns.join(","))?;
         Ok(Self {

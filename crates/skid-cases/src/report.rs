@@ -24,7 +24,8 @@ use serde::Deserialize;
 
 use format::Counts;
 
-use crate::runner::{CASE_JSON, write_atomic};
+use crate::atomic::write_atomic;
+use crate::runner::CASE_JSON;
 use crate::schema::Case;
 
 /// The run used as reference when none is requested.
