@@ -6,7 +6,7 @@
 //! - [`history`]: the per-increment history of the drum (`history.csv`);
 //! - [`newton`]: the Newton residuals of every increment (`newton.csv`);
 //! - [`atomic`]: output files that are complete or absent (written aside, then renamed);
-//! - [`csv_out`]: CSV files that appear only when complete;
+//! - [`csv_out`]: CSV tables, written quoted and complete-or-absent, read by column name;
 //! - [`summary`]: stop time, spin-down straightness, post-stop motion, energy balance;
 //! - [`fields`]: ParaView field output (VTU frames and a PVD collection);
 //! - [`runner`]: running one case into an output directory;
