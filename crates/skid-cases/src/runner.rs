@@ -1,6 +1,10 @@
 //! Runs one case: builds the scene, integrates it, writes `case.json` (the case as run, overrides
 //! applied), `history.csv`, `newton.csv`, `summary.json` and, if the case asks for it, the
 //! ParaView field output in `fields/`.
+//!
+//! Each output is complete or absent: those of an earlier run in the directory are removed
+//! before the run, and each file appears under its name only when written whole
+//! ([`crate::atomic`], [`crate::csv_out`]).
 
 use std::path::{Path, PathBuf};
 
