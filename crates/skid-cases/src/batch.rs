@@ -11,7 +11,8 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::runner::{run_case, write_atomic};
+use crate::atomic::write_atomic;
+use crate::runner::run_case;
 use crate::schema::Case;
 use crate::summary::Summary;
 use crate::validate::load_case;

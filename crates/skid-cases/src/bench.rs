@@ -22,8 +22,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::atomic::write_atomic;
 use crate::report::{ReportError, e_slide, load_run};
-use crate::runner::{run_case, write_atomic};
+use crate::runner::run_case;
 use crate::schema::{AdaptiveSpec, Case, ContactSolveSpec, StepSpec};
 use crate::validate::CaseError;
 

@@ -42,8 +42,8 @@ use skid_fem::cell::embed;
 use skid_integrator::stepper::{IncrementReport, Observer};
 use skid_integrator::{Model, State};
 
+use crate::atomic::write_atomic;
 use crate::drum::DRUM;
-use crate::runner::write_atomic;
 
 /// Subdirectory of a case's output directory that holds the field output.
 pub const FIELDS_DIR: &str = "fields";

@@ -1,11 +1,14 @@
 //! The drum's history: one CSV row per converged increment, and the samples the summary is
 //! computed from.
 //!
-//! The CSV is written to `history.csv.partial` and renamed to `history.csv` only when the run
-//! has ended (completed, or stopped with an error that the summary reports), so an interrupted
-//! process never leaves a file that looks complete ([`PartialCsv`]).
+//! `history.csv` has the columns [`COLUMNS`]: the step name as text, the counts (`increment`,
+//! `active_contacts`, `sliding_contacts`, `newton_iterations`, `contact_solves`) as integers,
+//! `load_factor` with six decimals, `max_penetration` with 4 significant digits, `dt` with 7, and
+//! every other number with 10 (`1.234567890e-3`). It is written through [`PartialCsv`] (a step
+//! name holding a comma, a quote or a line break is quoted) to `history.csv.partial`, renamed to
+//! `history.csv` only when the run has ended (completed, or stopped with an error that the
+//! summary reports), so an interrupted process never leaves a file that looks complete.
 
-use std::io::Write;
 use std::path::Path;
 
 use skid_integrator::Model;
@@ -134,32 +137,30 @@ impl<const D: usize> Observer<D> for DrumRecorder {
             }
         }
         let e = &s.energy;
-        writeln!(
-            self.csv.rows(),
-            "{:.9e},{},{},{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{},{},{},{},{:.3e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e}",
-            s.time,
-            report.step,
-            report.increment,
-            s.load_factor,
-            angle,
-            omega,
-            plate,
-            normal,
-            friction,
-            torque,
-            active,
-            sliding,
-            report.counters.newton_iterations,
-            report.counters.contact_solves,
-            penetration.max(0.0),
-            e.kinetic,
-            e.strain,
-            e.hourglass,
-            e.external_work,
-            e.friction_dissipation,
-            e.normal_work,
-            report.size,
-        )?;
+        self.csv.record([
+            format!("{:.9e}", s.time),
+            report.step.to_string(),
+            report.increment.to_string(),
+            format!("{:.6}", s.load_factor),
+            format!("{angle:.9e}"),
+            format!("{omega:.9e}"),
+            format!("{plate:.9e}"),
+            format!("{normal:.9e}"),
+            format!("{friction:.9e}"),
+            format!("{torque:.9e}"),
+            active.to_string(),
+            sliding.to_string(),
+            report.counters.newton_iterations.to_string(),
+            report.counters.contact_solves.to_string(),
+            format!("{:.3e}", penetration.max(0.0)),
+            format!("{:.9e}", e.kinetic),
+            format!("{:.9e}", e.strain),
+            format!("{:.9e}", e.hourglass),
+            format!("{:.9e}", e.external_work),
+            format!("{:.9e}", e.friction_dissipation),
+            format!("{:.9e}", e.normal_work),
+            format!("{:.6e}", report.size),
+        ])?;
         self.samples.push(Sample {
             time: s.time,
             dynamic: report.dynamic,

@@ -5,7 +5,8 @@
 //! - [`drum`]: building the drum scene (any idealization, 2D or 3D) as a model;
 //! - [`history`]: the per-increment history of the drum (`history.csv`);
 //! - [`newton`]: the Newton residuals of every increment (`newton.csv`);
-//! - [`csv_out`]: CSV files that appear only when complete;
+//! - [`atomic`]: output files that are complete or absent (written aside, then renamed);
+//! - [`csv_out`]: CSV tables, written quoted and complete-or-absent, read by column name;
 //! - [`summary`]: stop time, spin-down straightness, post-stop motion, energy balance;
 //! - [`fields`]: ParaView field output (VTU frames and a PVD collection);
 //! - [`runner`]: running one case into an output directory;
@@ -14,6 +15,7 @@
 //! - [`report`]: the validation report: the benchmark runs, the hard cases, the convergence
 //!   study.
 
+pub mod atomic;
 pub mod batch;
 pub mod bench;
 pub mod csv_out;

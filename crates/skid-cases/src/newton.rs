@@ -6,9 +6,10 @@
 //! update), `force_residual` (`max_i |R_i - (H^T r)_i|` scaled by the largest force in play)
 //! and `contact_residual` (largest difference between the actual and the linearised gaps and
 //! slips, over the model size): the two measures the increment's convergence test compares with
-//! its tolerances ([`skid_integrator::increment`]). Written through [`PartialCsv`].
+//! its tolerances ([`skid_integrator::increment`]). `time` has 10 significant digits, `size` and
+//! the residuals 7. Written through [`PartialCsv`], which quotes a step name holding a comma, a
+//! quote or a line break.
 
-use std::io::Write;
 use std::path::Path;
 
 use skid_integrator::Model;
@@ -62,17 +63,15 @@ impl<const D: usize> Observer<D> for NewtonRecorder {
         report: &IncrementReport<'_>,
     ) -> std::io::Result<()> {
         for (k, (force, contact)) in report.counters.residuals.iter().enumerate() {
-            writeln!(
-                self.csv.rows(),
-                "{},{},{:.9e},{:.6e},{},{:.6e},{:.6e}",
-                report.step,
-                report.increment,
-                report.state.time,
-                report.size,
-                k + 1,
-                force,
-                contact,
-            )?;
+            self.csv.record([
+                report.step.to_string(),
+                report.increment.to_string(),
+                format!("{:.9e}", report.state.time),
+                format!("{:.6e}", report.size),
+                (k + 1).to_string(),
+                format!("{force:.6e}"),
+                format!("{contact:.6e}"),
+            ])?;
         }
         Ok(())
     }

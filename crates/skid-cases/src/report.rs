@@ -24,7 +24,9 @@ use serde::Deserialize;
 
 use format::Counts;
 
-use crate::runner::{CASE_JSON, write_atomic};
+use crate::atomic::write_atomic;
+use crate::csv_out::{CsvError, CsvTable};
+use crate::runner::CASE_JSON;
 use crate::schema::Case;
 
 /// The run used as reference when none is requested.
@@ -71,6 +73,15 @@ pub enum ReportError {
         /// Cause.
         source: std::io::Error,
     },
+}
+
+impl From<CsvError> for ReportError {
+    fn from(e: CsvError) -> Self {
+        Self::Parse {
+            path: e.path,
+            message: e.message,
+        }
+    }
 }
 
 /// The fields of `summary.json` the report uses.
@@ -171,49 +182,26 @@ pub fn dynamic_part(time: &[f64], omega: &[f64]) -> History {
     out
 }
 
-/// Reads `history.csv` text (columns found by name: `time`, `drum_omega`) and keeps its
-/// dynamic part ([`dynamic_part`]), counting the non-finite numbers in every column; `path` is
-/// only used in messages.
+/// Reads `history.csv` text ([`CsvTable`]: columns found by name, `time` and `drum_omega`) and
+/// keeps its dynamic part ([`dynamic_part`]), counting the non-finite numbers in every column;
+/// `path` is only used in messages.
 ///
 /// # Errors
-/// [`ReportError::Parse`] naming the line and column at fault.
+/// [`ReportError::Parse`] naming the file, and the line and column at fault.
 pub fn parse_history(text: &str, path: &Path) -> Result<History, ReportError> {
-    let parse_error = |message: String| ReportError::Parse {
-        path: path.to_path_buf(),
-        message,
-    };
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines
-        .next()
-        .ok_or_else(|| parse_error("empty file, expected a CSV header".into()))?
-        .split(',')
-        .collect();
-    let column = |name: &str| {
-        header
-            .iter()
-            .position(|c| c.trim() == name)
-            .ok_or_else(|| parse_error(format!("no column '{name}' in the header")))
-    };
-    let (it, iw) = (column("time")?, column("drum_omega")?);
+    let table = CsvTable::new(text, path)?;
+    let (it, iw) = (table.column("time")?, table.column("drum_omega")?);
     let (mut time, mut omega) = (Vec::new(), Vec::new());
     let mut non_finite = 0;
-    for (k, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
-        let fields: Vec<&str> = line.split(',').collect();
-        non_finite += fields
-            .iter()
+    for row in table {
+        let row = row?;
+        non_finite += row
+            .fields()
             .filter_map(|f| f.trim().parse::<f64>().ok())
             .filter(|v| !v.is_finite())
             .count();
-        let value = |i: usize, name: &str| {
-            fields
-                .get(i)
-                .and_then(|f| f.trim().parse::<f64>().ok())
-                .ok_or_else(|| {
-                    parse_error(format!("line {}: expected a number in '{name}'", k + 2))
-                })
-        };
-        time.push(value(it, "time")?);
-        omega.push(value(iw, "drum_omega")?);
+        time.push(row.number(it)?);
+        omega.push(row.number(iw)?);
     }
     Ok(History {
         non_finite,
@@ -592,14 +580,33 @@ mod tests {
     }
 
     #[test]
+    fn a_quoted_step_name_with_commas_leaves_the_columns_in_place() {
+        let text = "time,step,drum_omega\n\
+                    0.0,preload,60\n\
+                    0.5,\"spin, down \"\"fast\"\"\",50\n\
+                    1.0,\"spin, down \"\"fast\"\"\",40\n";
+        let h = parse_history(text, Path::new("h.csv")).expect("parses");
+        assert_eq!(h.time, vec![0.0, 0.5, 1.0]);
+        assert_eq!(h.omega, vec![60.0, 50.0, 40.0]);
+    }
+
+    #[test]
     fn malformed_histories_name_the_file_line_and_column() {
         let e = parse_history("time,x\n0,1\n", Path::new("run/history.csv"))
             .expect_err("no omega column");
-        assert!(e.to_string().contains("run/history.csv"), "{e}");
-        assert!(e.to_string().contains("drum_omega"), "{e}");
-        let e = parse_history("time,drum_omega\n0,1\n0.1,oops\n", Path::new("h.csv"))
-            .expect_err("not a number");
-        assert!(e.to_string().contains("line 3"), "{e}");
+        assert_eq!(
+            e.to_string(),
+            "run/history.csv: no column 'drum_omega' in the header"
+        );
+        let e = parse_history(
+            "time,drum_omega\n0,1\n0.1,oops\n",
+            Path::new("run/history.csv"),
+        )
+        .expect_err("not a number");
+        assert_eq!(
+            e.to_string(),
+            "run/history.csv: line 3: expected a number in 'drum_omega'"
+        );
     }
 
     fn run(name: &str) -> Run {

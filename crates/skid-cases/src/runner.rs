@@ -1,12 +1,17 @@
 //! Runs one case: builds the scene, integrates it, writes `case.json` (the case as run, overrides
 //! applied), `history.csv`, `newton.csv`, `summary.json` and, if the case asks for it, the
 //! ParaView field output in `fields/`.
+//!
+//! Each output is complete or absent: those of an earlier run in the directory are removed
+//! before the run, and each file appears under its name only when written whole
+//! ([`crate::atomic`], [`crate::csv_out`]).
 
 use std::path::{Path, PathBuf};
 
 use skid_integrator::Model;
 use skid_integrator::stepper::{IncrementReport, Observer, run};
 
+use crate::atomic::write_atomic;
 use crate::drum::build;
 use crate::fields::{self, DrumOutline, FieldWriter};
 use crate::history::DrumRecorder;
@@ -70,7 +75,7 @@ fn run_in<const D: usize>(case: &Case, source: &Path, dir: &Path) -> Result<Summ
     }
     write_atomic(
         &dir.join(CASE_JSON),
-        &serde_json::to_string_pretty(case).unwrap_or_default(),
+        serde_json::to_string_pretty(case).unwrap_or_default(),
     )
     .map_err(output(dir.join(CASE_JSON)))?;
     let fields_dir = dir.join(fields::FIELDS_DIR);
@@ -105,7 +110,7 @@ fn run_in<const D: usize>(case: &Case, source: &Path, dir: &Path) -> Result<Summ
     let summary = summarize(case, &samples, &stats, result.err().as_ref());
     write_atomic(
         &dir.join("summary.json"),
-        &serde_json::to_string_pretty(&summary).unwrap_or_default(),
+        serde_json::to_string_pretty(&summary).unwrap_or_default(),
     )
     .map_err(output(dir.join("summary.json")))?;
     Ok(summary)
@@ -131,16 +136,4 @@ impl<const D: usize> Observer<D> for Observers<'_> {
         }
         Ok(())
     }
-}
-
-/// Writes `path` through a temporary sibling and a rename, so readers never see half a file.
-///
-/// # Errors
-/// I/O errors.
-pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".partial");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, text)?;
-    std::fs::rename(&tmp, path)
 }

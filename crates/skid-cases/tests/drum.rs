@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use skid_cases::csv_out::CsvTable;
 use skid_cases::{Summary, parse_case, run_case};
 
 const CASE_2D: &str = include_str!("../../../cases/drum/2d-analytic.json");
@@ -66,8 +67,10 @@ fn drum_spins_down_in_a_straight_line_and_rocks_in_stick_after_the_stop() {
     let t_stop = s.t_stop.expect("the drum stops");
     // Outputs are complete: renamed from .partial, one history row per increment plus the
     // initial state.
-    let history = std::fs::read_to_string(dir.path().join("history.csv")).expect("history");
-    assert_eq!(history.lines().count(), s.increments + 2);
+    let path = dir.path().join("history.csv");
+    let history = std::fs::read_to_string(&path).expect("history");
+    let records = CsvTable::new(&history, &path).expect("header").count();
+    assert_eq!(records, s.increments + 1);
     assert!(!dir.path().join("history.csv.partial").exists());
     let written: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(dir.path().join("summary.json")).expect("summary"),
@@ -108,19 +111,12 @@ fn without_friction_the_drum_keeps_its_speed() {
         residual.abs() < 1e-3 * 315.0,
         "energy residual {residual} J"
     );
-    let history = std::fs::read_to_string(dir.path().join("history.csv")).expect("history");
-    let header: Vec<&str> = history.lines().next().expect("header").split(',').collect();
-    let col = header
-        .iter()
-        .position(|c| *c == "drum_omega")
-        .expect("column");
-    for line in history.lines().skip(1) {
-        let omega: f64 = line
-            .split(',')
-            .nth(col)
-            .expect("cell")
-            .parse()
-            .expect("number");
+    let path = dir.path().join("history.csv");
+    let history = std::fs::read_to_string(&path).expect("history");
+    let table = CsvTable::new(&history, &path).expect("header");
+    let col = table.column("drum_omega").expect("column");
+    for row in table {
+        let omega: f64 = row.expect("record").number(col).expect("number");
         assert!((omega - 60.0).abs() < 1e-9 * 60.0, "omega {omega}");
     }
 }
@@ -162,13 +158,21 @@ fn tetrahedral_drum_and_general_contact_agree_with_the_3d_analytic_pair() {
 fn large_steps_converge_quadratically() {
     let (s, dir) = run(&["steps[1].dt=1.6e-3", "steps[1].duration=0.02"]);
     assert_eq!(s.status, "completed", "{:?}", s.error);
-    let text = std::fs::read_to_string(dir.path().join("newton.csv")).expect("newton.csv");
+    let path = dir.path().join("newton.csv");
+    let text = std::fs::read_to_string(&path).expect("newton.csv");
+    let table = CsvTable::new(&text, &path).expect("header");
+    let column = |name| table.column(name).expect(name);
+    let (step, number, force) = (
+        column("step"),
+        column("increment"),
+        column("force_residual"),
+    );
     let mut histories: std::collections::BTreeMap<usize, Vec<f64>> = Default::default();
-    for line in text.lines().skip(1) {
-        let fields: Vec<&str> = line.split(',').collect();
-        if fields[0] == "spin-down" {
-            let increment = fields[1].parse().expect("increment");
-            let residual = fields[5].parse().expect("force residual");
+    for row in table {
+        let row = row.expect("record");
+        if row.text(step).expect("step") == "spin-down" {
+            let increment = row.number(number).expect("increment");
+            let residual = row.number(force).expect("force residual");
             histories.entry(increment).or_default().push(residual);
         }
     }
@@ -203,21 +207,26 @@ fn a_preloaded_pad_stays_put_on_a_resting_drum_at_millisecond_steps() {
         ],
     );
     assert_eq!(s.status, "completed", "{:?}", s.error);
-    let history = std::fs::read_to_string(dir.path().join("history.csv")).expect("history");
-    let mut lines = history.lines();
-    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
-    let column = |name: &str| header.iter().position(|h| *h == name).expect(name);
+    let path = dir.path().join("history.csv");
+    let history = std::fs::read_to_string(&path).expect("history");
+    let table = CsvTable::new(&history, &path).expect("header");
+    let column = |name| table.column(name).expect(name);
     let (step, plate) = (column("step"), column("plate_displacement"));
-    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-    let preloaded: f64 = rows
+    let rows: Vec<(String, f64)> = table
+        .map(|row| {
+            let row = row.expect("record");
+            let name = row.text(step).expect("step").to_string();
+            (name, row.number(plate).expect("number"))
+        })
+        .collect();
+    let preloaded = rows
         .iter()
         .rev()
-        .find(|r| r[step] == "preload")
-        .expect("preload rows")[plate]
-        .parse()
-        .expect("number");
-    for row in rows.iter().filter(|r| r[step] == "spin-down") {
-        let moved = row[plate].parse::<f64>().expect("number") - preloaded;
+        .find(|(name, _)| name == "preload")
+        .expect("preload rows")
+        .1;
+    for (_, displacement) in rows.iter().filter(|(name, _)| name == "spin-down") {
+        let moved = displacement - preloaded;
         assert!(moved.abs() < 1e-6, "the plate moved {moved} m");
     }
     assert!(s.max_gap_violation_m < 1e-6);
@@ -257,15 +266,17 @@ fn adaptive_increments_land_on_the_stop_with_the_fixed_steps_answer() {
     assert!(d < 1e-7, "deceleration differs by {d}");
     let t = relative(s.t_stop, fixed.t_stop);
     assert!(t < 5e-4, "t_stop differs by {t}");
-    let history = std::fs::read_to_string(dir.path().join("history.csv")).expect("history");
-    let mut lines = history.lines();
-    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).expect("column");
-    let (time, omega) = (col("time"), col("drum_omega"));
+    let path = dir.path().join("history.csv");
+    let history = std::fs::read_to_string(&path).expect("history");
+    let table = CsvTable::new(&history, &path).expect("header");
+    let (time, omega) = (
+        table.column("time").expect("time"),
+        table.column("drum_omega").expect("omega"),
+    );
     let t_stop = s.t_stop.expect("stops");
-    let landed = lines.map(|l| l.split(',').collect::<Vec<_>>()).any(|f| {
-        let t: f64 = f[time].parse().expect("time");
-        let w: f64 = f[omega].parse().expect("omega");
+    let landed = table.map(|row| row.expect("record")).any(|row| {
+        let t: f64 = row.number(time).expect("time");
+        let w: f64 = row.number(omega).expect("omega");
         (t - t_stop).abs() < 1e-9 && w.abs() < 1e-9 * 60.0
     });
     assert!(landed, "no increment ends at the stop {t_stop}");

@@ -5,6 +5,7 @@ use std::collections::HashMap;
 use std::f64::consts::TAU;
 use std::path::Path;
 
+use skid_cases::csv_out::CsvTable;
 use skid_cases::{parse_case, run_case};
 use vtkio::model::{Attribute, CellType, UnstructuredGridPiece, VertexNumbers};
 
@@ -143,16 +144,18 @@ fn read_collection(dir: &Path) -> Vec<(f64, String, String)> {
 
 /// The last row of `history.csv` at `time`.
 fn history_at(dir: &Path, time: f64) -> HashMap<String, f64> {
-    let text = std::fs::read_to_string(dir.join("history.csv")).expect("history");
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
-    lines
+    let path = dir.join("history.csv");
+    let text = std::fs::read_to_string(&path).expect("history");
+    let table = CsvTable::new(&text, &path).expect("header");
+    let header: Vec<String> = table.header().map(str::to_string).collect();
+    let rows: Vec<_> = table.map(|row| row.expect("record")).collect();
+    rows.iter()
         .rev()
-        .map(|line| {
+        .map(|row| {
             header
                 .iter()
-                .zip(line.split(','))
-                .filter_map(|(k, v)| Some((k.to_string(), v.parse::<f64>().ok()?)))
+                .zip(row.fields())
+                .filter_map(|(k, v)| Some((k.clone(), v.parse::<f64>().ok()?)))
                 .collect::<HashMap<_, _>>()
         })
         .find(|row| (row["time"] - time).abs() <= 1e-9)

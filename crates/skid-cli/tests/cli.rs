@@ -2,6 +2,8 @@
 
 use std::process::Command;
 
+use skid_cases::csv_out::CsvTable;
+
 fn skid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_skid"))
 }
@@ -43,8 +45,9 @@ fn run_writes_history_and_summary_and_prints_one_json_line() {
     ] {
         assert!(summary.get(key).is_some(), "summary lacks {key}");
     }
-    let history = std::fs::read_to_string(dir.path().join("history.csv")).expect("history");
-    let header = history.lines().next().expect("header");
+    let history_path = dir.path().join("history.csv");
+    let history = std::fs::read_to_string(&history_path).expect("history");
+    let table = CsvTable::new(&history, &history_path).expect("header");
     for column in [
         "time",
         "drum_angle",
@@ -56,29 +59,32 @@ fn run_writes_history_and_summary_and_prints_one_json_line() {
         "newton_iterations",
         "contact_solves",
     ] {
-        assert!(
-            header.split(',').any(|c| c == column),
-            "history lacks {column}"
-        );
+        assert!(table.column(column).is_ok(), "history lacks {column}");
     }
     assert!(dir.path().join("summary.json").exists());
 
     // newton.csv: one row per Newton iteration of every converged increment, the residuals
     // of the last one of each increment within the tolerances.
-    let newton = std::fs::read_to_string(dir.path().join("newton.csv")).expect("newton.csv");
-    let rows: Vec<Vec<&str>> = newton
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').collect())
-        .collect();
+    let newton_path = dir.path().join("newton.csv");
+    let newton = std::fs::read_to_string(&newton_path).expect("newton.csv");
+    let table = CsvTable::new(&newton, &newton_path).expect("header");
+    let column = |name| table.column(name).expect(name);
+    let (iteration, force_column, contact_column) = (
+        column("iteration"),
+        column("force_residual"),
+        column("contact_residual"),
+    );
+    let rows: Vec<_> = table.map(|row| row.expect("record")).collect();
     assert_eq!(
         Some(rows.len() as u64),
         summary["newton_iterations"].as_u64()
     );
     for (k, row) in rows.iter().enumerate() {
-        let last_of_increment = rows.get(k + 1).is_none_or(|next| next[4] == "1");
-        let force: f64 = row[5].parse().expect("force residual");
-        let contact: f64 = row[6].parse().expect("contact residual");
+        let last_of_increment = rows
+            .get(k + 1)
+            .is_none_or(|next| next.number::<usize>(iteration).expect("iteration") == 1);
+        let force: f64 = row.number(force_column).expect("force residual");
+        let contact: f64 = row.number(contact_column).expect("contact residual");
         assert!(force.is_finite() && contact.is_finite(), "{row:?}");
         if last_of_increment {
             assert!(force <= 1e-6 && contact <= 1e-9, "not converged: {row:?}");

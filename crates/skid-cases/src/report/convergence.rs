@@ -22,6 +22,7 @@ use serde_json::Value;
 use super::format::{Sig, percent, show};
 use super::plot::{NEWTON_SVG, plot_newton};
 use super::{ReportError, Run, e_slide, load_runs};
+use crate::csv_out::CsvTable;
 use crate::newton::NEWTON_CSV;
 use crate::schema::{Case, StepSpec};
 
@@ -190,26 +191,24 @@ fn refinement(names: &[&str], cases: &[&Case]) -> Result<Refinement, String> {
     }
 }
 
-/// Parses `newton.csv` and keeps the increment of a dynamic step (named in `dynamic`) with the
-/// most Newton iterations, the earliest of equals; `None` if there is none.
+/// Parses `newton.csv` text ([`CsvTable`]: columns found by name) and keeps the increment of a
+/// dynamic step (named in `dynamic`) with the most Newton iterations, the earliest of equals;
+/// `None` if there is none. `path` is only used in messages.
 ///
 /// # Errors
-/// A message naming the line or column at fault.
-pub fn hardest_increment(text: &str, dynamic: &[&str]) -> Result<Option<NewtonIncrement>, String> {
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().ok_or("empty file")?.split(',').collect();
-    let column = |name: &str| {
-        header
-            .iter()
-            .position(|c| c.trim() == name)
-            .ok_or_else(|| format!("no column '{name}' in the header"))
-    };
+/// [`ReportError::Parse`] naming the file, and the line or column at fault.
+pub fn hardest_increment(
+    text: &str,
+    path: &Path,
+    dynamic: &[&str],
+) -> Result<Option<NewtonIncrement>, ReportError> {
+    let table = CsvTable::new(text, path)?;
     let (is, ii, it, ie, ic) = (
-        column("step")?,
-        column("increment")?,
-        column("time")?,
-        column("force_residual")?,
-        column("contact_residual")?,
+        table.column("step")?,
+        table.column("increment")?,
+        table.column("time")?,
+        table.column("force_residual")?,
+        table.column("contact_residual")?,
     );
     let mut best: Option<NewtonIncrement> = None;
     let mut current = NewtonIncrement::default();
@@ -223,30 +222,21 @@ pub fn hardest_increment(text: &str, dynamic: &[&str]) -> Result<Option<NewtonIn
             *current = NewtonIncrement::default();
         }
     };
-    for (k, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
-        let f: Vec<&str> = line.split(',').map(str::trim).collect();
-        let bad = |name: &str| format!("line {}: expected a number in '{name}'", k + 2);
-        let number = |i: usize, name: &str| {
-            f.get(i)
-                .and_then(|v| v.parse::<f64>().ok())
-                .ok_or_else(|| bad(name))
-        };
-        let step = *f.get(is).ok_or_else(|| bad("step"))?;
+    for row in table {
+        let row = row?;
+        let step = row.text(is)?;
         if !dynamic.contains(&step) {
             continue;
         }
-        let increment = f
-            .get(ii)
-            .and_then(|v| v.parse::<usize>().ok())
-            .ok_or_else(|| bad("increment"))?;
+        let increment = row.number(ii)?;
         if current.step != step || current.increment != increment {
             flush(&mut current);
             current.step = step.to_string();
             current.increment = increment;
         }
-        current.time = number(it, "time")?;
-        current.force.push(number(ie, "force_residual")?);
-        current.contact.push(number(ic, "contact_residual")?);
+        current.time = row.number(it)?;
+        current.force.push(row.number(ie)?);
+        current.contact.push(row.number(ic)?);
     }
     flush(&mut current);
     Ok(best)
@@ -303,10 +293,7 @@ fn load_series(dir: &Path, name: String) -> Result<Series, ReportError> {
             .as_ref()
             .map(dynamic_steps)
             .unwrap_or_default();
-        hardest_increment(&text, &dynamic).map_err(|message| ReportError::Parse {
-            path: newton_path,
-            message,
-        })?
+        hardest_increment(&text, &newton_path, &dynamic)?
     } else {
         None
     };
@@ -618,22 +605,47 @@ mod tests {
                     spin,3,3e-4,1e-4,1,1e-2,1e-5\n\
                     spin,3,3e-4,1e-4,2,1e-4,1e-9\n\
                     spin,3,3e-4,1e-4,3,1e-8,1e-16\n";
-        let n = hardest_increment(text, &["spin"])
+        let path = Path::new("run/newton.csv");
+        let n = hardest_increment(text, path, &["spin"])
             .expect("parses")
             .expect("found");
         assert_eq!((n.step.as_str(), n.increment), ("spin", 2));
         assert_eq!(n.force, vec![1e-2, 1e-4, 1e-8]);
         assert_eq!(n.contact, vec![1e-5, 1e-9, 1e-16]);
         assert!((n.time - 2e-4).abs() < 1e-18);
-        assert_eq!(hardest_increment(text, &["other"]).expect("parses"), None);
-        let e = hardest_increment("step,increment\n", &["spin"]).expect_err("columns");
-        assert!(e.contains("time"), "{e}");
+        assert_eq!(
+            hardest_increment(text, path, &["other"]).expect("parses"),
+            None
+        );
+        let e = hardest_increment("step,increment\n", path, &["spin"]).expect_err("columns");
+        assert_eq!(
+            e.to_string(),
+            "run/newton.csv: no column 'time' in the header"
+        );
         let e = hardest_increment(
             "step,increment,time,force_residual,contact_residual\nspin,1,0,x,1\n",
+            path,
             &["spin"],
         )
         .expect_err("number");
-        assert!(e.contains("line 2") && e.contains("force_residual"), "{e}");
+        assert_eq!(
+            e.to_string(),
+            "run/newton.csv: line 2: expected a number in 'force_residual'"
+        );
+    }
+
+    #[test]
+    fn a_quoted_step_name_with_commas_is_one_field() {
+        let text = "step,increment,time,size,iteration,force_residual,contact_residual\n\
+                    \"spin, down \"\"fast\"\"\",1,1e-4,1e-4,1,1e-3,1e-6\n\
+                    \"spin, down \"\"fast\"\"\",1,1e-4,1e-4,2,1e-7,1e-12\n";
+        let n = hardest_increment(text, Path::new("newton.csv"), &["spin, down \"fast\""])
+            .expect("parses")
+            .expect("found");
+        assert_eq!(n.step, "spin, down \"fast\"");
+        assert_eq!(n.increment, 1);
+        assert_eq!(n.force, vec![1e-3, 1e-7]);
+        assert_eq!(n.contact, vec![1e-6, 1e-12]);
     }
 
     fn case(overrides: &[&str]) -> Case {
