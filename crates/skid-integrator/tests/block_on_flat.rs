@@ -4,13 +4,11 @@
 
 mod common;
 
-use nalgebra::{SVector, Vector3};
+use nalgebra::Vector3;
 use skid_contact::plane::RigidPlane;
-use skid_fem::material::PolynomialN1;
-use skid_fem::mesh::SolidMesh;
 use skid_integrator::increment::ContactSolve;
 use skid_integrator::stepper::{IncrementReport, Observer, Settings, Step, StepKind, run};
-use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, State, Tie};
+use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie};
 
 const MU: f64 = 0.3;
 const WIDTH: f64 = 0.02;
@@ -30,24 +28,18 @@ impl<const D: usize> Observer<D> for Record {
 /// Block of 2 x 1 plane-strain elements on the plane y = 0; its top face is tied to a slider
 /// that may translate in x and y; pressure on top and on the left face.
 fn block(side_force: f64) -> (Model<2>, f64) {
-    let mesh = SolidMesh::<2>::structured_block(
-        SVector::<f64, 2>::new(0.0, 0.0),
-        SVector::<f64, 2>::new(WIDTH, HEIGHT),
+    let part = common::block_part(
+        [0.0, 0.0],
+        [WIDTH, HEIGHT],
         [2, 1],
-    )
-    .expect("mesh");
-    let bottom = mesh.node_sets["ymin"].clone();
-    let top = mesh.node_sets["ymax"].clone();
-    let top_faces = mesh.surfaces["ymax"].clone();
-    let left_faces = mesh.surfaces["xmin"].clone();
-    let part = SolidPart {
-        mesh,
-        material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6).expect("material")),
-        density: 1000.0,
-        thickness: THICKNESS,
-        hourglass_scale: 1.0,
-        quasi_static: false,
-    };
+        THICKNESS,
+        0.145e-6,
+        false,
+    );
+    let bottom = part.mesh.node_sets["ymin"].clone();
+    let top = part.mesh.node_sets["ymax"].clone();
+    let top_faces = part.mesh.surfaces["ymax"].clone();
+    let left_faces = part.mesh.surfaces["xmin"].clone();
     let body = common::translating_body;
     let model = Model::new(
         part,

@@ -7,12 +7,10 @@
 
 mod common;
 
-use nalgebra::{SVector, Vector3};
+use nalgebra::Vector3;
 use skid_contact::plane::RigidPlane;
-use skid_fem::material::PolynomialN1;
-use skid_fem::mesh::SolidMesh;
 use skid_integrator::stepper::{IncrementReport, Observer, Settings, Step, StepKind, run};
-use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, State, Tie};
+use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie};
 
 const LENGTH: f64 = 0.1;
 const THICKNESS: f64 = 0.05;
@@ -35,23 +33,17 @@ impl<const D: usize> Observer<D> for Last {
 /// The pad (4 x 1 plane-strain elements, compressibility `d1`) on the plane y = 0, its back face
 /// tied to a plate that may only translate in y and loaded by `pressure`.
 fn pad(pressure: f64, d1: f64) -> Model<2> {
-    let mesh = SolidMesh::<2>::structured_block(
-        SVector::<f64, 2>::new(-0.5 * LENGTH, 0.0),
-        SVector::<f64, 2>::new(LENGTH, THICKNESS),
+    let part = common::block_part(
+        [-0.5 * LENGTH, 0.0],
+        [LENGTH, THICKNESS],
         [4, 1],
-    )
-    .expect("mesh");
-    let front = mesh.node_sets["ymin"].clone();
-    let back = mesh.node_sets["ymax"].clone();
-    let back_faces = mesh.surfaces["ymax"].clone();
-    let part = SolidPart {
-        mesh,
-        material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, d1).expect("material")),
-        density: 1000.0,
-        thickness: WIDTH,
-        hourglass_scale: 1.0,
-        quasi_static: false,
-    };
+        WIDTH,
+        d1,
+        false,
+    );
+    let front = part.mesh.node_sets["ymin"].clone();
+    let back = part.mesh.node_sets["ymax"].clone();
+    let back_faces = part.mesh.surfaces["ymax"].clone();
     let body = common::translating_body;
     Model::new(
         part,

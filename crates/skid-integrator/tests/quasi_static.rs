@@ -13,12 +13,10 @@ mod common;
 
 use nalgebra::{SVector, Vector3};
 use skid_contact::plane::RigidPlane;
-use skid_fem::material::PolynomialN1;
-use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 use skid_integrator::increment::ContactSolve;
 use skid_integrator::stepper::{IncrementReport, Observer, Settings, Step, StepKind, run};
-use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, State, Tie};
+use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie};
 
 const MU: f64 = 0.3;
 const WIDTH: f64 = 0.02;
@@ -40,23 +38,17 @@ impl<const D: usize> Observer<D> for Record {
 /// A 2 x 1 block on the plane y = 0 of a ground that slides along x; the block's top face is
 /// tied to a massless plate that may only move vertically and carries the pressure.
 fn scene(quasi_static: bool, plate_mass: f64) -> Result<Model<2>, skid_integrator::ModelError> {
-    let mesh = SolidMesh::<2>::structured_block(
-        SVector::<f64, 2>::new(-WIDTH / 2.0, 0.0),
-        SVector::<f64, 2>::new(WIDTH, HEIGHT),
+    let part = common::block_part(
+        [-WIDTH / 2.0, 0.0],
+        [WIDTH, HEIGHT],
         [2, 1],
-    )
-    .expect("mesh");
-    let bottom = mesh.node_sets["ymin"].clone();
-    let top = mesh.node_sets["ymax"].clone();
-    let top_faces = mesh.surfaces["ymax"].clone();
-    let part = SolidPart {
-        mesh,
-        material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6).expect("material")),
-        density: 1000.0,
-        thickness: THICKNESS,
-        hourglass_scale: 1.0,
+        THICKNESS,
+        0.145e-6,
         quasi_static,
-    };
+    );
+    let bottom = part.mesh.node_sets["ymin"].clone();
+    let top = part.mesh.node_sets["ymax"].clone();
+    let top_faces = part.mesh.surfaces["ymax"].clone();
     let ground = RigidBody::<2> {
         mass: GROUND_MASS,
         initial_velocity: SVector::<f64, 2>::new(V0, 0.0),

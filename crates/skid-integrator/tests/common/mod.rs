@@ -1,7 +1,10 @@
 //! Fixtures shared by the integration tests.
 
 use nalgebra::SVector;
+use skid_fem::material::PolynomialN1;
+use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
+use skid_integrator::SolidPart;
 
 /// A massless 2D rigid body at `(0, y)` that may translate along the axes marked in `free` and
 /// never rotates: a held ground (`[false, false]`) or a loaded plate.
@@ -15,5 +18,31 @@ pub fn translating_body(name: &str, free: [bool; 2], y: f64) -> RigidBody<2> {
         rotation_axis: None,
         initial_velocity: SVector::zeros(),
         initial_angular_velocity: 0.0,
+    }
+}
+
+/// A plane-strain block of the DRUM.md pad material (with bulk compliance `d1`) from `corner`,
+/// `size` and `divisions` elements, out-of-plane `thickness`, density 1000 kg/m^3.
+pub fn block_part(
+    corner: [f64; 2],
+    size: [f64; 2],
+    divisions: [usize; 2],
+    thickness: f64,
+    d1: f64,
+    quasi_static: bool,
+) -> SolidPart<2> {
+    let mesh = SolidMesh::<2>::structured_block(
+        SVector::<f64, 2>::new(corner[0], corner[1]),
+        SVector::<f64, 2>::new(size[0], size[1]),
+        divisions,
+    )
+    .expect("mesh");
+    SolidPart {
+        mesh,
+        material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, d1).expect("material")),
+        density: 1000.0,
+        thickness,
+        hourglass_scale: 1.0,
+        quasi_static,
     }
 }
