@@ -1,9 +1,10 @@
 //! Rigid triangle mesh (the exterior faces of a tetrahedral C3D4 drum) with exact closest points
-//! and cylinder-chart convected coordinates.
+//! found through an R*-tree, and cylinder-chart convected coordinates.
 
 use std::collections::BTreeMap;
 
 use nalgebra::{Matrix3, Vector3};
+use rstar::{AABB, PointDistance, RTree, RTreeObject};
 
 use crate::error::ContactError;
 use crate::facets::FacetedCylinder;
@@ -41,7 +42,7 @@ impl Feature {
     }
 }
 
-/// One triangle with its angle-weighted pseudo-normals and bounding sphere.
+/// One triangle with its angle-weighted pseudo-normals.
 #[derive(Clone, Debug)]
 struct Triangle {
     corners: [Vector3<f64>; 3],
@@ -52,8 +53,9 @@ struct Triangle {
     /// Pseudo-normal of corner `i`: `sum_t alpha_t n_t` over incident triangles `t`, `alpha_t` the
     /// triangle's angle at the corner.
     vertex_normals: [Vector3<f64>; 3],
+    /// Centroid, for the tests' orientation checks.
+    #[cfg(test)]
     centre: Vector3<f64>,
-    bound: f64,
 }
 
 /// Closest point of one triangle.
@@ -63,52 +65,100 @@ struct Closest {
     distance: f64,
 }
 
-impl Triangle {
-    /// Closest point to `y`: the plane projection `p = y - (n.(y - a)) n` if it lies in the
-    /// (closed) triangle, otherwise the closest of the three edges' clamped segment projections
-    /// `a_i + clamp(t, 0, 1) (a_{i+1} - a_i)`, `t = (y - a_i).(a_{i+1} - a_i) / |a_{i+1} - a_i|^2`
-    /// (an edge for `0 < t < 1`, else a corner).
-    fn closest(&self, y: &Vector3<f64>) -> Closest {
-        let height = self.normal.dot(&(y - self.corners[0]));
-        let in_plane = y - self.normal * height;
-        let inside = (0..3).all(|i| {
-            let (a, b) = (self.corners[i], self.corners[(i + 1) % 3]);
-            (b - a).cross(&(in_plane - a)).dot(&self.normal) >= 0.0
-        });
-        if inside {
-            return Closest {
-                point: in_plane,
-                feature: Feature::Face,
-                distance: height.abs(),
-            };
-        }
-        let on_edge = |i: usize| {
-            let (a, b) = (self.corners[i], self.corners[(i + 1) % 3]);
-            let edge = b - a;
-            let t = (y - a).dot(&edge) / edge.norm_squared();
-            let (point, feature) = if t <= 0.0 {
-                (a, Feature::Vertex(i))
-            } else if t >= 1.0 {
-                (b, Feature::Vertex((i + 1) % 3))
-            } else {
-                (a + edge * t, Feature::Edge(i))
-            };
-            Closest {
-                point,
-                feature,
-                distance: (y - point).norm(),
-            }
+/// Closest point to `y` of the triangle of `corners` `a_i` and unit normal `n`: the plane
+/// projection `p = y - (n.(y - a_0)) n` if it lies in the (closed) triangle, otherwise the
+/// closest of the three edges' clamped segment projections `a_i + clamp(t, 0, 1) (a_{i+1} - a_i)`,
+/// `t = (y - a_i).(a_{i+1} - a_i) / |a_{i+1} - a_i|^2` (an edge for `0 < t < 1`, else a corner).
+fn closest(corners: &[Vector3<f64>; 3], normal: &Vector3<f64>, y: &Vector3<f64>) -> Closest {
+    let height = normal.dot(&(y - corners[0]));
+    let in_plane = y - normal * height;
+    let inside = (0..3).all(|i| {
+        let (a, b) = (corners[i], corners[(i + 1) % 3]);
+        (b - a).cross(&(in_plane - a)).dot(normal) >= 0.0
+    });
+    if inside {
+        return Closest {
+            point: in_plane,
+            feature: Feature::Face,
+            distance: height.abs(),
         };
-        let mut best = on_edge(0);
-        for i in 1..3 {
-            let candidate = on_edge(i);
-            if candidate.distance < best.distance {
-                best = candidate;
-            }
-        }
-        best
     }
+    let on_edge = |i: usize| {
+        let (a, b) = (corners[i], corners[(i + 1) % 3]);
+        let edge = b - a;
+        let t = (y - a).dot(&edge) / edge.norm_squared();
+        let (point, feature) = if t <= 0.0 {
+            (a, Feature::Vertex(i))
+        } else if t >= 1.0 {
+            (b, Feature::Vertex((i + 1) % 3))
+        } else {
+            (a + edge * t, Feature::Edge(i))
+        };
+        Closest {
+            point,
+            feature,
+            distance: (y - point).norm(),
+        }
+    };
+    let mut best = on_edge(0);
+    for i in 1..3 {
+        let candidate = on_edge(i);
+        if candidate.distance < best.distance {
+            best = candidate;
+        }
+    }
+    best
+}
 
+impl Closest {
+    /// Whether this closest point, of a later triangle, replaces `best` in the index-order scan:
+    /// it is nearer by more than `tolerance`, or no more than `tolerance` farther with a
+    /// higher-ranked feature.
+    fn replaces(&self, best: &Closest, tolerance: f64) -> bool {
+        self.distance < best.distance - tolerance
+            || (self.distance <= best.distance + tolerance
+                && self.feature.rank() > best.feature.rank())
+    }
+}
+
+/// A triangle's corners and normal in the search tree, with its index in the mesh.
+#[derive(Clone, Debug)]
+struct Located {
+    index: usize,
+    corners: [Vector3<f64>; 3],
+    normal: Vector3<f64>,
+}
+
+impl Located {
+    fn closest(&self, y: &Vector3<f64>) -> Closest {
+        closest(&self.corners, &self.normal, y)
+    }
+}
+
+impl RTreeObject for Located {
+    type Envelope = AABB<[f64; 3]>;
+
+    /// Axis-aligned bounding box of the corners.
+    fn envelope(&self) -> Self::Envelope {
+        let [a, b, c] = self.corners;
+        AABB::from_corners(a.inf(&b).inf(&c).into(), a.sup(&b).sup(&c).into())
+    }
+}
+
+impl PointDistance for Located {
+    /// Square of the exact distance of [`closest`]; a NaN (only from overflowing coordinates)
+    /// counts as infinitely far, as the tree needs an order.
+    fn distance_2(&self, point: &[f64; 3]) -> f64 {
+        let distance = self.closest(&Vector3::from(*point)).distance;
+        if distance.is_nan() {
+            f64::INFINITY
+        } else {
+            distance * distance
+        }
+    }
+}
+
+impl Triangle {
     fn pseudo_normal(&self, feature: Feature) -> Vector3<f64> {
         match feature {
             Feature::Face => self.normal,
@@ -148,9 +198,13 @@ impl Triangle {
 /// meaningful near the surface. Equally distant features (to round-off) resolve to the face,
 /// then the edge, then the lowest triangle index. The projection is undefined (`None`) if `p`
 /// lies on the chart axis.
+///
+/// The closest triangles are found in an R*-tree of the triangles' bounding boxes, bulk-loaded
+/// on construction, so that a projection visits the few triangles near `y` rather than all.
 #[derive(Clone, Debug)]
 pub struct TriangulatedSurface {
     triangles: Vec<Triangle>,
+    tree: RTree<Located>,
     chart: AnalyticCylinder,
     /// Largest vertex norm, the length scale of round-off tolerances.
     scale: f64,
@@ -214,7 +268,6 @@ impl TriangulatedSurface {
             .zip(&normals)
             .map(|(tri, normal)| {
                 let corners = tri.map(|i| vertices[i]);
-                let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
                 let edge = |i: usize| {
                     let (a, b) = (tri[i], tri[(i + 1) % 3]);
                     edge_sums
@@ -227,17 +280,26 @@ impl TriangulatedSurface {
                     normal: *normal,
                     edge_normals: [edge(0), edge(1), edge(2)],
                     vertex_normals: tri.map(|i| vertex_sums[i]),
-                    centre,
-                    bound: corners
-                        .iter()
-                        .map(|c| (c - centre).norm())
-                        .fold(0.0, f64::max),
+                    #[cfg(test)]
+                    centre: (corners[0] + corners[1] + corners[2]) / 3.0,
                 }
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let tree = RTree::bulk_load(
+            built
+                .iter()
+                .enumerate()
+                .map(|(index, t)| Located {
+                    index,
+                    corners: t.corners,
+                    normal: t.normal,
+                })
+                .collect(),
+        );
         let scale = vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
         Ok(Self {
             triangles: built,
+            tree,
             chart,
             scale,
         })
@@ -285,30 +347,35 @@ impl TriangulatedSurface {
         )
     }
 
-    /// Closest feature over all triangles: `(triangle index, closest point)`; triangles whose
-    /// bounding sphere lies farther than the best distance so far are skipped.
+    /// Closest feature over all triangles, `(triangle index, closest point)`, as a scan of the
+    /// triangles in index order finds it: the first triangle is the best so far, and each later
+    /// one replaces it if nearer by more than `tolerance`, or no more than `tolerance` farther
+    /// with a higher-ranked feature (face, then edge, then vertex).
+    ///
+    /// Only the candidates are scanned: the triangles the tree yields nearest first, up to the
+    /// first one more than `2 tolerance` farther than all before it. Each triangle left out is
+    /// then more than `2 tolerance` farther than every candidate, so it never replaces one, while
+    /// every candidate replaces it; leaving it out does not change the result. This holds for a
+    /// `tolerance` above the round-off of the distances, as in [`RigidSurface::project`].
     fn nearest(&self, y: &Vector3<f64>, tolerance: f64) -> Option<(usize, Closest)> {
-        let mut best: Option<(usize, Closest)> = None;
-        for (index, triangle) in self.triangles.iter().enumerate() {
-            if let Some((_, b)) = &best
-                && (y - triangle.centre).norm() - triangle.bound > b.distance + tolerance
-            {
-                continue;
+        let mut candidates: Vec<(usize, Closest)> = Vec::new();
+        let mut farthest = f64::NEG_INFINITY;
+        for located in self.tree.nearest_neighbor_iter(&[y.x, y.y, y.z]) {
+            let closest = located.closest(y);
+            if !candidates.is_empty() && closest.distance > farthest + 2.0 * tolerance {
+                break;
             }
-            let candidate = triangle.closest(y);
-            let better = match &best {
-                None => true,
-                Some((_, b)) => {
-                    candidate.distance < b.distance - tolerance
-                        || (candidate.distance <= b.distance + tolerance
-                            && candidate.feature.rank() > b.feature.rank())
-                }
-            };
-            if better {
-                best = Some((index, candidate));
-            }
+            farthest = farthest.max(closest.distance);
+            candidates.push((located.index, closest));
         }
-        best
+        candidates.sort_unstable_by_key(|(index, _)| *index);
+        candidates.into_iter().reduce(|best, candidate| {
+            if candidate.1.replaces(&best.1, tolerance) {
+                candidate
+            } else {
+                best
+            }
+        })
     }
 }
 
@@ -364,6 +431,7 @@ mod tests {
     use crate::facets::tests::check_gradients;
     use crate::kinematics::slip_increment;
     use approx::assert_relative_eq;
+    use proptest::prelude::*;
     use std::f64::consts::{PI, TAU};
 
     const R: f64 = 0.2;
@@ -622,5 +690,147 @@ mod tests {
         assert_relative_eq!(slip[0], expected, epsilon = 1e-14);
         assert_relative_eq!(slip[1], -0.03, epsilon = 1e-15);
         check_gradients(&mesh, &Vector3::new(-d - 0.001, 1e-8, 0.01), 1e-6);
+    }
+
+    /// The closest triangle as a scan over every triangle in index order finds it, the
+    /// definition that [`TriangulatedSurface::nearest`] computes with the tree.
+    fn scan_all(mesh: &TriangulatedSurface, y: &Vector3<f64>, tolerance: f64) -> (usize, Closest) {
+        let mut best: Option<(usize, Closest)> = None;
+        for (index, t) in mesh.triangles.iter().enumerate() {
+            let candidate = closest(&t.corners, &t.normal, y);
+            let better = match &best {
+                None => true,
+                Some((_, b)) => {
+                    candidate.distance < b.distance - tolerance
+                        || (candidate.distance <= b.distance + tolerance
+                            && candidate.feature.rank() > b.feature.rank())
+                }
+            };
+            if better {
+                best = Some((index, candidate));
+            }
+        }
+        best.expect("a mesh has triangles")
+    }
+
+    /// Round-off tolerance of [`RigidSurface::project`] and three larger ones, by `choice`.
+    fn tolerance(mesh: &TriangulatedSurface, y: &Vector3<f64>, choice: usize) -> f64 {
+        let tiny = 64.0 * f64::EPSILON * (mesh.scale + y.norm());
+        [
+            tiny,
+            1e-9 * mesh.scale,
+            1e-4 * mesh.scale,
+            1e-2 * mesh.scale,
+        ][choice]
+    }
+
+    fn check_nearest(
+        mesh: &TriangulatedSurface,
+        y: &Vector3<f64>,
+        tolerance: f64,
+    ) -> Result<(), TestCaseError> {
+        let (index, found) = mesh.nearest(y, tolerance).expect("a mesh has triangles");
+        let (expected_index, expected) = scan_all(mesh, y, tolerance);
+        prop_assert_eq!(
+            (index, found.feature, found.distance, found.point),
+            (
+                expected_index,
+                expected.feature,
+                expected.distance,
+                expected.point
+            ),
+            "y = {:?}, tolerance {:e}",
+            y,
+            tolerance
+        );
+        Ok(())
+    }
+
+    /// A coordinate in `range`, or one of `snapped` (on faces, edges, symmetry planes: ties).
+    fn coordinate(range: std::ops::Range<f64>, snapped: Vec<f64>) -> BoxedStrategy<f64> {
+        prop_oneof![range, proptest::sample::select(snapped)].boxed()
+    }
+
+    #[test]
+    fn candidates_reach_past_the_best_when_the_scan_needs_them() {
+        // from the origin: a face at 1.15, a vertex at 1.08, a vertex at 1, in index order
+        let vertices = vec![
+            Vector3::new(-1.0, -1.0, -1.15),
+            Vector3::new(1.0, -1.0, -1.15),
+            Vector3::new(0.0, 1.0, -1.15),
+            Vector3::new(1.08, 0.0, 0.0),
+            Vector3::new(2.0, 1.0, 0.0),
+            Vector3::new(2.0, -1.0, 0.0),
+            Vector3::new(-1.0, 0.0, 0.0),
+            Vector3::new(-2.0, -1.0, 0.0),
+            Vector3::new(-2.0, 1.0, 0.0),
+        ];
+        let triangles = vec![[0, 1, 2], [3, 4, 5], [6, 7, 8]];
+        let mesh = TriangulatedSurface::new(vertices, triangles, z_chart(1.0)).expect("mesh");
+        let y = Vector3::zeros();
+        // the vertex at 1.08 does not replace the face, the one at 1 does (more than 0.1 nearer);
+        // among the triangles within 0.1 of the nearest alone, the vertex at 1.08 would stay
+        let (index, found) = mesh.nearest(&y, 0.1).expect("nearest");
+        assert_eq!((index, found.feature), (2, Feature::Vertex(0)));
+        assert_eq!(found.distance, 1.0);
+        check_nearest(&mesh, &y, 0.1).expect("as the scan");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig {
+            cases: 512,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x7e1a_5eed),
+            ..ProptestConfig::default()
+        })]
+
+        /// Around and inside the cube, the tree finds the scan's triangle, distance and feature.
+        #[test]
+        fn cube_search_matches_the_scan(
+            x in coordinate(-1.5..1.5, vec![-1.3, -1.0, -0.5, 0.0, 0.5, 1.0, 1.3]),
+            y in coordinate(-1.5..1.5, vec![-1.3, -1.0, -0.5, 0.0, 0.5, 1.0, 1.3]),
+            z in coordinate(-1.5..1.5, vec![-1.3, -1.0, -0.5, 0.0, 0.5, 1.0, 1.3]),
+            choice in 0usize..4,
+        ) {
+            let cube = cube();
+            let y = Vector3::new(x, y, z);
+            check_nearest(&cube, &y, tolerance(&cube, &y, choice))?;
+        }
+
+        /// Around and inside the 72-sector closed prism, including its axis, vertex lines,
+        /// facet middles, rims and caps.
+        #[test]
+        fn closed_prism_search_matches_the_scan(
+            radius in coordinate(0.0..0.3, vec![0.0, 0.1, 0.2 * (PI / 72.0).cos(), R, 0.25]),
+            sector in prop_oneof![
+                (-PI..PI).boxed(),
+                (0..144).prop_map(|k| f64::from(k) * PI / 72.0).boxed(),
+            ],
+            z in coordinate(-0.08..0.08, vec![-0.06, -0.05, 0.0, 0.02, 0.05, 0.06]),
+            choice in 0usize..4,
+        ) {
+            let mesh = TriangulatedSurface::closed_prism(&drum_72(), [-0.05, 0.05])
+                .expect("prism");
+            let y = Vector3::new(radius * sector.cos(), radius * sector.sin(), z);
+            check_nearest(&mesh, &y, tolerance(&mesh, &y, choice))?;
+        }
+
+        /// Among up to 200 random, overlapping triangles.
+        #[test]
+        fn triangle_soup_search_matches_the_scan(
+            soup in proptest::collection::vec(proptest::array::uniform9(-1.0..1.0f64), 1..200),
+            point in proptest::array::uniform3(-1.5..1.5f64),
+            choice in 0usize..4,
+        ) {
+            let vertices = soup
+                .iter()
+                .flat_map(|t| t.chunks(3).map(|c| Vector3::new(c[0], c[1], c[2])))
+                .collect();
+            let triangles = (0..soup.len()).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+            let mesh = TriangulatedSurface::new(vertices, triangles, z_chart(1.0));
+            prop_assume!(mesh.is_ok());
+            let mesh = mesh.expect("valid soup");
+            let y = Vector3::from(point);
+            check_nearest(&mesh, &y, tolerance(&mesh, &y, choice))?;
+        }
     }
 }
