@@ -217,10 +217,14 @@ fn solve_increment_with<const D: usize>(
             load_factor,
             regularization,
         } => (load_factor, 1.0, regularization, shift_mass),
-        IncrementKind::Dynamic { hht, h } if model.part().quasi_static => {
-            (1.0, hht.quasi_static_factor(), hht.mass_factor(h), mass)
+        IncrementKind::Dynamic { hht, h } => {
+            let k_factor = if model.part().quasi_static {
+                hht.quasi_static_factor()
+            } else {
+                1.0 + hht.alpha
+            };
+            (1.0, k_factor, hht.mass_factor(h), mass)
         }
-        IncrementKind::Dynamic { hht, h } => (1.0, 1.0 + hht.alpha, hht.mass_factor(h), mass),
     };
     // A quasi-static solid has no mass term in a dynamic tangent; if the tangent is indefinite
     // without the contacts, the shift starts far below the inertia its density would give.

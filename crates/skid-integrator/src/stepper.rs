@@ -119,6 +119,62 @@ impl Adaptive {
     }
 }
 
+/// An adaptive step's memory between increments.
+struct AdaptiveRun {
+    control: Adaptive,
+    /// `abar` of the last accepted increment (none before the first).
+    mean_acceleration: Option<DVector<f64>>,
+    /// The rotations that have stopped in this step.
+    stopped: Vec<bool>,
+}
+
+/// What an adaptive step makes of a converged increment.
+enum Verdict {
+    /// Take it again with this size, s.
+    Retry(f64),
+    /// Keep it; the next increment's size, s.
+    Accept(f64),
+}
+
+impl AdaptiveRun {
+    /// Judges the converged increment of size `h` from `start` to `end` (see [`Adaptive`]): its
+    /// error measure decides whether it is kept and the next size, which is then shortened to
+    /// end where a spinning body would stop.
+    fn judge<const D: usize>(
+        &mut self,
+        model: &Model<D>,
+        hht: &Hht,
+        h: f64,
+        start: &State,
+        end: &State,
+        held: &[bool],
+    ) -> Verdict {
+        let control = self.control;
+        let abar = (&end.v - &start.v) / h;
+        let mut next = match &self.mean_acceleration {
+            Some(previous) => {
+                let eta = control.error_measure(model, hht, h, &abar, previous, held);
+                if eta > 1.0 && h > control.min_dt * (1.0 + 1e-9) {
+                    return Verdict::Retry(control.next_size(h, eta));
+                }
+                control.next_size(h, eta)
+            }
+            None => (2.0 * h).min(control.max_dt),
+        };
+        for (eq, stopped) in self.stopped.iter_mut().enumerate() {
+            *stopped |= start.v[eq] * end.v[eq] <= 0.0 && start.v[eq] != 0.0;
+        }
+        if let Some(stop) = time_to_stop(model, &end.v, &abar, held, &self.stopped)
+            && stop < next
+            && stop > control.min_dt
+        {
+            next = stop;
+        }
+        self.mean_acceleration = Some(abar);
+        Verdict::Accept(next)
+    }
+}
+
 /// The time from the end of an increment until a spinning rigid body's angular velocity `v`,
 /// changing at the mean rate `abar` of the increment, reaches zero: `-v / abar` where that is
 /// positive; the soonest over the free, unheld rotations with inertia that have not stopped
@@ -466,13 +522,14 @@ fn run_steps<const D: usize>(
                 (dt / duration, duration, adaptive)
             }
         };
-        // With adaptive increments the size may grow to `max_dt` and shrink to `min_dt`.
-        let (largest, smallest) = match adaptive {
-            Some(a) => (a.max_dt / span, a.min_dt / span),
-            None => (nominal, nominal * settings.cutback.min_fraction),
-        };
-        let mut mean_acceleration: Option<DVector<f64>> = None;
-        let mut stopped = vec![false; n];
+        // With adaptive increments the size may shrink to `min_dt`.
+        let smallest =
+            adaptive.map_or(nominal * settings.cutback.min_fraction, |a| a.min_dt / span);
+        let mut adaptive = adaptive.map(|control| AdaptiveRun {
+            control,
+            mean_acceleration: None,
+            stopped: vec![false; n],
+        });
         let mut progress = 0.0;
         let mut size = nominal;
         let mut consecutive_failures = 0;
@@ -504,31 +561,15 @@ fn run_steps<const D: usize>(
             ) {
                 Ok((mut next, counters)) => {
                     let mut next_size = None;
-                    if let (Some(control), IncrementKind::Dynamic { hht, h }) = (adaptive, kind) {
-                        let abar = (&next.v - &state.v) / h;
-                        if let Some(previous) = &mean_acceleration {
-                            let eta = control.error_measure(model, &hht, h, &abar, previous, &held);
-                            if eta > 1.0 && dp > smallest * (1.0 + 1e-9) {
+                    if let (Some(run), IncrementKind::Dynamic { hht, h }) = (&mut adaptive, kind) {
+                        match run.judge(model, &hht, h, &state, &next, &held) {
+                            Verdict::Retry(h) => {
                                 stats.error_rejections += 1;
-                                size = control.next_size(h, eta) / span;
+                                size = h / span;
                                 continue;
                             }
-                            next_size = Some(control.next_size(h, eta) / span);
-                        } else {
-                            next_size = Some((2.0 * dp).min(largest));
+                            Verdict::Accept(h) => next_size = Some(h / span),
                         }
-                        for (eq, stopped) in stopped.iter_mut().enumerate() {
-                            *stopped |= state.v[eq] * next.v[eq] <= 0.0 && state.v[eq] != 0.0;
-                        }
-                        // end the next increment where a spinning body would stop
-                        let stop = time_to_stop(model, &next.v, &abar, &held, &stopped);
-                        if let (Some(stop), Some(size)) = (stop, next_size.as_mut())
-                            && stop / span < *size
-                            && stop / span > smallest
-                        {
-                            *size = stop / span;
-                        }
-                        mean_acceleration = Some(abar);
                     }
                     progress += dp;
                     increment += 1;
@@ -570,7 +611,7 @@ fn run_steps<const D: usize>(
                     successes = 0;
                     let cut = dp * settings.cutback.factor;
                     let exhausted = !cause.calls_for_cutback()
-                        || match adaptive {
+                        || match &adaptive {
                             // an adaptive step cuts back to its smallest increment, then gives up
                             Some(_) => dp <= smallest * (1.0 + 1e-9),
                             None => cut < smallest,
