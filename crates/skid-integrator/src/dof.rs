@@ -32,10 +32,13 @@ impl<const D: usize> DofMap<D> {
     ///
     /// - `node_count`: number of mesh nodes;
     /// - `tied_to`: for each node, the rigid body it is tied to, if any;
+    /// - `fixed`: for each node, the components held at zero displacement (a shorter slice
+    ///   leaves the remaining nodes free);
     /// - `free_translations` / `free_rotation`: per body, which motions are free.
     pub fn new(
         node_count: usize,
         tied_to: &[Option<usize>],
+        fixed: &[[bool; D]],
         free_translations: &[[bool; D]],
         free_rotation: &[bool],
     ) -> Self {
@@ -47,8 +50,11 @@ impl<const D: usize> DofMap<D> {
         let mut node = vec![[None; D]; node_count];
         for (n, eqs) in node.iter_mut().enumerate() {
             if tied_to.get(n).copied().flatten().is_none() {
-                for eq in eqs.iter_mut() {
-                    *eq = Some(next(EquationKind::Translation));
+                let fixed = fixed.get(n).copied().unwrap_or([false; D]);
+                for (eq, fixed) in eqs.iter_mut().zip(fixed) {
+                    if !fixed {
+                        *eq = Some(next(EquationKind::Translation));
+                    }
                 }
             }
         }
@@ -154,6 +160,7 @@ mod tests {
         let map = DofMap::<2>::new(
             4,
             &[None, None, Some(0), Some(0)],
+            &[],
             &[[false, true], [false, false]],
             &[false, true],
         );
@@ -168,5 +175,20 @@ mod tests {
         assert_eq!(map.node_displacement(&x, 3)[1], -0.004);
         assert_eq!(map.body_angle(&x, 1), 1.5);
         assert_eq!(map.body_equations(0), vec![4]);
+    }
+
+    #[test]
+    fn fixed_node_components_get_no_equation() {
+        // node 0 fixed along x, node 1 along both axes
+        let map = DofMap::<2>::new(3, &[None; 3], &[[true, false], [true, true]], &[], &[]);
+        assert_eq!(map.len(), 1 + 2);
+        assert_eq!(map.node(0), &[None, Some(0)]);
+        assert_eq!(map.node(1), &[None, None]);
+        assert_eq!(map.node(2), &[Some(1), Some(2)]);
+        let x = DVector::from_vec(vec![0.5, 1.0, 2.0]);
+        assert_eq!(
+            map.node_displacement(&x, 0),
+            SVector::<f64, 2>::new(0.0, 0.5)
+        );
     }
 }

@@ -31,6 +31,8 @@ pub struct SolidPart<const D: usize> {
     /// [`crate::increment`]). `density` then serves only the regularisation of static Newton
     /// steps.
     pub quasi_static: bool,
+    /// Node components held at zero displacement throughout, as `(node, axis)` pairs.
+    pub fixed: Vec<(usize, usize)>,
 }
 
 /// Nodes tied to a rigid body: they translate with its reference node.
@@ -155,6 +157,23 @@ impl<const D: usize> Model<D> {
                 }
             }
         }
+        let mut fixed = vec![[false; D]; n_nodes];
+        for &(n, axis) in &part.fixed {
+            check_node(n, "fixed node")?;
+            if axis >= D {
+                return invalid(format!(
+                    "fixed node {n}: axis {axis} does not exist in {D}D"
+                ));
+            }
+            if let Some(b) = tied_to[n] {
+                return invalid(format!(
+                    "node {n} is both fixed and tied to rigid body '{}': a tied node moves \
+                     with the body; fix the body's motion instead",
+                    bodies[b].name
+                ));
+            }
+            fixed[n][axis] = true;
+        }
         let face_nodes = 1 << (D - 1);
         for load in &pressures {
             if !load.pressure.is_finite() {
@@ -196,7 +215,13 @@ impl<const D: usize> Model<D> {
         let free_translations: Vec<[bool; D]> =
             bodies.iter().map(|b| b.free_translations).collect();
         let free_rotation: Vec<bool> = bodies.iter().map(|b| b.rotation_axis.is_some()).collect();
-        let dofs = DofMap::new(n_nodes, &tied_to, &free_translations, &free_rotation);
+        let dofs = DofMap::new(
+            n_nodes,
+            &tied_to,
+            &fixed,
+            &free_translations,
+            &free_rotation,
+        );
 
         let mut solid_mass = DVector::zeros(dofs.len());
         for (element, conn) in elements.iter().zip(&part.mesh.elements) {

@@ -201,8 +201,46 @@ pub struct Step {
     pub name: String,
     /// What the step does.
     pub kind: StepKind,
-    /// Rigid bodies held fixed during the step (all their free motions).
-    pub held_bodies: Vec<usize>,
+    /// Rigid-body motions held at their value at the start of the step.
+    pub held: Vec<HeldMotion>,
+}
+
+/// A motion of a rigid body's reference node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BodyMotion {
+    /// Translation along global axis `i`.
+    Translation(usize),
+    /// The rotation about the body's free axis.
+    Rotation,
+}
+
+/// A rigid-body motion held during a step: one motion, or every free motion of the body.
+/// Holding a motion that the model already fixes changes nothing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HeldMotion {
+    /// Index of the rigid body.
+    pub body: usize,
+    /// The motion held; `None`: all the body's free motions.
+    pub motion: Option<BodyMotion>,
+}
+
+impl HeldMotion {
+    /// Holds every free motion of `body`.
+    pub fn body(body: usize) -> Self {
+        Self { body, motion: None }
+    }
+
+    /// Equations this hold fixes (none for a motion the model already fixes).
+    fn equations<const D: usize>(&self, model: &Model<D>) -> Vec<usize> {
+        let dofs = model.dofs();
+        match self.motion {
+            None => dofs.body_equations(self.body),
+            Some(BodyMotion::Translation(i)) => {
+                dofs.body_translation(self.body)[i].into_iter().collect()
+            }
+            Some(BodyMotion::Rotation) => dofs.body_rotation(self.body).into_iter().collect(),
+        }
+    }
 }
 
 /// Cutback settings.
@@ -384,8 +422,15 @@ fn consistent_acceleration<const D: usize>(
 fn validate_steps<const D: usize>(model: &Model<D>, steps: &[Step]) -> Result<(), RunError> {
     let bad = |s: &Step, msg: String| Err(RunError::Invalid(format!("step '{}': {msg}", s.name)));
     for s in steps {
-        if let Some(&b) = s.held_bodies.iter().find(|&&b| b >= model.bodies().len()) {
-            return bad(s, format!("held body {b} does not exist"));
+        for hold in &s.held {
+            if hold.body >= model.bodies().len() {
+                return bad(s, format!("held body {} does not exist", hold.body));
+            }
+            if let Some(BodyMotion::Translation(i)) = hold.motion
+                && i >= D
+            {
+                return bad(s, format!("held translation along axis {i} in {D}D"));
+            }
         }
         match s.kind {
             StepKind::Static {
@@ -503,10 +548,8 @@ fn run_steps<const D: usize>(
     let n = model.dofs().len();
     for step in steps {
         let mut held = vec![false; n];
-        for &b in &step.held_bodies {
-            for eq in model.dofs().body_equations(b) {
-                held[eq] = true;
-            }
+        for eq in step.held.iter().flat_map(|h| h.equations(model)) {
+            held[eq] = true;
         }
         let lambda0 = state.load_factor;
         let t0 = state.time;

@@ -28,6 +28,7 @@ pub(crate) fn pad_block<const D: usize>(
         thickness: 0.1,
         hourglass_scale: 1.0,
         quasi_static: false,
+        fixed: vec![],
     }
 }
 

@@ -94,7 +94,7 @@ fn simulate(
             alpha,
             adaptive: None,
         },
-        held_bodies: vec![],
+        held: vec![],
     }];
     if preload {
         steps.insert(
@@ -105,7 +105,7 @@ fn simulate(
                     increments: 4,
                     regularization_time: 1e-2,
                 },
-                held_bodies: vec![],
+                held: vec![],
             },
         );
     }

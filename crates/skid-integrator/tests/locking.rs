@@ -43,6 +43,7 @@ fn tip_deflection(k_over_mu: f64) -> f64 {
         thickness: THICKNESS,
         hourglass_scale: 1.0,
         quasi_static: false,
+        fixed: vec![],
     };
     let wall = RigidBody::<2> {
         name: "wall".into(),
@@ -74,7 +75,7 @@ fn tip_deflection(k_over_mu: f64) -> f64 {
             increments: 1,
             regularization_time: 1.0,
         },
-        held_bodies: vec![],
+        held: vec![],
     }];
     let mut last = Last(None);
     let (_, result) = run(&model, &steps, &Settings::default(), &mut last);

@@ -79,7 +79,7 @@ fn load(model: &Model<2>, regularization_time: f64, settle: usize) -> State {
             increments: 4,
             regularization_time,
         },
-        held_bodies: vec![],
+        held: vec![],
     }];
     if settle > 0 {
         steps.push(Step {
@@ -90,7 +90,7 @@ fn load(model: &Model<2>, regularization_time: f64, settle: usize) -> State {
                 alpha: -0.3,
                 adaptive: None,
             },
-            held_bodies: vec![],
+            held: vec![],
         });
     }
     let mut last = Last(None);

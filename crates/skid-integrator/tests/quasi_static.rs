@@ -15,7 +15,9 @@ use nalgebra::{SVector, Vector3};
 use skid_contact::plane::RigidPlane;
 use skid_fem::rigid::RigidBody;
 use skid_integrator::increment::ContactSolve;
-use skid_integrator::stepper::{IncrementReport, Observer, Settings, Step, StepKind, run};
+use skid_integrator::stepper::{
+    HeldMotion, IncrementReport, Observer, Settings, Step, StepKind, run,
+};
 use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie};
 
 const MU: f64 = 0.3;
@@ -90,7 +92,7 @@ fn slide(dt: f64, method: ContactSolve) -> Vec<State> {
                 increments: 4,
                 regularization_time: 1e-2,
             },
-            held_bodies: vec![0],
+            held: vec![HeldMotion::body(0)],
         },
         Step {
             name: "slide".into(),
@@ -100,7 +102,7 @@ fn slide(dt: f64, method: ContactSolve) -> Vec<State> {
                 alpha: -0.3,
                 adaptive: None,
             },
-            held_bodies: vec![],
+            held: vec![],
         },
     ];
     let settings = Settings {

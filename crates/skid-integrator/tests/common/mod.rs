@@ -44,5 +44,6 @@ pub fn block_part(
         thickness,
         hourglass_scale: 1.0,
         quasi_static,
+        fixed: vec![],
     }
 }
