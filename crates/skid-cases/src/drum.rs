@@ -1,4 +1,5 @@
-//! Builds the braking-drum scene of a case as a finite-element model (2D or 3D, one code path).
+//! The braking-drum scene of a case, generated as a model file ([`model_spec`]) and built as
+//! any model file is (2D or 3D, one code path):
 //!
 //! - the pad: a structured block of one-point elements; its front face (`ymin`) is the slave
 //!   side of the contact, its back face (`ymax`) is tied to the back plate and loaded by the
@@ -8,24 +9,17 @@
 //!   of freedom of its own;
 //! - the back plate: a rigid body whose only free motion is the radial (y) translation.
 
-use nalgebra::{SVector, Vector3};
-use skid_contact::error::ContactError;
-use skid_contact::facets::FacetedCylinder;
-use skid_contact::surface::{AnalyticCylinder, RigidSurface};
-use skid_contact::triangles::{CylinderChart, TriangulatedSurface};
-use skid_fem::cell::embed;
-use skid_fem::material::PolynomialN1;
+use nalgebra::SVector;
 use skid_fem::mesh::SolidMesh;
-use skid_fem::rigid::RigidBody;
 use skid_fem::tetra::TetMesh;
-use skid_integrator::increment::{ContactSolve, NewtonSettings};
-use skid_integrator::stepper::{Adaptive, CutbackSettings, Settings, Step, StepKind};
-use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, Tie};
 
-use crate::schema::{
-    Case, ContactFormulation, ContactSolveSpec, CoulombMethodSpec, DrumSurfaceSpec, MaterialSpec,
-    StepSpec,
+use crate::model_file::spec::ContactPairSpec;
+use crate::model_file::spec::{
+    BoundarySpec, Dof, ElementBlockSpec, ElementType, LoadSpec, ModelStepSpec, PartSpec,
+    RigidBodySpec, RigidSurfaceSpec, SectionSpec, SlaveSpec, StepBoundarySpec, TieSpec,
 };
+use crate::model_file::{self, MODEL_FORMAT_VERSION, ModelSpec, Scene};
+use crate::schema::{Case, ContactFormulation, DrumSurfaceSpec, StepSpec};
 
 /// Index of the drum among the model's rigid bodies.
 pub const DRUM: usize = 0;
@@ -34,26 +28,37 @@ pub const BACK_PLATE: usize = 1;
 /// Names of the rigid bodies, by index (as case files name them in a step's `hold`).
 pub const BODY_NAMES: [&str; 2] = ["drum", "back_plate"];
 
-/// A built scene: model, steps and solver settings.
-#[derive(Debug)]
-pub struct DrumScene<const D: usize> {
-    /// The model.
-    pub model: Model<D>,
-    /// Analysis steps.
-    pub steps: Vec<Step>,
-    /// Solver settings.
-    pub settings: Settings,
-}
-
-/// Builds the scene of a validated case in dimension `D` (which must equal `case.dimension`).
+/// Builds the scene of a validated case in dimension `D` (which must equal `case.dimension`):
+/// the case's model file ([`model_spec`]) built as any model file is.
 ///
 /// # Errors
 /// A message if the model is inconsistent (the case was validated, so this means a mesh or
 /// element problem such as a degenerate geometry).
-pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
+pub fn build<const D: usize>(case: &Case) -> Result<Scene<D>, String> {
     if case.dimension != D {
         return Err(format!("case is {}D, builder is {D}D", case.dimension));
     }
+    let spec = model_spec(case)?;
+    model_file::build::<D>(&spec).map_err(|e| format!("{}: {}", e.field, e.message))
+}
+
+/// The model file of a validated case: the pad as a structured block of one-point elements
+/// (node sets and surfaces `xmin` ... `zmax` of its boundary planes, `ymin` facing the drum),
+/// the drum and the back plate as rigid bodies whose fixed motions are boundary conditions,
+/// the back face `ymax` tied to the plate and loaded by the pressure, one contact pair
+/// `pad-drum`.
+///
+/// # Errors
+/// A message if the pad or drum mesh cannot be generated.
+pub fn model_spec(case: &Case) -> Result<ModelSpec, String> {
+    match case.dimension {
+        2 => model_spec_in::<2>(case),
+        3 => model_spec_in::<3>(case),
+        d => Err(format!("dimension must be 2 or 3, got {d}")),
+    }
+}
+
+fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
     let pad = &case.pad;
     let r = case.drum.radius;
     let extent = [pad.length, pad.thickness, pad.width];
@@ -69,92 +74,68 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
         std::array::from_fn(|i| counts[i]),
     )
     .map_err(|e| format!("pad mesh: {e}"))?;
-    let material = match pad.material {
-        MaterialSpec::PolynomialN1 { c10, c01, d1 } => {
-            PolynomialN1::new(c10, c01, d1).map_err(|e| format!("pad.material: {e}"))?
-        }
+    let part = PartSpec {
+        name: "pad".into(),
+        nodes: mesh
+            .nodes
+            .iter()
+            .map(|p| p.iter().copied().collect())
+            .collect(),
+        elements: vec![ElementBlockSpec {
+            kind: ElementType::solid(D),
+            connectivity: mesh.elements,
+        }],
+        node_sets: mesh.node_sets,
+        surfaces: mesh.surfaces,
+        section: SectionSpec {
+            material: pad.material.clone(),
+            density: pad.density,
+            thickness: if D == 2 { pad.width } else { 1.0 },
+            hourglass_scale: pad.hourglass_scale,
+            quasi_static: pad.quasi_static,
+        },
     };
-    let set = |name: &str| {
-        mesh.node_sets
-            .get(name)
-            .cloned()
-            .ok_or_else(|| format!("pad mesh has no node set '{name}'"))
-    };
-    let front = set("ymin")?;
-    let back = set("ymax")?;
-    let back_faces = mesh
-        .surfaces
-        .get("ymax")
-        .cloned()
-        .ok_or("pad mesh has no surface 'ymax'")?;
-
-    let drum = RigidBody::<D> {
+    let mut plate_point = vec![0.0; D];
+    plate_point[1] = r + pad.standoff + pad.thickness;
+    let drum = RigidBodySpec {
         name: BODY_NAMES[DRUM].into(),
-        reference_point: SVector::zeros(),
+        reference_point: vec![0.0; D],
         mass: case.drum.mass,
         rotary_inertia: case.drum.rotary_inertia,
-        free_translations: [false; D],
-        rotation_axis: Some(Vector3::z()),
-        initial_velocity: SVector::zeros(),
-        initial_angular_velocity: case.drum.omega0,
+        surface: Some(drum_surface(case)?),
+        initial_velocity: None,
+        initial_angular_velocity: Some([0.0, 0.0, case.drum.omega0]),
     };
-    let mut plate_point = SVector::<f64, D>::zeros();
-    plate_point[1] = r + pad.standoff + pad.thickness;
-    let mut free = [false; D];
-    free[1] = true;
-    let plate = RigidBody::<D> {
+    let plate = RigidBodySpec {
         name: BODY_NAMES[BACK_PLATE].into(),
         reference_point: plate_point,
         mass: case.back_plate.mass,
         rotary_inertia: 0.0,
-        free_translations: free,
-        rotation_axis: None,
-        initial_velocity: SVector::zeros(),
-        initial_angular_velocity: 0.0,
+        surface: None,
+        initial_velocity: None,
+        initial_angular_velocity: None,
     };
-    let surface = drum_surface(case).map_err(|e| format!("drum.surface: {e}"))?;
-    let contact_nodes = match case.contact.formulation {
-        ContactFormulation::Pair => front,
-        ContactFormulation::General { search_distance } => {
-            general_contact_candidates(&mesh, surface.as_ref(), search_distance)
-        }
+    // the drum spins about its fixed axis; the plate only moves radially (along y)
+    let fixed = |body: usize, free: &[Dof]| BoundarySpec {
+        body: Some(BODY_NAMES[body].into()),
+        node_set: None,
+        dofs: Dof::all(D)
+            .iter()
+            .filter(|d| !free.contains(d))
+            .copied()
+            .collect(),
     };
-    let part = SolidPart {
-        mesh,
-        material: Box::new(material),
-        density: pad.density,
-        thickness: if D == 2 { pad.width } else { 1.0 },
-        hourglass_scale: pad.hourglass_scale,
-        quasi_static: pad.quasi_static,
+    let slave = match case.contact.formulation {
+        ContactFormulation::Pair => SlaveSpec::NodeSet {
+            name: "ymin".into(),
+        },
+        ContactFormulation::General { search_distance } => SlaveSpec::General { search_distance },
     };
-    let model = Model::new(
-        part,
-        vec![drum, plate],
-        vec![Tie {
-            body: BACK_PLATE,
-            nodes: back,
-        }],
-        vec![PressureLoad {
-            faces: back_faces,
-            pressure: case.back_plate.pressure,
-        }],
-        vec![ContactPair {
-            name: "pad-drum".into(),
-            nodes: contact_nodes,
-            body: DRUM,
-            surface,
-            mu: case.contact.mu,
-        }],
-    )
-    .map_err(|e| e.to_string())?;
-
-    let held = |hold: &[String]| -> Result<Vec<usize>, String> {
+    let hold = |hold: &[String]| {
         hold.iter()
-            .map(|h| {
-                BODY_NAMES
-                    .iter()
-                    .position(|b| b == h)
-                    .ok_or_else(|| format!("no rigid body named '{h}' to hold"))
+            .map(|body| StepBoundarySpec {
+                body: body.clone(),
+                dofs: None,
             })
             .collect()
     };
@@ -165,68 +146,56 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
             StepSpec::Static {
                 name,
                 increments,
-                hold,
+                hold: held,
                 regularization_time,
-            } => Ok(Step {
+            } => ModelStepSpec::Static {
                 name: name.clone(),
-                kind: StepKind::Static {
-                    increments: *increments,
-                    regularization_time: *regularization_time,
-                },
-                held_bodies: held(hold)?,
-            }),
+                increments: *increments,
+                regularization_time: *regularization_time,
+                boundary: hold(held),
+            },
             StepSpec::Dynamic {
                 name,
                 duration,
                 dt,
                 alpha,
-                hold,
+                hold: held,
                 adaptive,
-            } => Ok(Step {
+            } => ModelStepSpec::Dynamic {
                 name: name.clone(),
-                kind: StepKind::Dynamic {
-                    duration: *duration,
-                    dt: *dt,
-                    alpha: *alpha,
-                    adaptive: adaptive.map(|a| Adaptive {
-                        tolerance: a.tolerance,
-                        min_dt: a.min_dt,
-                        max_dt: a.max_dt,
-                    }),
-                },
-                held_bodies: held(hold)?,
-            }),
+                duration: *duration,
+                dt: *dt,
+                alpha: *alpha,
+                boundary: hold(held),
+                adaptive: *adaptive,
+            },
         })
-        .collect::<Result<Vec<_>, String>>()?;
-    let s = &case.solver;
-    let settings = Settings {
-        newton: NewtonSettings {
-            max_iterations: s.max_newton_iterations,
-            force_tolerance: s.force_tolerance,
-            contact_tolerance: s.contact_tolerance,
-        },
-        coulomb: skid_contact::coulomb::CoulombSettings {
-            tolerance: s.coulomb_tolerance,
-            max_fixed_point_iterations: s.max_fixed_point_iterations,
-            method: s.coulomb_method.into(),
-            ..Default::default()
-        },
-        // the conic method solves the Coulomb problem on the Delassus operator: the reduced path
-        contact_solve: match (s.contact_solve, s.coulomb_method) {
-            (_, CoulombMethodSpec::Conic) | (ContactSolveSpec::Reduced, _) => ContactSolve::Reduced,
-            (ContactSolveSpec::Auto, _) if !case.pad.quasi_static => ContactSolve::Reduced,
-            _ => ContactSolve::Global,
-        },
-        cutback: CutbackSettings {
-            factor: s.cutback_factor,
-            max_cutbacks: s.max_cutbacks,
-            ..Default::default()
-        },
-    };
-    Ok(DrumScene {
-        model,
+        .collect();
+    Ok(ModelSpec {
+        skid_model: MODEL_FORMAT_VERSION,
+        name: case.name.clone(),
+        description: case.description.clone(),
+        dimension: D,
+        part,
+        rigid_bodies: vec![drum, plate],
+        boundary: vec![fixed(DRUM, &[Dof::Rz]), fixed(BACK_PLATE, &[Dof::Y])],
+        ties: vec![TieSpec {
+            node_set: "ymax".into(),
+            body: BODY_NAMES[BACK_PLATE].into(),
+        }],
+        loads: vec![LoadSpec::Pressure {
+            surface: "ymax".into(),
+            pressure: case.back_plate.pressure,
+        }],
+        contact: vec![ContactPairSpec {
+            name: "pad-drum".into(),
+            slave,
+            master: BODY_NAMES[DRUM].into(),
+            mu: case.contact.mu,
+        }],
         steps,
-        settings,
+        solver: case.solver.clone(),
+        output: case.output.clone(),
     })
 }
 
@@ -234,19 +203,18 @@ pub fn build<const D: usize>(case: &Case) -> Result<DrumScene<D>, String> {
 /// tetrahedral drums have their vertices at `(2 k + 1) pi / n` from +x (n facets or sectors), so
 /// that for the benchmark's 72 a facet's midpoint, not a vertex, lies under the pad's centre
 /// (the statement does not say; a vertex there would hold the pad's centre node on a corner).
-///
-/// # Errors
-/// If the surface geometry is invalid.
-pub fn drum_surface(case: &Case) -> Result<Box<dyn RigidSurface>, ContactError> {
+/// A tetrahedral drum contributes the exterior faces of its mesh.
+fn drum_surface(case: &Case) -> Result<RigidSurfaceSpec, String> {
     let r = case.drum.radius;
+    let axis = [0.0, 0.0, 1.0];
     Ok(match case.drum.surface {
-        DrumSurfaceSpec::Analytic => Box::new(AnalyticCylinder::new(r, Vector3::z())?),
-        DrumSurfaceSpec::Facets { count, .. } => Box::new(FacetedCylinder::new(
-            r,
-            Vector3::z(),
-            count,
-            std::f64::consts::PI / count as f64,
-        )?),
+        DrumSurfaceSpec::Analytic => RigidSurfaceSpec::Cylinder { radius: r, axis },
+        DrumSurfaceSpec::Facets { count, .. } => RigidSurfaceSpec::FacetedCylinder {
+            radius: r,
+            axis,
+            facets: count,
+            phase: std::f64::consts::PI / count as f64,
+        },
         DrumSurfaceSpec::Tetrahedra {
             sectors,
             rings,
@@ -260,40 +228,27 @@ pub fn drum_surface(case: &Case) -> Result<Box<dyn RigidSurface>, ContactError> 
                 [sectors, rings, layers],
                 std::f64::consts::PI / sectors as f64,
             )
-            .map_err(|e| ContactError::InvalidSurface(e.to_string()))?;
+            .map_err(|e| format!("drum.surface: {e}"))?;
+            // keep the vertices the exterior faces use, numbered in their original order
             let faces = mesh.exterior_faces();
-            Box::new(TriangulatedSurface::new(
-                mesh.nodes,
-                faces,
-                CylinderChart {
-                    radius: r,
-                    axis: Vector3::z(),
-                },
-            )?)
+            let mut used = vec![false; mesh.nodes.len()];
+            for &n in faces.iter().flatten() {
+                used[n] = true;
+            }
+            let mut number = vec![0; mesh.nodes.len()];
+            let mut vertices = Vec::new();
+            for (n, _) in used.iter().enumerate().filter(|(_, used)| **used) {
+                number[n] = vertices.len();
+                vertices.push(mesh.nodes[n].into());
+            }
+            RigidSurfaceSpec::Triangles {
+                vertices,
+                triangles: faces.iter().map(|t| t.map(|n| number[n])).collect(),
+                chart_radius: r,
+                chart_axis: axis,
+            }
         }
     })
-}
-
-/// General contact: the nodes of every exterior face of the pad whose distance to the drum
-/// surface (in the initial configuration) is below `search_distance`, sorted.
-fn general_contact_candidates<const D: usize>(
-    mesh: &SolidMesh<D>,
-    surface: &dyn RigidSurface,
-    search_distance: f64,
-) -> Vec<usize> {
-    let mut nodes: Vec<usize> = mesh
-        .surfaces
-        .values()
-        .flat_map(|faces| faces.iter().flatten().copied())
-        .filter(|&n| {
-            surface
-                .project(&embed(&mesh.nodes[n]))
-                .is_some_and(|p| p.gap < search_distance)
-        })
-        .collect();
-    nodes.sort_unstable();
-    nodes.dedup();
-    nodes
 }
 
 #[cfg(test)]

@@ -2,7 +2,8 @@
 //!
 //! - [`schema`]: the JSON case-file format;
 //! - [`validate`]: reading a case with field-level error messages and overrides;
-//! - [`drum`]: building the drum scene (any idealization, 2D or 3D) as a model;
+//! - [`model_file`]: the general model file (any scene) and building it into a model;
+//! - [`drum`]: the drum scene of a case (any idealization, 2D or 3D) as a model file;
 //! - [`history`]: the per-increment history of the drum (`history.csv`);
 //! - [`newton`]: the Newton residuals of every increment (`newton.csv`);
 //! - [`atomic`]: output files that are complete or absent (written aside, then renamed);
@@ -22,6 +23,7 @@ pub mod csv_out;
 pub mod drum;
 pub mod fields;
 pub mod history;
+pub mod model_file;
 pub mod newton;
 pub mod report;
 pub mod runner;
@@ -31,7 +33,7 @@ pub mod validate;
 
 pub use batch::{BatchEntry, BatchError, BatchStatus, collect_case_files, run_batch};
 pub use report::{ReportError, ReportOutcome, ReportSources, write_report};
-pub use runner::{default_output_dir, run_case, run_case_file};
+pub use runner::{RunSummary, default_output_dir, run_case, run_case_file, run_file};
 pub use schema::Case;
 pub use summary::Summary;
 pub use validate::{CaseError, load_case, parse_case};

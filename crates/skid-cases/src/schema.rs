@@ -263,11 +263,13 @@ pub struct AdaptiveSpec {
     pub max_dt: f64,
 }
 
-fn default_regularization_time() -> f64 {
+/// Default time scale of the static regularisation, s.
+pub(crate) fn default_regularization_time() -> f64 {
     1e-2
 }
 
-fn default_alpha() -> f64 {
+/// Default HHT alpha.
+pub(crate) fn default_alpha() -> f64 {
     -0.3
 }
 

@@ -81,6 +81,32 @@ pub fn load_case(path: &Path, overrides: &[String]) -> Result<Case, CaseError> {
 /// # Errors
 /// [`CaseError`] naming the field at fault.
 pub fn parse_case(text: &str, path: &Path, overrides: &[String]) -> Result<Case, CaseError> {
+    if serde_json::from_str::<Value>(text).is_ok_and(|v| crate::model_file::is_model_file(&v)) {
+        return Err(CaseError::Invalid {
+            path: path.to_path_buf(),
+            field: "skid_model".into(),
+            message: "this is a model file, not a drum case file: run it with `skid run`".into(),
+        });
+    }
+    let case: Case = parse_document(text, path, overrides)?;
+    validate(&case).map_err(|(field, message)| CaseError::Invalid {
+        path: path.to_path_buf(),
+        field,
+        message,
+    })?;
+    Ok(case)
+}
+
+/// Parses JSON text into `T` with `overrides` applied (`path` is only used in messages).
+///
+/// # Errors
+/// [`CaseError::Parse`] for text that is not JSON (naming line and column) or not of `T`'s
+/// format (naming the field path), [`CaseError::Override`] for a malformed override.
+pub(crate) fn parse_document<T: serde::de::DeserializeOwned>(
+    text: &str,
+    path: &Path,
+    overrides: &[String],
+) -> Result<T, CaseError> {
     let parse_error = |field: String, message: String| CaseError::Parse {
         path: path.to_path_buf(),
         field,
@@ -95,19 +121,13 @@ pub fn parse_case(text: &str, path: &Path, overrides: &[String]) -> Result<Case,
     for o in overrides {
         apply_override(&mut value, o)?;
     }
-    let case: Case = serde_path_to_error::deserialize(value).map_err(|e| {
+    serde_path_to_error::deserialize(value).map_err(|e| {
         let field = match e.path().to_string() {
             p if p == "." => "(top level)".to_string(),
             p => p,
         };
         parse_error(field, e.into_inner().to_string())
-    })?;
-    validate(&case).map_err(|(field, message)| CaseError::Invalid {
-        path: path.to_path_buf(),
-        field,
-        message,
-    })?;
-    Ok(case)
+    })
 }
 
 /// Sets a field: `drum.omega0=600`, `steps[1].dt=1e-4` (dots and `[i]` indices into existing

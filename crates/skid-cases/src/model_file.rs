@@ -1,0 +1,47 @@
+//! General model files: any scene the solver can run, as one JSON document ([`ModelSpec`]).
+//!
+//! - [`spec`]: the format (parts, rigid bodies, boundary conditions, ties, loads, contact
+//!   pairs, steps, solver and output settings);
+//! - [`build`]: resolving names and checking values into a [`Scene`] (the integrator's model,
+//!   steps and settings), each problem reported with its field path;
+//! - [`history`]: the generic `history.csv` (every body's motions, every pair's resultants,
+//!   the energy ledger);
+//! - [`summary`]: the generic `summary.json`.
+//!
+//! A case file of the drum benchmark is generated into a model file by
+//! [`crate::drum::model_spec`], and runs through the same [`build`].
+
+pub mod build;
+pub mod history;
+pub mod spec;
+pub mod summary;
+
+use std::path::Path;
+
+use serde_json::Value;
+
+pub use build::{Scene, SpecError, build};
+pub use spec::{MODEL_FORMAT_VERSION, ModelSpec};
+
+use crate::validate::{CaseError, parse_document};
+
+/// Whether a parsed JSON document is a model file (it declares `skid_model`) rather than a
+/// drum case file.
+pub fn is_model_file(value: &Value) -> bool {
+    value.get("skid_model").is_some()
+}
+
+/// Parses model-file text with `overrides` applied (`path` is only used in messages). Names
+/// and values are checked when the scene is built ([`build`]).
+///
+/// # Errors
+/// [`CaseError::Parse`] for text that is not JSON or not of the format, naming the line or the
+/// field.
+pub fn parse_model(text: &str, path: &Path, overrides: &[String]) -> Result<ModelSpec, CaseError> {
+    parse_document(text, path, overrides)
+}
+
+/// The model file's text: pretty JSON whose numbers read back to the same bits.
+pub fn to_json(spec: &ModelSpec) -> String {
+    serde_json::to_string_pretty(spec).unwrap_or_default()
+}

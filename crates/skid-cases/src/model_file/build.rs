@@ -1,0 +1,774 @@
+//! Building a [`Scene`] from a [`ModelSpec`]: every name resolved, every value checked, each
+//! problem reported with the field path at fault.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use nalgebra::{SVector, Vector3};
+use skid_contact::facets::FacetedCylinder;
+use skid_contact::plane::RigidPlane;
+use skid_contact::surface::{AnalyticCylinder, RigidSurface};
+use skid_contact::triangles::{CylinderChart, TriangulatedSurface};
+use skid_fem::cell::{embed, face_corners};
+use skid_fem::material::PolynomialN1;
+use skid_fem::mesh::SolidMesh;
+use skid_fem::rigid::RigidBody;
+use skid_integrator::increment::{ContactSolve, NewtonSettings};
+use skid_integrator::stepper::{
+    Adaptive, BodyMotion, CutbackSettings, HeldMotion, Settings, Step, StepKind,
+};
+use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, Tie};
+
+use super::spec::{
+    BoundarySpec, Dof, LoadSpec, MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, RigidSurfaceSpec,
+    SlaveSpec, StepBoundarySpec,
+};
+use crate::schema::{AdaptiveSpec, ContactSolveSpec, CoulombMethodSpec, MaterialSpec, SolverSpec};
+
+/// A built scene: model, steps and solver settings.
+#[derive(Debug)]
+pub struct Scene<const D: usize> {
+    /// The model.
+    pub model: Model<D>,
+    /// Analysis steps.
+    pub steps: Vec<Step>,
+    /// Solver settings.
+    pub settings: Settings,
+}
+
+/// A problem in a model: the field path at fault and what was expected.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpecError {
+    /// Field path, e.g. `rigid_bodies[0].mass`.
+    pub field: String,
+    /// What is wrong and what was expected.
+    pub message: String,
+}
+
+fn fail<T>(field: impl Into<String>, message: impl Into<String>) -> Result<T, SpecError> {
+    Err(SpecError {
+        field: field.into(),
+        message: message.into(),
+    })
+}
+
+/// `Ok` for a finite `v > 0`.
+pub(crate) fn positive(field: &str, v: f64) -> Result<(), SpecError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        fail(field, format!("expected a finite value > 0, got {v}"))
+    }
+}
+
+/// `Ok` for a finite `v >= 0`.
+pub(crate) fn non_negative(field: &str, v: f64) -> Result<(), SpecError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        fail(field, format!("expected a finite value >= 0, got {v}"))
+    }
+}
+
+fn finite_point<const D: usize>(field: &str, p: &[f64]) -> Result<SVector<f64, D>, SpecError> {
+    if p.len() != D {
+        return fail(field, format!("expected {D} coordinates, got {}", p.len()));
+    }
+    if let Some(v) = p.iter().find(|v| !v.is_finite()) {
+        return fail(field, format!("expected finite coordinates, got {v}"));
+    }
+    Ok(SVector::from_fn(|i, _| p[i]))
+}
+
+fn vector3(field: &str, v: [f64; 3]) -> Result<Vector3<f64>, SpecError> {
+    if v.iter().all(|c| c.is_finite()) {
+        Ok(Vector3::from(v))
+    } else {
+        fail(field, format!("expected finite components, got {v:?}"))
+    }
+}
+
+/// Builds the scene of `spec` in dimension `D` (which must equal `spec.dimension`).
+///
+/// # Errors
+/// The first problem found, as a [`SpecError`].
+pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
+    if spec.skid_model != MODEL_FORMAT_VERSION {
+        return fail(
+            "skid_model",
+            format!(
+                "expected format version {MODEL_FORMAT_VERSION}, got {}",
+                spec.skid_model
+            ),
+        );
+    }
+    if spec.dimension != D {
+        return fail(
+            "dimension",
+            format!("expected {D} (2 or 3), got {}", spec.dimension),
+        );
+    }
+    let mesh = part_mesh::<D>(spec)?;
+    let section = &spec.part.section;
+    let material = match section.material {
+        MaterialSpec::PolynomialN1 { c10, c01, d1 } => {
+            PolynomialN1::new(c10, c01, d1).map_err(|e| SpecError {
+                field: "part.section.material".into(),
+                message: e.to_string(),
+            })?
+        }
+    };
+    positive("part.section.density", section.density)?;
+    positive("part.section.thickness", section.thickness)?;
+    if D == 3 && section.thickness != 1.0 {
+        return fail(
+            "part.section.thickness",
+            format!(
+                "a 3D part has no out-of-plane thickness: expected 1, got {}",
+                section.thickness
+            ),
+        );
+    }
+    positive("part.section.hourglass_scale", section.hourglass_scale)?;
+
+    let body_index = body_names(spec)?;
+    let body_of = |field: &str, name: &str| {
+        body_index.get(name).copied().ok_or_else(|| SpecError {
+            field: field.into(),
+            message: format!("no rigid body named '{name}'"),
+        })
+    };
+    let node_set = |field: &str, name: &str| {
+        mesh.node_sets.get(name).ok_or_else(|| SpecError {
+            field: field.into(),
+            message: format!("no node set named '{name}' in part '{}'", spec.part.name),
+        })
+    };
+
+    let mut body_fixed: Vec<BTreeSet<Dof>> = vec![BTreeSet::new(); spec.rigid_bodies.len()];
+    let mut fixed_nodes = Vec::new();
+    for (i, bc) in spec.boundary.iter().enumerate() {
+        let f = |name: &str| format!("boundary[{i}].{name}");
+        check_dofs::<D>(&f("dofs"), &bc.dofs)?;
+        match bc {
+            BoundarySpec {
+                body: Some(body),
+                node_set: None,
+                dofs,
+            } => body_fixed[body_of(&f("body"), body)?].extend(dofs),
+            BoundarySpec {
+                body: None,
+                node_set: Some(set),
+                dofs,
+            } => {
+                let nodes = node_set(&f("node_set"), set)?;
+                for dof in dofs {
+                    let Some(axis) = dof.translation_axis() else {
+                        return fail(
+                            f("dofs"),
+                            format!("nodes of a solid part have no rotation {dof:?}"),
+                        );
+                    };
+                    fixed_nodes.extend(nodes.iter().map(|&n| (n, axis)));
+                }
+            }
+            _ => {
+                return fail(
+                    format!("boundary[{i}]"),
+                    "expected exactly one of body and node_set",
+                );
+            }
+        }
+    }
+    fixed_nodes.sort_unstable();
+    fixed_nodes.dedup();
+
+    let bodies = spec
+        .rigid_bodies
+        .iter()
+        .zip(&body_fixed)
+        .enumerate()
+        .map(|(i, (b, fixed))| rigid_body::<D>(i, b, fixed))
+        .collect::<Result<Vec<_>, _>>()?;
+
+    let ties = spec
+        .ties
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            Ok(Tie {
+                body: body_of(&format!("ties[{i}].body"), &t.body)?,
+                nodes: node_set(&format!("ties[{i}].node_set"), &t.node_set)?.clone(),
+            })
+        })
+        .collect::<Result<Vec<_>, SpecError>>()?;
+
+    let pressures = spec
+        .loads
+        .iter()
+        .enumerate()
+        .map(|(i, load)| match load {
+            LoadSpec::Pressure { surface, pressure } => {
+                if !pressure.is_finite() {
+                    return fail(
+                        format!("loads[{i}].pressure"),
+                        format!("expected a finite value, got {pressure}"),
+                    );
+                }
+                let faces = mesh.surfaces.get(surface).ok_or_else(|| SpecError {
+                    field: format!("loads[{i}].surface"),
+                    message: format!("no surface named '{surface}' in part '{}'", spec.part.name),
+                })?;
+                Ok(PressureLoad {
+                    faces: faces.clone(),
+                    pressure: *pressure,
+                })
+            }
+        })
+        .collect::<Result<Vec<_>, SpecError>>()?;
+
+    let mut pair_names = BTreeSet::new();
+    let mut contacts = Vec::with_capacity(spec.contact.len());
+    for (i, pair) in spec.contact.iter().enumerate() {
+        let f = |name: &str| format!("contact[{i}].{name}");
+        if pair.name.is_empty() || !pair_names.insert(pair.name.as_str()) {
+            return fail(
+                f("name"),
+                format!("expected a unique non-empty name, got '{}'", pair.name),
+            );
+        }
+        non_negative(&f("mu"), pair.mu)?;
+        let body = body_of(&f("master"), &pair.master)?;
+        let Some(surface_spec) = &spec.rigid_bodies[body].surface else {
+            return fail(
+                f("master"),
+                format!("rigid body '{}' has no surface", pair.master),
+            );
+        };
+        let surface = rigid_surface::<D>(&format!("rigid_bodies[{body}].surface"), surface_spec)?;
+        let nodes = match &pair.slave {
+            SlaveSpec::NodeSet { name } => node_set(&f("slave.name"), name)?.clone(),
+            SlaveSpec::General { search_distance } => {
+                positive(&f("slave.search_distance"), *search_distance)?;
+                let origin = bodies[body].reference_point;
+                nodes_near(&mesh, surface.as_ref(), &origin, *search_distance)
+            }
+        };
+        contacts.push(ContactPair {
+            name: pair.name.clone(),
+            nodes,
+            body,
+            surface,
+            mu: pair.mu,
+        });
+    }
+
+    let steps = spec
+        .steps
+        .iter()
+        .enumerate()
+        .map(|(i, s)| step::<D>(i, s, &body_of))
+        .collect::<Result<Vec<_>, _>>()?;
+    if steps.is_empty() {
+        return fail("steps", "expected at least one step");
+    }
+    let settings = solver_settings(&spec.solver, section.quasi_static)?;
+    if let Some(interval) = spec.output.field_interval {
+        positive("output.field_interval", interval)?;
+    }
+
+    let part = SolidPart {
+        mesh,
+        material: Box::new(material),
+        density: section.density,
+        thickness: section.thickness,
+        hourglass_scale: section.hourglass_scale,
+        quasi_static: section.quasi_static,
+        fixed: fixed_nodes,
+    };
+    let model = Model::new(part, bodies, ties, pressures, contacts).map_err(|e| SpecError {
+        field: "(model)".into(),
+        message: e.to_string(),
+    })?;
+    Ok(Scene {
+        model,
+        steps,
+        settings,
+    })
+}
+
+/// The part's mesh: nodes, elements of every block, sorted node sets, checked surfaces.
+fn part_mesh<const D: usize>(spec: &ModelSpec) -> Result<SolidMesh<D>, SpecError> {
+    let part = &spec.part;
+    let nodes = part
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(i, p)| finite_point::<D>(&format!("part.nodes[{i}]"), p))
+        .collect::<Result<Vec<_>, _>>()?;
+    if nodes.is_empty() {
+        return fail("part.nodes", "expected at least one node");
+    }
+    let corners = 1 << D;
+    let mut elements = Vec::new();
+    for (b, block) in part.elements.iter().enumerate() {
+        if block.kind.dimension() != D {
+            return fail(
+                format!("part.elements[{b}].type"),
+                format!("expected a {D}D element type, got {:?}", block.kind),
+            );
+        }
+        for (e, conn) in block.connectivity.iter().enumerate() {
+            let field = || format!("part.elements[{b}].connectivity[{e}]");
+            if conn.len() != corners {
+                return fail(
+                    field(),
+                    format!("expected {corners} nodes, got {}", conn.len()),
+                );
+            }
+            if let Some(n) = conn.iter().find(|&&n| n >= nodes.len()) {
+                return fail(
+                    field(),
+                    format!("node {n} does not exist ({} nodes)", nodes.len()),
+                );
+            }
+            elements.push(conn.clone());
+        }
+    }
+    if elements.is_empty() {
+        return fail("part.elements", "expected at least one element");
+    }
+    let mut node_sets = BTreeMap::new();
+    for (name, set) in &part.node_sets {
+        if let Some(n) = set.iter().find(|&&n| n >= nodes.len()) {
+            return fail(
+                format!("part.node_sets.{name}"),
+                format!("node {n} does not exist ({} nodes)", nodes.len()),
+            );
+        }
+        let mut set = set.clone();
+        set.sort_unstable();
+        set.dedup();
+        node_sets.insert(name.clone(), set);
+    }
+    let faces = element_faces::<D>(&elements);
+    let mut surfaces = BTreeMap::new();
+    for (name, list) in &part.surfaces {
+        if list.is_empty() {
+            return fail(
+                format!("part.surfaces.{name}"),
+                "expected at least one face",
+            );
+        }
+        for (i, face) in list.iter().enumerate() {
+            check_face(&format!("part.surfaces.{name}[{i}]"), face, &faces)?;
+        }
+        surfaces.insert(name.clone(), list.clone());
+    }
+    Ok(SolidMesh {
+        nodes,
+        elements,
+        node_sets,
+        surfaces,
+    })
+}
+
+/// Every element face with its outward corner order, keyed by its sorted corner nodes.
+fn element_faces<const D: usize>(elements: &[Vec<usize>]) -> BTreeMap<Vec<usize>, Vec<Vec<usize>>> {
+    let mut faces: BTreeMap<Vec<usize>, Vec<Vec<usize>>> = BTreeMap::new();
+    for conn in elements {
+        for axis in 0..D {
+            for upper in [false, true] {
+                let local = face_corners::<D>(axis, upper).unwrap_or(&[]);
+                let face: Vec<usize> = local.iter().map(|&c| conn[c]).collect();
+                let mut key = face.clone();
+                key.sort_unstable();
+                faces.entry(key).or_default().push(face);
+            }
+        }
+    }
+    faces
+}
+
+/// `Ok` if `face` is an element face listed in its outward order (in 3D up to a cyclic shift;
+/// a 2D edge reversed points inward).
+fn check_face(
+    field: &str,
+    face: &[usize],
+    faces: &BTreeMap<Vec<usize>, Vec<Vec<usize>>>,
+) -> Result<(), SpecError> {
+    let mut key = face.to_vec();
+    key.sort_unstable();
+    let Some(candidates) = faces.get(&key) else {
+        return fail(
+            field,
+            format!("nodes {face:?} are not a face of any element"),
+        );
+    };
+    let shifts = if face.len() > 2 { face.len() } else { 1 };
+    let same_cycle = |a: &[usize], b: &[usize]| {
+        (0..shifts).any(|shift| (0..a.len()).all(|k| a[(k + shift) % a.len()] == b[k]))
+    };
+    if candidates.iter().any(|c| same_cycle(c, face)) {
+        Ok(())
+    } else {
+        fail(
+            field,
+            format!(
+                "face {face:?} points into its element: list its nodes as {:?}",
+                candidates[0]
+            ),
+        )
+    }
+}
+
+/// Rejects degrees of freedom that do not exist in dimension `D`.
+fn check_dofs<const D: usize>(field: &str, dofs: &[Dof]) -> Result<(), SpecError> {
+    if dofs.is_empty() {
+        return fail(field, "expected at least one degree of freedom");
+    }
+    match dofs.iter().find(|d| !Dof::all(D).contains(d)) {
+        Some(d) => fail(field, format!("{d:?} is not a degree of freedom in {D}D")),
+        None => Ok(()),
+    }
+}
+
+fn body_names(spec: &ModelSpec) -> Result<BTreeMap<&str, usize>, SpecError> {
+    let mut index = BTreeMap::new();
+    for (i, b) in spec.rigid_bodies.iter().enumerate() {
+        if b.name.is_empty() || index.insert(b.name.as_str(), i).is_some() {
+            return fail(
+                format!("rigid_bodies[{i}].name"),
+                format!("expected a unique non-empty name, got '{}'", b.name),
+            );
+        }
+    }
+    Ok(index)
+}
+
+/// A rigid body whose motions are those `fixed` leaves free; at most one rotation may be free.
+fn rigid_body<const D: usize>(
+    i: usize,
+    b: &super::spec::RigidBodySpec,
+    fixed: &BTreeSet<Dof>,
+) -> Result<RigidBody<D>, SpecError> {
+    let f = |name: &str| format!("rigid_bodies[{i}].{name}");
+    let reference_point = finite_point::<D>(&f("reference_point"), &b.reference_point)?;
+    non_negative(&f("mass"), b.mass)?;
+    non_negative(&f("rotary_inertia"), b.rotary_inertia)?;
+    let free = |d: &Dof| !fixed.contains(d);
+    let free_translations: [bool; D] =
+        std::array::from_fn(|axis| [Dof::X, Dof::Y, Dof::Z][axis]).map(|d| free(&d));
+    let free_rotations: Vec<Dof> = Dof::all(D)
+        .iter()
+        .filter(|d| d.rotation_axis().is_some() && free(d))
+        .copied()
+        .collect();
+    let rotation_axis = match free_rotations.as_slice() {
+        [] => None,
+        [d] => {
+            let mut axis = Vector3::zeros();
+            axis[d.rotation_axis().unwrap_or(2)] = 1.0;
+            Some(axis)
+        }
+        several => {
+            return fail(
+                format!("rigid_bodies[{i}]"),
+                format!(
+                    "rigid body '{}' may rotate about {several:?}: a rigid body rotates about at \
+                     most one axis; fix the others with a boundary condition",
+                    b.name
+                ),
+            );
+        }
+    };
+    let initial_velocity = match &b.initial_velocity {
+        Some(v) => finite_point::<D>(&f("initial_velocity"), v)?,
+        None => SVector::zeros(),
+    };
+    if let Some(axis) = (0..D).find(|&a| !free_translations[a] && initial_velocity[a] != 0.0) {
+        return fail(
+            f("initial_velocity"),
+            format!("the translation along axis {axis} is fixed: expected 0 there"),
+        );
+    }
+    let w = vector3(
+        &f("initial_angular_velocity"),
+        b.initial_angular_velocity.unwrap_or([0.0; 3]),
+    )?;
+    let initial_angular_velocity = match rotation_axis {
+        Some(axis) if (w - axis * w.dot(&axis)).norm() == 0.0 => w.dot(&axis),
+        _ if w.norm() == 0.0 => 0.0,
+        _ => {
+            return fail(
+                f("initial_angular_velocity"),
+                format!(
+                    "expected a vector along the free rotation axis {rotation_axis:?}, got {w:?}"
+                ),
+            );
+        }
+    };
+    Ok(RigidBody {
+        name: b.name.clone(),
+        reference_point,
+        mass: b.mass,
+        rotary_inertia: b.rotary_inertia,
+        free_translations,
+        rotation_axis,
+        initial_velocity,
+        initial_angular_velocity,
+    })
+}
+
+/// The contact surface of a body, in its body frame.
+fn rigid_surface<const D: usize>(
+    field: &str,
+    spec: &RigidSurfaceSpec,
+) -> Result<Box<dyn RigidSurface>, SpecError> {
+    let invalid = |e: skid_contact::error::ContactError| SpecError {
+        field: field.into(),
+        message: e.to_string(),
+    };
+    Ok(match spec {
+        RigidSurfaceSpec::Cylinder { radius, axis } => {
+            positive(&format!("{field}.radius"), *radius)?;
+            let axis = vector3(&format!("{field}.axis"), *axis)?;
+            Box::new(AnalyticCylinder::new(*radius, axis).map_err(invalid)?)
+        }
+        RigidSurfaceSpec::Plane { normal, tangent } => Box::new(
+            RigidPlane::new(
+                vector3(&format!("{field}.normal"), *normal)?,
+                vector3(&format!("{field}.tangent"), *tangent)?,
+            )
+            .map_err(invalid)?,
+        ),
+        RigidSurfaceSpec::FacetedCylinder {
+            radius,
+            axis,
+            facets,
+            phase,
+        } => {
+            positive(&format!("{field}.radius"), *radius)?;
+            if !phase.is_finite() {
+                return fail(
+                    format!("{field}.phase"),
+                    format!("expected a finite angle, got {phase}"),
+                );
+            }
+            let axis = vector3(&format!("{field}.axis"), *axis)?;
+            Box::new(FacetedCylinder::new(*radius, axis, *facets, *phase).map_err(invalid)?)
+        }
+        RigidSurfaceSpec::Triangles {
+            vertices,
+            triangles,
+            chart_radius,
+            chart_axis,
+        } => {
+            if D != 3 {
+                return fail(field, "triangles are a 3D surface");
+            }
+            positive(&format!("{field}.chart_radius"), *chart_radius)?;
+            let vertices = vertices.iter().map(|v| Vector3::from(*v)).collect();
+            let chart = CylinderChart {
+                radius: *chart_radius,
+                axis: vector3(&format!("{field}.chart_axis"), *chart_axis)?,
+            };
+            Box::new(TriangulatedSurface::new(vertices, triangles.clone(), chart).map_err(invalid)?)
+        }
+    })
+}
+
+/// General contact: the nodes of every surface of the part whose distance to `surface` (carried
+/// by a body whose reference node is at `origin`) is below `search_distance` in the initial
+/// configuration, sorted.
+fn nodes_near<const D: usize>(
+    mesh: &SolidMesh<D>,
+    surface: &dyn RigidSurface,
+    origin: &SVector<f64, D>,
+    search_distance: f64,
+) -> Vec<usize> {
+    let mut nodes: Vec<usize> = mesh
+        .surfaces
+        .values()
+        .flat_map(|faces| faces.iter().flatten().copied())
+        .filter(|&n| {
+            surface
+                .project(&embed(&(mesh.nodes[n] - origin)))
+                .is_some_and(|p| p.gap < search_distance)
+        })
+        .collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
+}
+
+fn step<const D: usize>(
+    i: usize,
+    spec: &ModelStepSpec,
+    body_of: &impl Fn(&str, &str) -> Result<usize, SpecError>,
+) -> Result<Step, SpecError> {
+    let f = |name: &str| format!("steps[{i}].{name}");
+    let (name, boundary) = match spec {
+        ModelStepSpec::Static { name, boundary, .. }
+        | ModelStepSpec::Dynamic { name, boundary, .. } => (name, boundary),
+    };
+    if name.is_empty() {
+        return fail(f("name"), "expected a non-empty name");
+    }
+    let held = held_motions::<D>(&f("boundary"), boundary, body_of)?;
+    let kind = match spec {
+        ModelStepSpec::Static {
+            increments,
+            regularization_time,
+            ..
+        } => {
+            if *increments == 0 {
+                return fail(f("increments"), "expected at least 1");
+            }
+            positive(&f("regularization_time"), *regularization_time)?;
+            StepKind::Static {
+                increments: *increments,
+                regularization_time: *regularization_time,
+            }
+        }
+        ModelStepSpec::Dynamic {
+            duration,
+            dt,
+            alpha,
+            adaptive,
+            ..
+        } => {
+            check_dynamic_timing(*duration, *dt, *alpha, adaptive.as_ref()).map_err(
+                |(field, message)| SpecError {
+                    field: f(&field),
+                    message,
+                },
+            )?;
+            StepKind::Dynamic {
+                duration: *duration,
+                dt: *dt,
+                alpha: *alpha,
+                adaptive: adaptive.map(|a| Adaptive {
+                    tolerance: a.tolerance,
+                    min_dt: a.min_dt,
+                    max_dt: a.max_dt,
+                }),
+            }
+        }
+    };
+    Ok(Step {
+        name: name.clone(),
+        kind,
+        held,
+    })
+}
+
+/// Checks a dynamic step's timing: `0 < dt <= duration`, an admissible HHT `alpha`, and for
+/// adaptive increments `min_dt <= dt <= max_dt <= duration` with a positive tolerance.
+///
+/// # Errors
+/// The first problem as (field name within the step, what was expected).
+pub fn check_dynamic_timing(
+    duration: f64,
+    dt: f64,
+    alpha: f64,
+    adaptive: Option<&AdaptiveSpec>,
+) -> Result<(), (String, String)> {
+    let positive = |field: &str, v: f64| positive(field, v).map_err(|e| (e.field, e.message));
+    positive("duration", duration)?;
+    positive("dt", dt)?;
+    if dt > duration {
+        return Err(("dt".into(), format!("expected dt <= duration ({duration})")));
+    }
+    if let Some(a) = adaptive {
+        positive("adaptive.tolerance", a.tolerance)?;
+        positive("adaptive.min_dt", a.min_dt)?;
+        positive("adaptive.max_dt", a.max_dt)?;
+        if a.min_dt > dt {
+            return Err((
+                "adaptive.min_dt".into(),
+                format!("expected min_dt <= dt ({dt})"),
+            ));
+        }
+        if a.max_dt < dt || a.max_dt > duration {
+            return Err((
+                "adaptive.max_dt".into(),
+                format!("expected dt ({dt}) <= max_dt <= duration ({duration})"),
+            ));
+        }
+    }
+    // The integrator owns the admissible range; its message names it.
+    skid_integrator::hht::Hht::new(alpha).map_err(|message| ("alpha".to_string(), message))?;
+    Ok(())
+}
+
+fn held_motions<const D: usize>(
+    field: &str,
+    boundary: &[StepBoundarySpec],
+    body_of: &impl Fn(&str, &str) -> Result<usize, SpecError>,
+) -> Result<Vec<HeldMotion>, SpecError> {
+    let mut held = Vec::new();
+    for (k, bc) in boundary.iter().enumerate() {
+        let body = body_of(&format!("{field}[{k}].body"), &bc.body)?;
+        let Some(dofs) = &bc.dofs else {
+            held.push(HeldMotion::body(body));
+            continue;
+        };
+        check_dofs::<D>(&format!("{field}[{k}].dofs"), dofs)?;
+        for dof in dofs {
+            let motion = match (dof.translation_axis(), dof.rotation_axis()) {
+                (Some(axis), _) => BodyMotion::Translation(axis),
+                // a body has one rotation equation; holding any rotation holds it
+                _ => BodyMotion::Rotation,
+            };
+            held.push(HeldMotion {
+                body,
+                motion: Some(motion),
+            });
+        }
+    }
+    Ok(held)
+}
+
+/// Solver settings; `auto` takes the global contact solve for a quasi-static part (the
+/// reduced one needs its stiffness inverse, singular without contact) and the reduced one
+/// otherwise; the conic Coulomb method works on the reduced operator only.
+fn solver_settings(s: &SolverSpec, quasi_static: bool) -> Result<Settings, SpecError> {
+    if s.max_newton_iterations == 0 {
+        return fail("solver.max_newton_iterations", "expected at least 1");
+    }
+    positive("solver.force_tolerance", s.force_tolerance)?;
+    positive("solver.contact_tolerance", s.contact_tolerance)?;
+    positive("solver.coulomb_tolerance", s.coulomb_tolerance)?;
+    if s.max_fixed_point_iterations == 0 {
+        return fail("solver.max_fixed_point_iterations", "expected at least 1");
+    }
+    if !(s.cutback_factor > 0.0 && s.cutback_factor < 1.0) {
+        return fail(
+            "solver.cutback_factor",
+            format!("expected a value in (0, 1), got {}", s.cutback_factor),
+        );
+    }
+    Ok(Settings {
+        newton: NewtonSettings {
+            max_iterations: s.max_newton_iterations,
+            force_tolerance: s.force_tolerance,
+            contact_tolerance: s.contact_tolerance,
+        },
+        coulomb: skid_contact::coulomb::CoulombSettings {
+            tolerance: s.coulomb_tolerance,
+            max_fixed_point_iterations: s.max_fixed_point_iterations,
+            method: s.coulomb_method.into(),
+            ..Default::default()
+        },
+        contact_solve: match (s.contact_solve, s.coulomb_method) {
+            (_, CoulombMethodSpec::Conic) | (ContactSolveSpec::Reduced, _) => ContactSolve::Reduced,
+            (ContactSolveSpec::Auto, _) if !quasi_static => ContactSolve::Reduced,
+            _ => ContactSolve::Global,
+        },
+        cutback: CutbackSettings {
+            factor: s.cutback_factor,
+            max_cutbacks: s.max_cutbacks,
+            ..Default::default()
+        },
+    })
+}

@@ -1,0 +1,280 @@
+//! The history of any model: one CSV row per converged increment with every rigid body's free
+//! motions, every contact pair's resultants and the energy ledger.
+//!
+//! Columns, in order: `time`, `step`, `increment`, `load_factor`, `dt`, `newton_iterations`,
+//! `contact_solves`; for each rigid body `B` (model order) `B.u_x`, `B.v_x` (displacement and
+//! velocity of the reference node, likewise `y`, `z`) for each free translation and `B.angle`,
+//! `B.omega` if it rotates; for each contact pair `P`:
+//! `P.normal_force` (sum of the normal forces, N), `P.tangential_force_1` (and `_2` in 3D: sums
+//! of the friction force components along the master surface's coordinate directions, N),
+//! `P.active`, `P.sliding` (closed contacts, and those at the cone's boundary), `P.max_penetration`
+//! (m); then `kinetic_energy`, `strain_energy`, `hourglass_energy`, `external_work`,
+//! `friction_dissipation`, `normal_work` (J). Numbers carry 10 significant digits. The file is
+//! complete or absent ([`PartialCsv`]).
+
+use std::path::Path;
+
+use skid_integrator::state::EnergyLedger;
+use skid_integrator::stepper::{IncrementReport, Observer};
+use skid_integrator::{Model, State};
+
+use crate::csv_out::PartialCsv;
+
+/// File name of the history.
+pub const HISTORY_CSV: &str = "history.csv";
+
+/// A contact is counted as sliding when its friction force reaches `mu N` to this relative
+/// tolerance.
+const SLIDING_TOLERANCE: f64 = 1e-6;
+
+/// Resultants of one contact pair in one state.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PairTotals {
+    /// Sum of the normal forces, N.
+    pub normal_force: f64,
+    /// Sums of the friction force components along the surface coordinates, N.
+    pub tangential_force: [f64; 2],
+    /// Closed contacts.
+    pub active: usize,
+    /// Closed contacts whose friction force is at the cone's boundary (`|t| >= mu N`).
+    pub sliding: usize,
+    /// Deepest penetration, m (0 if none).
+    pub max_penetration: f64,
+    /// Largest gap at a sliding contact, m.
+    pub max_sliding_separation: f64,
+}
+
+/// Resultants of every contact pair of `model` in `state`.
+pub fn pair_totals<const D: usize>(model: &Model<D>, state: &State) -> Vec<PairTotals> {
+    let mut totals = vec![PairTotals::default(); model.contacts().len()];
+    for c in &state.contacts {
+        let t = &mut totals[c.pair];
+        t.max_penetration = t.max_penetration.max(-c.gap);
+        if !c.is_closed() {
+            continue;
+        }
+        t.active += 1;
+        t.normal_force += c.normal_force;
+        t.tangential_force[0] += c.tangential_force[0];
+        t.tangential_force[1] += c.tangential_force[1];
+        let mu = model.contacts()[c.pair].mu;
+        if mu > 0.0 && c.tangential_force.norm() >= mu * c.normal_force * (1.0 - SLIDING_TOLERANCE)
+        {
+            t.sliding += 1;
+            t.max_sliding_separation = t.max_sliding_separation.max(c.gap);
+        }
+    }
+    totals
+}
+
+/// The column names of a model's history.
+pub fn columns<const D: usize>(model: &Model<D>) -> Vec<String> {
+    let mut names: Vec<String> = [
+        "time",
+        "step",
+        "increment",
+        "load_factor",
+        "dt",
+        "newton_iterations",
+        "contact_solves",
+    ]
+    .map(String::from)
+    .to_vec();
+    let dofs = model.dofs();
+    for (b, body) in model.bodies().iter().enumerate() {
+        for (axis, eq) in dofs.body_translation(b).iter().enumerate() {
+            if eq.is_some() {
+                let axis = ["x", "y", "z"][axis];
+                names.push(format!("{}.u_{axis}", body.name));
+                names.push(format!("{}.v_{axis}", body.name));
+            }
+        }
+        if dofs.body_rotation(b).is_some() {
+            names.push(format!("{}.angle", body.name));
+            names.push(format!("{}.omega", body.name));
+        }
+    }
+    for pair in model.contacts() {
+        names.push(format!("{}.normal_force", pair.name));
+        for k in 1..D {
+            names.push(format!("{}.tangential_force_{k}", pair.name));
+        }
+        for what in ["active", "sliding", "max_penetration"] {
+            names.push(format!("{}.{what}", pair.name));
+        }
+    }
+    names.extend(
+        [
+            "kinetic_energy",
+            "strain_energy",
+            "hourglass_energy",
+            "external_work",
+            "friction_dissipation",
+            "normal_work",
+        ]
+        .map(String::from),
+    );
+    names
+}
+
+/// A rigid body's motion in one state.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct BodyState {
+    /// Body name.
+    pub name: String,
+    /// Displacement of the reference node, m.
+    pub displacement: Vec<f64>,
+    /// Velocity of the reference node, m/s.
+    pub velocity: Vec<f64>,
+    /// Rotation angle about the free axis, rad (0 if it cannot rotate).
+    pub angle: f64,
+    /// Angular velocity about the free axis, rad/s.
+    pub omega: f64,
+}
+
+/// The motions of every rigid body of `model` in `state`.
+pub fn body_states<const D: usize>(model: &Model<D>, state: &State) -> Vec<BodyState> {
+    let dofs = model.dofs();
+    model
+        .bodies()
+        .iter()
+        .enumerate()
+        .map(|(b, body)| BodyState {
+            name: body.name.clone(),
+            displacement: dofs
+                .body_displacement(&state.x, b)
+                .iter()
+                .copied()
+                .collect(),
+            velocity: dofs
+                .body_displacement(&state.v, b)
+                .iter()
+                .copied()
+                .collect(),
+            angle: dofs.body_angle(&state.x, b),
+            omega: dofs.body_angle(&state.v, b),
+        })
+        .collect()
+}
+
+/// What a run's summary needs of its history.
+#[derive(Clone, Debug, Default)]
+pub struct RunRecord {
+    /// Time of the last converged state, s.
+    pub final_time: f64,
+    /// Motions of every rigid body in the last converged state.
+    pub final_bodies: Vec<BodyState>,
+    /// Pair resultants of the last converged state.
+    pub final_pairs: Vec<PairTotals>,
+    /// Energy ledger of the first recorded state (the initial one).
+    pub first_energy: Option<EnergyLedger>,
+    /// Energy ledger of the last converged state.
+    pub last_energy: Option<EnergyLedger>,
+    /// Largest of the kinetic + strain + hourglass energy, |external work|, |normal work| and
+    /// the frictional dissipation over the run, J: the scale of the energy balance.
+    pub energy_scale: f64,
+    /// Deepest penetration over the run, m.
+    pub max_penetration: f64,
+    /// Largest gap at a sliding contact over the run, m.
+    pub max_sliding_separation: f64,
+}
+
+/// Observer writing a model's `history.csv` and keeping its [`RunRecord`].
+pub struct ModelRecorder {
+    csv: PartialCsv,
+    record: RunRecord,
+}
+
+impl ModelRecorder {
+    /// Creates `dir/history.csv.partial` with the header for `model`.
+    ///
+    /// # Errors
+    /// I/O errors.
+    pub fn create<const D: usize>(dir: &Path, model: &Model<D>) -> std::io::Result<Self> {
+        let columns = columns(model);
+        let names: Vec<&str> = columns.iter().map(String::as_str).collect();
+        Ok(Self {
+            csv: PartialCsv::create(&dir.join(HISTORY_CSV), &names)?,
+            record: RunRecord::default(),
+        })
+    }
+
+    /// Flushes and renames the file to `history.csv`.
+    ///
+    /// # Errors
+    /// I/O errors.
+    pub fn finish(self) -> std::io::Result<RunRecord> {
+        self.csv.finish()?;
+        Ok(self.record)
+    }
+}
+
+impl<const D: usize> Observer<D> for ModelRecorder {
+    fn on_increment(
+        &mut self,
+        model: &Model<D>,
+        report: &IncrementReport<'_>,
+    ) -> std::io::Result<()> {
+        let s = report.state;
+        let number = |v: f64| format!("{v:.9e}");
+        let mut row = vec![
+            number(s.time),
+            report.step.to_string(),
+            report.increment.to_string(),
+            format!("{:.6}", s.load_factor),
+            format!("{:.6e}", report.size),
+            report.counters.newton_iterations.to_string(),
+            report.counters.contact_solves.to_string(),
+        ];
+        let dofs = model.dofs();
+        for b in 0..model.bodies().len() {
+            for &eq in dofs.body_translation(b).iter().flatten() {
+                row.push(number(s.x[eq]));
+                row.push(number(s.v[eq]));
+            }
+            if let Some(eq) = dofs.body_rotation(b) {
+                row.push(number(s.x[eq]));
+                row.push(number(s.v[eq]));
+            }
+        }
+        let totals = pair_totals(model, s);
+        let record = &mut self.record;
+        for t in &totals {
+            row.push(number(t.normal_force));
+            row.extend(t.tangential_force[..D - 1].iter().map(|&f| number(f)));
+            row.push(t.active.to_string());
+            row.push(t.sliding.to_string());
+            row.push(format!("{:.3e}", t.max_penetration.max(0.0)));
+            record.max_penetration = record.max_penetration.max(t.max_penetration);
+            record.max_sliding_separation =
+                record.max_sliding_separation.max(t.max_sliding_separation);
+        }
+        let e = &s.energy;
+        row.extend(
+            [
+                e.kinetic,
+                e.strain,
+                e.hourglass,
+                e.external_work,
+                e.friction_dissipation,
+                e.normal_work,
+            ]
+            .map(number),
+        );
+        self.csv.record(row)?;
+        record.energy_scale = [
+            e.kinetic + e.strain + e.hourglass,
+            e.external_work.abs(),
+            e.normal_work.abs(),
+            e.friction_dissipation,
+        ]
+        .into_iter()
+        .fold(record.energy_scale, f64::max);
+        record.first_energy.get_or_insert_with(|| e.clone());
+        record.last_energy = Some(e.clone());
+        record.final_pairs = totals;
+        record.final_bodies = body_states(model, s);
+        record.final_time = s.time;
+        Ok(())
+    }
+}

@@ -1,0 +1,382 @@
+//! The model-file format: one JSON document, the serialization of [`ModelSpec`].
+//!
+//! Nodes and elements are numbered from 0 in the order they are listed; node sets and surfaces
+//! refer to those numbers, and everything else refers to sets, surfaces and bodies by name.
+//! Element corners follow the Abaqus order, which is also the solver's cell order: CPE4R
+//! counter-clockwise; C3D8R four corners of one face, counter-clockwise seen from the opposite
+//! face, then the opposite face's corners in the same order.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::schema::{
+    AdaptiveSpec, MaterialSpec, OutputSpec, SolverSpec, default_alpha, default_regularization_time,
+};
+
+/// Format version a model file must declare in `skid_model`.
+pub const MODEL_FORMAT_VERSION: u32 = 1;
+
+/// A whole scene: one deformable part, rigid bodies, constraints, loads, contact, steps.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    /// Format version, [`MODEL_FORMAT_VERSION`]; its presence marks the file as a model file.
+    pub skid_model: u32,
+    /// Name of the model (default output directory `out/<name>`).
+    pub name: String,
+    /// Free text.
+    #[serde(default)]
+    pub description: String,
+    /// 2 (plane strain) or 3.
+    pub dimension: usize,
+    /// The deformable part.
+    pub part: PartSpec,
+    /// Rigid bodies; each moves in all its degrees of freedom unless `boundary` fixes some.
+    #[serde(default)]
+    pub rigid_bodies: Vec<RigidBodySpec>,
+    /// Boundary conditions held throughout the analysis.
+    #[serde(default)]
+    pub boundary: Vec<BoundarySpec>,
+    /// Node sets tied to rigid bodies.
+    #[serde(default)]
+    pub ties: Vec<TieSpec>,
+    /// Loads, ramped from 0 to full value over the first static step (full value in dynamic
+    /// steps).
+    #[serde(default)]
+    pub loads: Vec<LoadSpec>,
+    /// Contact pairs: nodes of the part against the surface of a rigid body.
+    #[serde(default)]
+    pub contact: Vec<ContactPairSpec>,
+    /// Analysis steps, run in order.
+    pub steps: Vec<ModelStepSpec>,
+    /// Solver settings; every field is optional.
+    #[serde(default)]
+    pub solver: SolverSpec,
+    /// Output settings; every field is optional.
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+/// The deformable part: a mesh of one-point elements with one section.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PartSpec {
+    /// Name used in messages.
+    pub name: String,
+    /// Reference coordinates of the nodes, `dimension` numbers each, m.
+    pub nodes: Vec<Vec<f64>>,
+    /// Element blocks, each of one type; elements are numbered across blocks in order.
+    pub elements: Vec<ElementBlockSpec>,
+    /// Named node sets (node numbers).
+    #[serde(default)]
+    pub node_sets: BTreeMap<String, Vec<usize>>,
+    /// Named surfaces: element faces given by their corner nodes, ordered so that the face's
+    /// normal points out of its element (2D: the outward normal is the edge direction turned
+    /// clockwise; 3D: counter-clockwise seen from outside).
+    #[serde(default)]
+    pub surfaces: BTreeMap<String, Vec<Vec<usize>>>,
+    /// Material and section of every element.
+    pub section: SectionSpec,
+}
+
+/// Element types of a deformable part.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+pub enum ElementType {
+    /// 4-node plane-strain quadrilateral, one-point integration with hourglass control (2D).
+    #[serde(rename = "CPE4R")]
+    Cpe4r,
+    /// 8-node hexahedron, one-point integration with hourglass control (3D).
+    #[serde(rename = "C3D8R")]
+    C3d8r,
+}
+
+impl ElementType {
+    /// Dimension the element lives in.
+    pub fn dimension(self) -> usize {
+        match self {
+            Self::Cpe4r => 2,
+            Self::C3d8r => 3,
+        }
+    }
+
+    /// The element type of a part's solid elements in dimension `dim`.
+    pub fn solid(dim: usize) -> Self {
+        if dim == 2 { Self::Cpe4r } else { Self::C3d8r }
+    }
+}
+
+/// Elements of one type.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ElementBlockSpec {
+    /// Element type.
+    #[serde(rename = "type")]
+    pub kind: ElementType,
+    /// Corner nodes of each element.
+    pub connectivity: Vec<Vec<usize>>,
+}
+
+/// The section of a part: its material and what the element formulation needs.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SectionSpec {
+    /// Hyperelastic material.
+    pub material: MaterialSpec,
+    /// Mass density, kg/m^3.
+    pub density: f64,
+    /// Out-of-plane thickness in 2D, m (must be 1 in 3D).
+    #[serde(default = "one")]
+    pub thickness: f64,
+    /// Factor on the hourglass stabilisation stiffness.
+    #[serde(default = "one")]
+    pub hourglass_scale: f64,
+    /// No inertia: in dynamic steps the part is in equilibrium with the mean contact forces of
+    /// each increment; rigid bodies tied to it must then be massless.
+    #[serde(default)]
+    pub quasi_static: bool,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// A rigid body: a reference node with a point mass and a rotary inertia, and optionally a
+/// contact surface described in its body frame (origin at the reference node).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RigidBodySpec {
+    /// Name (boundary conditions, ties and contact pairs refer to it).
+    pub name: String,
+    /// Reference node, `dimension` coordinates, m.
+    pub reference_point: Vec<f64>,
+    /// Point mass, kg.
+    #[serde(default)]
+    pub mass: f64,
+    /// Rotary inertia about the free rotation axis, kg m^2.
+    #[serde(default)]
+    pub rotary_inertia: f64,
+    /// Contact surface, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface: Option<RigidSurfaceSpec>,
+    /// Initial velocity of the reference node, `dimension` components, m/s (absent: 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_velocity: Option<Vec<f64>>,
+    /// Initial angular velocity vector `[wx, wy, wz]`, rad/s (absent: 0); it must lie along the
+    /// body's free rotation axis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_angular_velocity: Option<[f64; 3]>,
+}
+
+/// Rigid surfaces, in the body frame.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum RigidSurfaceSpec {
+    /// The cylinder `|y - (e.y) e| = radius` about the axis `e` through the origin (in 2D the
+    /// circle, `e = +z`).
+    Cylinder {
+        /// Radius, m.
+        radius: f64,
+        /// Axis direction.
+        axis: [f64; 3],
+    },
+    /// The plane (2D: line) through the origin with outward `normal`; `tangent` gives the
+    /// first in-plane direction of its surface coordinates.
+    Plane {
+        /// Outward normal.
+        normal: [f64; 3],
+        /// First in-plane direction.
+        tangent: [f64; 3],
+    },
+    /// A regular polygon of `facets` sides inscribed in the circle of `radius`, extruded along
+    /// `axis` (2D: the polygon of rigid lines); vertex `k` at the angle `phase + 2 pi k /
+    /// facets` from the cylinder's reference direction (+x for the axis +z).
+    FacetedCylinder {
+        /// Circumscribed radius, m.
+        radius: f64,
+        /// Axis direction.
+        axis: [f64; 3],
+        /// Number of facets (>= 3).
+        facets: usize,
+        /// Angle of the first vertex, rad.
+        phase: f64,
+    },
+    /// Triangles (3D), counter-clockwise seen from outside, with surface coordinates from a
+    /// cylinder chart (arc length about `chart_axis` at `chart_radius`, axial position).
+    Triangles {
+        /// Vertices, m.
+        vertices: Vec<[f64; 3]>,
+        /// Vertex numbers of each triangle.
+        triangles: Vec<[usize; 3]>,
+        /// Radius of the chart cylinder, m.
+        chart_radius: f64,
+        /// Axis of the chart cylinder.
+        chart_axis: [f64; 3],
+    },
+}
+
+/// A degree of freedom: translations `x`, `y`, `z`, rotations `rx`, `ry`, `rz`.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, PartialOrd, Ord)]
+#[serde(rename_all = "lowercase")]
+pub enum Dof {
+    /// Translation along x.
+    X,
+    /// Translation along y.
+    Y,
+    /// Translation along z (3D).
+    Z,
+    /// Rotation about x (3D).
+    Rx,
+    /// Rotation about y (3D).
+    Ry,
+    /// Rotation about z.
+    Rz,
+}
+
+impl Dof {
+    /// Every degree of freedom of a rigid body in dimension `dim`.
+    pub fn all(dim: usize) -> &'static [Dof] {
+        if dim == 2 {
+            &[Dof::X, Dof::Y, Dof::Rz]
+        } else {
+            &[Dof::X, Dof::Y, Dof::Z, Dof::Rx, Dof::Ry, Dof::Rz]
+        }
+    }
+
+    /// Axis of a translation (`None` for a rotation).
+    pub fn translation_axis(self) -> Option<usize> {
+        match self {
+            Dof::X => Some(0),
+            Dof::Y => Some(1),
+            Dof::Z => Some(2),
+            _ => None,
+        }
+    }
+
+    /// Axis of a rotation (`None` for a translation).
+    pub fn rotation_axis(self) -> Option<usize> {
+        match self {
+            Dof::Rx => Some(0),
+            Dof::Ry => Some(1),
+            Dof::Rz => Some(2),
+            _ => None,
+        }
+    }
+}
+
+/// Degrees of freedom held at zero displacement: of a rigid body's reference node, or of the
+/// nodes of a node set (translations only).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BoundarySpec {
+    /// Rigid body whose reference node is held (exactly one of `body` and `node_set`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<String>,
+    /// Node set of the part whose nodes are held.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub node_set: Option<String>,
+    /// The degrees of freedom held.
+    pub dofs: Vec<Dof>,
+}
+
+/// Nodes that translate with a rigid body's reference node.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TieSpec {
+    /// Node set of the part.
+    pub node_set: String,
+    /// Rigid body.
+    pub body: String,
+}
+
+/// Loads.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LoadSpec {
+    /// A uniform follower pressure on a surface of the part (positive pushes into it), Pa.
+    Pressure {
+        /// Surface name.
+        surface: String,
+        /// Pressure, Pa.
+        pressure: f64,
+    },
+}
+
+/// Frictional contact between nodes of the part and a rigid body's surface.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ContactPairSpec {
+    /// Name used in outputs and messages.
+    pub name: String,
+    /// Which nodes are contact candidates.
+    pub slave: SlaveSpec,
+    /// Rigid body whose surface is the master.
+    pub master: String,
+    /// Coulomb friction coefficient.
+    pub mu: f64,
+}
+
+/// Contact candidates of a pair.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum SlaveSpec {
+    /// The nodes of a node set.
+    NodeSet {
+        /// Node set name.
+        name: String,
+    },
+    /// General contact: every node on a surface of the part whose initial distance to the
+    /// master surface is below `search_distance`.
+    General {
+        /// Search distance, m.
+        search_distance: f64,
+    },
+}
+
+/// One analysis step; `boundary` adds rigid-body conditions held during this step only.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ModelStepSpec {
+    /// Static equilibrium with loads ramped to full value.
+    Static {
+        /// Step name.
+        name: String,
+        /// Number of increments.
+        increments: usize,
+        /// Time scale of the Newton regularisation `M/h_s^2`, s.
+        #[serde(default = "default_regularization_time")]
+        regularization_time: f64,
+        /// Rigid-body degrees of freedom held during the step (absent `dofs`: all).
+        #[serde(default)]
+        boundary: Vec<StepBoundarySpec>,
+    },
+    /// HHT-alpha dynamics.
+    Dynamic {
+        /// Step name.
+        name: String,
+        /// Duration, s.
+        duration: f64,
+        /// Time increment (the first one if adaptive), s.
+        dt: f64,
+        /// HHT alpha in [-1/3, 0].
+        #[serde(default = "default_alpha")]
+        alpha: f64,
+        /// Rigid-body degrees of freedom held during the step.
+        #[serde(default)]
+        boundary: Vec<StepBoundarySpec>,
+        /// Error-controlled increments (absent: `dt` throughout).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        adaptive: Option<AdaptiveSpec>,
+    },
+}
+
+/// Degrees of freedom of a rigid body held at their value at the start of a step.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct StepBoundarySpec {
+    /// Rigid body.
+    pub body: String,
+    /// Degrees of freedom held (absent: every free one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dofs: Option<Vec<Dof>>,
+}

@@ -1,0 +1,172 @@
+//! The summary of a model-file run (`summary.json`): how it ended, the final motions and
+//! contact resultants, the energy balance, the contact accuracy and the cost.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+use skid_integrator::{Model, RunError, RunStatistics};
+
+use super::history::{BodyState, RunRecord};
+
+/// The cost of a run.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct RunCost {
+    /// Equations (unknowns) of the model.
+    pub equations: usize,
+    /// Contact candidates (slave nodes over all pairs).
+    pub contact_candidates: usize,
+    /// Converged increments.
+    pub increments: usize,
+    /// Newton iterations.
+    pub newton_iterations: usize,
+    /// Conic (clarabel) solves.
+    pub contact_solves: usize,
+    /// De Saxce fixed-point iterations.
+    pub fixed_point_iterations: usize,
+    /// Semismooth Newton steps of the contact solves.
+    pub contact_newton_steps: usize,
+    /// Increments the global contact solve did not converge and the reduced one solved.
+    pub contact_fallbacks: usize,
+    /// Failed attempts answered by a cutback.
+    pub cutbacks: usize,
+    /// Converged increments of adaptive steps taken again shorter for their local error.
+    pub error_rejections: usize,
+    /// The failed attempts by cause.
+    pub cutback_causes: BTreeMap<String, usize>,
+    /// Wall time of the run, s.
+    pub wall_time_s: f64,
+    /// Of which: element loop, loads and contact kinematics, s.
+    pub assembly_s: f64,
+    /// Of which: factorizations and solves, s.
+    pub linear_solve_s: f64,
+    /// Of which: conic solves, s.
+    pub contact_solve_s: f64,
+}
+
+impl From<&RunStatistics> for RunCost {
+    fn from(stats: &RunStatistics) -> Self {
+        Self {
+            equations: stats.equations,
+            contact_candidates: stats.contact_candidates,
+            increments: stats.increments,
+            newton_iterations: stats.newton_iterations,
+            contact_solves: stats.contact_solves,
+            fixed_point_iterations: stats.fixed_point_iterations,
+            contact_newton_steps: stats.contact_newton_steps,
+            contact_fallbacks: stats.contact_fallbacks,
+            cutbacks: stats.cutbacks,
+            error_rejections: stats.error_rejections,
+            cutback_causes: stats
+                .cutback_causes
+                .iter()
+                .map(|(&k, &n)| (k.to_string(), n))
+                .collect(),
+            wall_time_s: stats.wall_time.as_secs_f64(),
+            assembly_s: stats.timings.assembly.as_secs_f64(),
+            linear_solve_s: stats.timings.linear_solve.as_secs_f64(),
+            contact_solve_s: stats.timings.contact_solve.as_secs_f64(),
+        }
+    }
+}
+
+/// A contact pair's resultants in the final state.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PairSummary {
+    /// Pair name.
+    pub name: String,
+    /// Sum of the normal forces, N.
+    pub normal_force: f64,
+    /// Sums of the friction force components along the surface coordinates, N.
+    pub tangential_force: [f64; 2],
+    /// Closed contacts.
+    pub active: usize,
+    /// Closed contacts at the friction cone's boundary.
+    pub sliding: usize,
+}
+
+/// `summary.json` of a model-file run.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ModelSummary {
+    /// Model name.
+    pub model: String,
+    /// Spatial dimension.
+    pub dimension: usize,
+    /// `"completed"` or `"failed"`.
+    pub status: String,
+    /// Why the run stopped early, if it did.
+    pub error: Option<String>,
+    /// The kind of failure that stopped it, if it did ([`RunError::kind`]).
+    pub failure: Option<String>,
+    /// Time reached, s.
+    pub final_time: f64,
+    /// Rigid-body motions in the last converged state.
+    pub bodies: Vec<BodyState>,
+    /// Contact resultants in the last converged state.
+    pub pairs: Vec<PairSummary>,
+    /// Energy the run lost beyond friction, J: `-(dE - dW_ext - dW_N + D_friction)` between the
+    /// initial and the last state (`E` kinetic + strain + hourglass, `W_ext` the loads' work,
+    /// `W_N` the normal contact forces' work); positive for numerical dissipation.
+    pub energy_balance_residual_j: Option<f64>,
+    /// `|residual| / scale` with the scale the largest energy, work or dissipation of the run;
+    /// `None` if nothing in the run carries energy.
+    pub energy_balance_error: Option<f64>,
+    /// Deepest penetration over the run, m.
+    pub max_gap_violation_m: f64,
+    /// Largest gap at a contact carrying force while sliding, m.
+    pub max_sliding_separation_m: f64,
+    /// Cost of the run.
+    #[serde(flatten)]
+    pub cost: RunCost,
+}
+
+/// Summarizes a run of `model` (named `name`) from its history record and statistics; `error` is why it
+/// stopped early, if it did.
+pub fn summarize<const D: usize>(
+    name: &str,
+    model: &Model<D>,
+    record: &RunRecord,
+    stats: &RunStatistics,
+    error: Option<&RunError>,
+) -> ModelSummary {
+    let residual = match (&record.first_energy, &record.last_energy) {
+        (Some(a), Some(b)) => Some(
+            -((b.kinetic + b.strain + b.hourglass - (a.kinetic + a.strain + a.hourglass))
+                - (b.external_work - a.external_work)
+                - (b.normal_work - a.normal_work)
+                + (b.friction_dissipation - a.friction_dissipation)),
+        ),
+        _ => None,
+    };
+    let scale = record.energy_scale;
+    ModelSummary {
+        model: name.to_string(),
+        dimension: D,
+        status: if error.is_none() {
+            "completed"
+        } else {
+            "failed"
+        }
+        .into(),
+        error: error.map(ToString::to_string),
+        failure: error.map(|e| e.kind().to_string()),
+        final_time: record.final_time,
+        bodies: record.final_bodies.clone(),
+        pairs: model
+            .contacts()
+            .iter()
+            .zip(&record.final_pairs)
+            .map(|(pair, t)| PairSummary {
+                name: pair.name.clone(),
+                normal_force: t.normal_force,
+                tangential_force: t.tangential_force,
+                active: t.active,
+                sliding: t.sliding,
+            })
+            .collect(),
+        energy_balance_residual_j: residual,
+        energy_balance_error: residual.filter(|_| scale > 0.0).map(|r| r.abs() / scale),
+        max_gap_violation_m: record.max_penetration.max(0.0),
+        max_sliding_separation_m: record.max_sliding_separation,
+        cost: RunCost::from(stats),
+    }
+}
