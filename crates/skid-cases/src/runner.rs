@@ -1,6 +1,8 @@
 //! Runs one case: builds the scene, integrates it, writes `case.json` (the case as run, overrides
 //! applied), `history.csv`, `newton.csv`, `summary.json` and, if the case asks for it, the
-//! ParaView field output in `fields/`.
+//! ParaView field output in `fields/`. A model file runs the same way with its own outputs:
+//! `model.json` (the model as run), the generic `history.csv` and `summary.json` of
+//! [`crate::model_file`], and `newton.csv`.
 //!
 //! Each output is complete or absent: those of an earlier run in the directory are removed
 //! before the run, and each file appears under its name only when written whole
@@ -11,10 +13,15 @@ use std::path::{Path, PathBuf};
 use skid_integrator::Model;
 use skid_integrator::stepper::{IncrementReport, Observer, run};
 
+use serde::Serialize;
+
 use crate::atomic::write_atomic;
 use crate::drum::build;
 use crate::fields::{self, DrumOutline, FieldWriter};
 use crate::history::DrumRecorder;
+use crate::model_file::history::ModelRecorder;
+use crate::model_file::summary::{ModelSummary, summarize as summarize_model};
+use crate::model_file::{self, ModelSpec, is_model_file};
 use crate::newton::{NEWTON_CSV, NewtonRecorder};
 use crate::schema::Case;
 use crate::summary::{Summary, summarize};
@@ -22,6 +29,59 @@ use crate::validate::{CaseError, load_case};
 
 /// The case as run (overrides applied), written into the output directory.
 pub const CASE_JSON: &str = "case.json";
+/// The model as run (overrides applied), written into the output directory.
+pub const MODEL_JSON: &str = "model.json";
+
+/// The summary of a run of a case file or of a model file.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum RunSummary {
+    /// A drum case.
+    Case(Summary),
+    /// A model file.
+    Model(ModelSummary),
+}
+
+impl RunSummary {
+    /// Why the run stopped early, if it did.
+    pub fn error(&self) -> Option<&str> {
+        match self {
+            Self::Case(s) => s.error.as_deref(),
+            Self::Model(s) => s.error.as_deref(),
+        }
+    }
+}
+
+/// Runs a case file or a model file (one that declares `skid_model`) into `out_dir` (default
+/// `out/<name>`).
+///
+/// # Errors
+/// See [`run_case_file`].
+pub fn run_file(
+    path: &Path,
+    overrides: &[String],
+    out_dir: Option<&Path>,
+) -> Result<RunSummary, CaseError> {
+    let text = read(path)?;
+    if !declares_model(&text) {
+        return run_case_file(path, overrides, out_dir).map(RunSummary::Case);
+    }
+    let spec = model_file::parse_model(&text, path, overrides)?;
+    let dir = out_dir.map_or_else(|| Path::new("out").join(&spec.name), Path::to_path_buf);
+    run_model(&spec, path, &dir).map(RunSummary::Model)
+}
+
+fn read(path: &Path) -> Result<String, CaseError> {
+    std::fs::read_to_string(path).map_err(|source| CaseError::Read {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Whether JSON text is a model file; text that is not JSON is left to the parser to report.
+fn declares_model(text: &str) -> bool {
+    serde_json::from_str::<serde_json::Value>(text).is_ok_and(|v| is_model_file(&v))
+}
 
 /// Default output directory of a case: `out/<case name>`.
 pub fn default_output_dir(case: &Case) -> PathBuf {
@@ -65,21 +125,13 @@ fn run_in<const D: usize>(case: &Case, source: &Path, dir: &Path) -> Result<Summ
         message,
     })?;
     let output = |path: PathBuf| move |source| CaseError::Output { path, source };
-    std::fs::create_dir_all(dir).map_err(output(dir.to_path_buf()))?;
-    // Stale results of an earlier run must not survive next to a new, possibly interrupted one.
-    for stale in ["history.csv", NEWTON_CSV, "summary.json", CASE_JSON] {
-        let p = dir.join(stale);
-        if p.exists() {
-            std::fs::remove_file(&p).map_err(output(p.clone()))?;
-        }
-    }
+    clear_outputs(dir)?;
     write_atomic(
         &dir.join(CASE_JSON),
         serde_json::to_string_pretty(case).unwrap_or_default(),
     )
     .map_err(output(dir.join(CASE_JSON)))?;
     let fields_dir = dir.join(fields::FIELDS_DIR);
-    fields::clear(dir).map_err(output(fields_dir.clone()))?;
     let mut recorder = DrumRecorder::create(dir).map_err(output(dir.join("history.csv")))?;
     let mut newton = NewtonRecorder::create(dir).map_err(output(dir.join(NEWTON_CSV)))?;
     let mut field_writer = case
@@ -114,6 +166,105 @@ fn run_in<const D: usize>(case: &Case, source: &Path, dir: &Path) -> Result<Summ
     )
     .map_err(output(dir.join("summary.json")))?;
     Ok(summary)
+}
+
+/// Creates `dir` and removes the results of an earlier run from it: stale results must not
+/// survive next to a new, possibly interrupted one.
+fn clear_outputs(dir: &Path) -> Result<(), CaseError> {
+    let output = |path: PathBuf| move |source| CaseError::Output { path, source };
+    std::fs::create_dir_all(dir).map_err(output(dir.to_path_buf()))?;
+    for stale in [
+        "history.csv",
+        NEWTON_CSV,
+        "summary.json",
+        CASE_JSON,
+        MODEL_JSON,
+    ] {
+        let p = dir.join(stale);
+        if p.exists() {
+            std::fs::remove_file(&p).map_err(output(p.clone()))?;
+        }
+    }
+    fields::clear(dir).map_err(output(dir.join(fields::FIELDS_DIR)))
+}
+
+/// Runs a model into `dir`.
+///
+/// # Errors
+/// [`CaseError::Invalid`] naming the field at fault, or [`CaseError::Output`].
+pub fn run_model(spec: &ModelSpec, source: &Path, dir: &Path) -> Result<ModelSummary, CaseError> {
+    let invalid = |field: &str, message: String| CaseError::Invalid {
+        path: source.to_path_buf(),
+        field: field.into(),
+        message,
+    };
+    if spec.output.field_interval.is_some() {
+        return Err(invalid(
+            "output.field_interval",
+            "ParaView field output is written for drum case files only so far; remove it".into(),
+        ));
+    }
+    match spec.dimension {
+        2 => run_model_in::<2>(spec, source, dir),
+        3 => run_model_in::<3>(spec, source, dir),
+        d => Err(invalid("dimension", format!("expected 2 or 3, got {d}"))),
+    }
+}
+
+fn run_model_in<const D: usize>(
+    spec: &ModelSpec,
+    source: &Path,
+    dir: &Path,
+) -> Result<ModelSummary, CaseError> {
+    let scene = model_file::build::<D>(spec).map_err(|e| CaseError::Invalid {
+        path: source.to_path_buf(),
+        field: e.field,
+        message: e.message,
+    })?;
+    let output = |path: PathBuf| move |source| CaseError::Output { path, source };
+    clear_outputs(dir)?;
+    write_atomic(&dir.join(MODEL_JSON), model_file::to_json(spec))
+        .map_err(output(dir.join(MODEL_JSON)))?;
+    let mut history =
+        ModelRecorder::create(dir, &scene.model).map_err(output(dir.join("history.csv")))?;
+    let mut newton = NewtonRecorder::create(dir).map_err(output(dir.join(NEWTON_CSV)))?;
+    let mut observers = ModelObservers {
+        history: &mut history,
+        newton: &mut newton,
+    };
+    let (stats, result) = run(&scene.model, &scene.steps, &scene.settings, &mut observers);
+    let record = history.finish().map_err(output(dir.join("history.csv")))?;
+    newton.finish().map_err(output(dir.join(NEWTON_CSV)))?;
+    let summary = summarize_model(
+        &spec.name,
+        &scene.model,
+        &record,
+        &stats,
+        result.err().as_ref(),
+    );
+    write_atomic(
+        &dir.join("summary.json"),
+        serde_json::to_string_pretty(&summary).unwrap_or_default(),
+    )
+    .map_err(output(dir.join("summary.json")))?;
+    Ok(summary)
+}
+
+/// The observers of a model-file run: its history and the Newton residuals.
+struct ModelObservers<'a> {
+    history: &'a mut ModelRecorder,
+    newton: &'a mut NewtonRecorder,
+}
+
+impl<const D: usize> Observer<D> for ModelObservers<'_> {
+    fn on_increment(
+        &mut self,
+        model: &Model<D>,
+        report: &IncrementReport<'_>,
+    ) -> std::io::Result<()> {
+        self.history.on_increment(model, report)?;
+        self.newton.on_increment(model, report)
+    }
 }
 
 /// The observers of a run: the history, the Newton residuals and, optionally, the field output.

@@ -1,10 +1,11 @@
 //! `skid`: run braking-drum cases from the command line.
 //!
 //! One module per command, each documenting its exit codes: [`run`], [`batch`], [`report`],
-//! [`bench`].
+//! [`bench`], [`convert`].
 
 mod batch;
 mod bench;
+mod convert;
 mod report;
 mod run;
 
@@ -28,15 +29,26 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run one case file; writes history.csv and summary.json, and prints the summary as one
-    /// line of JSON.
+    /// Run one case file or model file; writes history.csv and summary.json, and prints the
+    /// summary as one line of JSON.
     Run {
-        /// The case file (JSON).
+        /// The case file or model file (JSON).
         case: PathBuf,
         /// Output directory [default: out/<case name>].
         #[arg(long)]
         out: Option<PathBuf>,
         /// Override a field of the case, e.g. `--set steps[1].dt=1e-4` (repeatable).
+        #[arg(long = "set", value_name = "FIELD=VALUE")]
+        overrides: Vec<String>,
+    },
+    /// Write the model file of a drum case file (the same run, as a general model).
+    Convert {
+        /// The case file (JSON).
+        case: PathBuf,
+        /// The model file to write.
+        #[arg(long, short)]
+        out: PathBuf,
+        /// Override a field of the case (repeatable).
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         overrides: Vec<String>,
     },
@@ -134,6 +146,11 @@ fn main() -> ExitCode {
             out,
             overrides,
         } => run::run(&case, &overrides, out.as_deref()),
+        Command::Convert {
+            case,
+            out,
+            overrides,
+        } => convert::run(&case, &overrides, &out),
         Command::Bench {
             cases,
             out,
