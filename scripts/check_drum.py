@@ -1,6 +1,6 @@
 """Checks the drum validation runs written by scripts/validate.sh and prints a table.
 
-Acceptance (issue 2, ../shared/DRUM.md sections 2.2 and 3):
+Acceptance (DRUM.md sections 2.2 and 3):
 - t_stop in [0.0990, 0.1015] s; deceleration within 1.5 % of 600 rad/s^2;
 - after the stop (to t = 0.15 s): |omega| < 5 rad/s, angle within 0.03 rad of its value at the stop;
 - energy balance error < 0.5 %; penetration and sliding separation < 1e-6 m;

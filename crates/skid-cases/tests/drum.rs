@@ -1,5 +1,5 @@
 //! End to end: the drum against the analytical circle (2D) and cylinder (3D) spins down as the
-//! benchmark says (../shared/DRUM.md sections 2.2 and 3), and without friction it keeps spinning.
+//! benchmark says (DRUM.md sections 2.2 and 3), and without friction it keeps spinning.
 
 use std::path::Path;
 

@@ -1,4 +1,4 @@
-//! The literal reading of D1 (K/mu = 1e7, ../shared/DRUM.md section 2.1): the first 2 ms of the
+//! The literal reading of D1 (K/mu = 1e7, DRUM.md section 2.1): the first 2 ms of the
 //! spin-down, where friction sets the nearly incompressible pad vibrating, must run at the
 //! nominal time step. With the displacement formulation's tangent the Newton iterates carried
 //! pressures `U'(J)` far above the shear modulus and the tangent turned indefinite: the 2D case
