@@ -2,6 +2,7 @@
 //!
 //! - [`schema`]: the JSON case-file format;
 //! - [`validate`]: reading a case with field-level error messages and overrides;
+//! - [`deck`]: Abaqus-style input decks (so far their keyword layer);
 //! - [`model_file`]: the general model file (any scene) and building it into a model;
 //! - [`drum`]: the drum scene of a case (any idealization, 2D or 3D) as a model file;
 //! - [`history`]: the per-increment history of the drum (`history.csv`);
@@ -20,6 +21,7 @@ pub mod atomic;
 pub mod batch;
 pub mod bench;
 pub mod csv_out;
+pub mod deck;
 pub mod drum;
 pub mod fields;
 pub mod history;
