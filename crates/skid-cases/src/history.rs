@@ -16,6 +16,7 @@ use skid_integrator::stepper::{IncrementReport, Observer};
 
 use crate::csv_out::PartialCsv;
 use crate::drum::{BACK_PLATE, DRUM};
+use crate::model_file::history::pair_totals;
 
 /// Column names of `history.csv`.
 pub const COLUMNS: [&str; 22] = [
@@ -116,25 +117,16 @@ impl<const D: usize> Observer<D> for DrumRecorder {
         let angle = drum_eq.map_or(0.0, |eq| s.x[eq]);
         let torque = drum_eq.map_or(0.0, |eq| s.contact_reaction[eq]);
         let plate = dofs.body_displacement(&s.x, BACK_PLATE)[1];
-        let mut normal = 0.0;
-        let mut friction = 0.0;
-        let mut active = 0;
-        let mut sliding = 0;
-        let mut penetration = 0.0_f64;
-        let mut separation = 0.0_f64;
-        for c in &s.contacts {
-            penetration = penetration.max(-c.gap);
-            if !c.is_closed() {
-                continue;
-            }
-            active += 1;
-            normal += c.normal_force;
-            friction += c.tangential_force[0];
-            let mu = model.contacts()[c.pair].mu;
-            if c.tangential_force.norm() >= mu * c.normal_force * (1.0 - 1e-6) && mu > 0.0 {
-                sliding += 1;
-                separation = separation.max(c.gap);
-            }
+        let (mut normal, mut friction) = (0.0, 0.0);
+        let (mut active, mut sliding) = (0, 0);
+        let (mut penetration, mut separation) = (0.0_f64, 0.0_f64);
+        for t in pair_totals(model, s) {
+            normal += t.normal_force;
+            friction += t.tangential_force[0];
+            active += t.active;
+            sliding += t.sliding;
+            penetration = penetration.max(t.max_penetration);
+            separation = separation.max(t.max_sliding_separation);
         }
         let e = &s.energy;
         self.csv.record([
