@@ -304,7 +304,7 @@ mod tests {
     #[test]
     fn duplicate_keys_are_refused_with_their_object() {
         let e = parse_json("{\"a\": {\"b\": 1,\n \"b\": 2}}").expect_err("duplicate");
-        assert_eq!(e.place, "a, line 2 column 5");
+        assert_eq!(e.place, "a, line 2 column 4");
         assert!(e.message.contains("duplicate field `b`"), "{}", e.message);
         assert!(parse_json("{\"a\": [1, 1], \"b\": {\"a\": 1}}").is_ok());
     }
@@ -312,7 +312,7 @@ mod tests {
     #[test]
     fn numbers_out_of_range_name_their_field_and_the_finite_range() {
         let e = parse_json("{\"pad\": {\"density\": -1e999}}").expect_err("infinite");
-        assert_eq!(e.place, "pad.density, line 1 column 29");
+        assert_eq!(e.place, "pad.density, line 1 column 26");
         assert!(
             e.message.contains("expected a finite number"),
             "{}",
