@@ -13,7 +13,7 @@
 //! - [`fields`]: ParaView field output (VTU frames and a PVD collection);
 //! - [`runner`]: running one case into an output directory;
 //! - [`batch`]: running many cases in parallel;
-//! - [`bench`]: the cost of a case beside its error over a ladder of time steps;
+//! - [`mod@bench`]: the cost of a case beside its error over a ladder of time steps;
 //! - [`report`]: the validation report: the benchmark runs, the hard cases, the convergence
 //!   study.
 

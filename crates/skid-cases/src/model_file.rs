@@ -2,14 +2,14 @@
 //!
 //! - [`spec`]: the format (parts, rigid bodies, boundary conditions, ties, loads, contact
 //!   pairs, steps, solver and output settings);
-//! - [`build`]: resolving names and checking values into a [`Scene`] (the integrator's model,
+//! - [`mod@build`]: resolving names and checking values into a [`Scene`] (the integrator's model,
 //!   steps and settings), each problem reported with its field path;
 //! - [`history`]: the generic `history.csv` (every body's motions, every pair's resultants,
 //!   the energy ledger);
 //! - [`summary`]: the generic `summary.json`.
 //!
 //! A case file of the drum benchmark is generated into a model file by
-//! [`crate::drum::model_spec`], and runs through the same [`build`].
+//! [`crate::drum::model_spec`], and runs through the same [`build()`].
 
 pub mod build;
 pub mod history;
@@ -32,7 +32,7 @@ pub fn is_model_file(value: &Value) -> bool {
 }
 
 /// Parses model-file text with `overrides` applied (`path` is only used in messages). Names
-/// and values are checked when the scene is built ([`build`]).
+/// and values are checked when the scene is built ([`build()`]).
 ///
 /// # Errors
 /// [`CaseError::Parse`] for text that is not JSON or not of the format, naming the line or the

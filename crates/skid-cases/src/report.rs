@@ -8,7 +8,7 @@
 //! - the convergence study ([`convergence`]): t_stop and e_slide against mesh and time-step
 //!   refinement with observed orders, and Newton residual histories.
 //!
-//! This module: reading runs, and the comparison math (interpolation, `e_slide`); [`format`]:
+//! This module: reading runs, and the comparison math (interpolation, `e_slide`); [`mod@format`]:
 //! number formatting and check lists shared by the sections.
 
 pub mod convergence;

@@ -62,20 +62,21 @@ pub fn run_file(
     overrides: &[String],
     out_dir: Option<&Path>,
 ) -> Result<RunSummary, CaseError> {
-    let text = read(path)?;
-    if !declares_model(&text) {
-        return run_case_file(path, overrides, out_dir).map(RunSummary::Case);
-    }
+    // Text that is not a model file (or not text: the case reader names the bad byte's line)
+    // is read as a case file.
+    let text = match std::fs::read_to_string(path) {
+        Ok(text) if declares_model(&text) => text,
+        Err(source) if source.kind() != std::io::ErrorKind::InvalidData => {
+            return Err(CaseError::Read {
+                path: path.to_path_buf(),
+                source,
+            });
+        }
+        _ => return run_case_file(path, overrides, out_dir).map(RunSummary::Case),
+    };
     let spec = model_file::parse_model(&text, path, overrides)?;
     let dir = out_dir.map_or_else(|| Path::new("out").join(&spec.name), Path::to_path_buf);
     run_model(&spec, path, &dir).map(RunSummary::Model)
-}
-
-fn read(path: &Path) -> Result<String, CaseError> {
-    std::fs::read_to_string(path).map_err(|source| CaseError::Read {
-        path: path.to_path_buf(),
-        source,
-    })
 }
 
 /// Whether JSON text is a model file; text that is not JSON is left to the parser to report.

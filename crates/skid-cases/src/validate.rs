@@ -11,6 +11,9 @@ use crate::schema::{
     Case, ContactFormulation, DrumSurfaceSpec, FacetElement, MaterialSpec, StepSpec,
 };
 
+mod json;
+pub mod memory;
+
 /// A problem with a case file or its run.
 #[derive(Debug, Error)]
 #[non_exhaustive]
@@ -23,17 +26,18 @@ pub enum CaseError {
         /// Cause.
         source: std::io::Error,
     },
-    /// Not valid JSON, or not of the schema (unknown/missing field, wrong type).
+    /// Not valid UTF-8 or JSON, or not of the schema (unknown/missing field, wrong type).
     #[error("{path}: {field}: {message}")]
     Parse {
         /// File.
         path: PathBuf,
-        /// Field path, e.g. `pad.material.c10`.
+        /// Field path, e.g. `pad.material.c10`, or `line L column C` of a syntax error.
         field: String,
         /// What is wrong.
         message: String,
     },
-    /// A value is out of its physical range or inconsistent with another.
+    /// A value is out of its physical range or inconsistent with another, or the case does
+    /// not fit in memory.
     #[error("{path}: {field}: {message}")]
     Invalid {
         /// File.
@@ -43,9 +47,16 @@ pub enum CaseError {
         /// What was expected.
         message: String,
     },
-    /// An override given on the command line is malformed.
-    #[error("override '{0}': expected FIELD.PATH=VALUE, e.g. steps[1].dt=1e-4")]
-    Override(String),
+    /// An override given on the command line cannot be applied.
+    #[error("{path}: --set {spec}: {message}")]
+    Override {
+        /// The case file it applies to.
+        path: PathBuf,
+        /// The override as given.
+        spec: String,
+        /// What is wrong and what was expected.
+        message: String,
+    },
     /// The model could not be built.
     #[error("{path}: model: {message}")]
     Model {
@@ -69,14 +80,28 @@ pub enum CaseError {
 /// # Errors
 /// [`CaseError`] naming the file and field at fault.
 pub fn load_case(path: &Path, overrides: &[String]) -> Result<Case, CaseError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CaseError::Read {
+    let bytes = std::fs::read(path).map_err(|source| CaseError::Read {
         path: path.to_path_buf(),
         source,
     })?;
-    parse_case(&text, path, overrides)
+    match String::from_utf8(bytes) {
+        Ok(text) => parse_case(&text, path, overrides),
+        Err(e) => {
+            let error = json::utf8_error(e.as_bytes()).unwrap_or(json::SyntaxError {
+                place: "line 1 column 1".into(),
+                message: "not valid UTF-8".into(),
+            });
+            Err(CaseError::Parse {
+                path: path.to_path_buf(),
+                field: error.place,
+                message: error.message,
+            })
+        }
+    }
 }
 
-/// Parses and validates case text (`path` is only used in messages).
+/// Parses and validates case text (`path` is only used in messages), and checks that the case
+/// fits in the memory available ([`memory`]).
 ///
 /// # Errors
 /// [`CaseError`] naming the field at fault.
@@ -89,11 +114,13 @@ pub fn parse_case(text: &str, path: &Path, overrides: &[String]) -> Result<Case,
         });
     }
     let case: Case = parse_document(text, path, overrides)?;
-    validate(&case).map_err(|(field, message)| CaseError::Invalid {
+    let invalid = |(field, message): Problem| CaseError::Invalid {
         path: path.to_path_buf(),
         field,
         message,
-    })?;
+    };
+    validate(&case).map_err(invalid)?;
+    memory::check(&case, memory::available()).map_err(invalid)?;
     Ok(case)
 }
 
@@ -112,50 +139,91 @@ pub(crate) fn parse_document<T: serde::de::DeserializeOwned>(
         field,
         message,
     };
-    let mut value: Value = serde_json::from_str(text).map_err(|e| {
-        parse_error(
-            format!("line {} column {}", e.line(), e.column()),
-            format!("not valid JSON: {e}"),
-        )
-    })?;
-    for o in overrides {
-        apply_override(&mut value, o)?;
+    let mut value = json::parse_json(text).map_err(|e| parse_error(e.place, e.message))?;
+    for spec in overrides {
+        apply_override(&mut value, spec).map_err(|message| CaseError::Override {
+            path: path.to_path_buf(),
+            spec: spec.clone(),
+            message,
+        })?;
     }
-    serde_path_to_error::deserialize(value).map_err(|e| {
-        let field = match e.path().to_string() {
-            p if p == "." => "(top level)".to_string(),
-            p => p,
-        };
-        parse_error(field, e.into_inner().to_string())
-    })
+    json::to_typed(&value).map_err(|(field, message)| parse_error(json::path_text(&field), message))
 }
 
+/// Longest field path an override may give, in parts (`steps[1].adaptive.min_dt` has 3).
+const MAX_OVERRIDE_PARTS: usize = 16;
+
 /// Sets a field: `drum.omega0=600`, `steps[1].dt=1e-4` (dots and `[i]` indices into existing
-/// arrays).
-fn apply_override(root: &mut Value, spec: &str) -> Result<(), CaseError> {
-    let bad = || CaseError::Override(spec.to_string());
-    let (path, raw) = spec.split_once('=').ok_or_else(bad)?;
-    let new: Value = serde_json::from_str(raw).or_else(|_| {
-        // Bare words are strings (`name=my-run`).
-        Ok::<Value, CaseError>(Value::String(raw.to_string()))
-    })?;
+/// arrays). The value is JSON; anything else is taken as a string (`name=my-run`), except a
+/// word that reads as a number, which must be finite (`nan`, `inf`, `1e999` are refused; a
+/// string of that spelling is written as JSON, `name="nan"`).
+///
+/// # Errors
+/// What is wrong with `spec`, and what was expected.
+fn apply_override(root: &mut Value, spec: &str) -> Result<(), String> {
+    let syntax = || "expected FIELD.PATH=VALUE, e.g. steps[1].dt=1e-4".to_string();
+    let (path, raw) = spec.split_once('=').ok_or_else(syntax)?;
+    let parts: Vec<&str> = path.split('.').collect();
+    if parts.len() > MAX_OVERRIDE_PARTS {
+        return Err(format!(
+            "expected a field path of at most {MAX_OVERRIDE_PARTS} parts, got {}",
+            parts.len()
+        ));
+    }
+    let new = match json::parse_json(raw) {
+        Ok(value) => value,
+        Err(_) => match raw.trim().parse::<f64>() {
+            Ok(number) if !number.is_finite() => {
+                return Err(format!("{path}: expected a finite number, got {raw}"));
+            }
+            _ => Value::String(raw.to_string()),
+        },
+    };
     let mut node = root;
-    for part in path.split('.') {
+    let mut reached = String::new();
+    for part in parts {
         let (key, indices) = match part.find('[') {
             Some(i) => (&part[..i], &part[i..]),
             None => (part, ""),
         };
-        if !key.is_empty() {
-            // Optional sections may be absent from the file: create them. A misspelt key is
-            // still caught, as an unknown field, when the result is parsed.
-            let object = node.as_object_mut().ok_or_else(bad)?;
-            node = object
-                .entry(key.to_string())
-                .or_insert_with(|| Value::Object(serde_json::Map::new()));
+        if key.is_empty() {
+            return Err(syntax());
         }
-        for idx in indices.split('[').filter(|s| !s.is_empty()) {
-            let i: usize = idx.trim_end_matches(']').parse().map_err(|_| bad())?;
-            node = node.get_mut(i).ok_or_else(bad)?;
+        let holder = if reached.is_empty() {
+            "the case".to_string()
+        } else {
+            reached.clone()
+        };
+        if !reached.is_empty() {
+            reached.push('.');
+        }
+        reached.push_str(key);
+        // Optional sections may be absent from the file: create them. A misspelt key is still
+        // caught, as an unknown field, when the result is parsed.
+        let object = node
+            .as_object_mut()
+            .ok_or_else(|| format!("{holder}: expected an object to hold `{key}`"))?;
+        node = object
+            .entry(key.to_string())
+            .or_insert_with(|| Value::Object(serde_json::Map::new()));
+        let mut rest = indices;
+        while !rest.is_empty() {
+            let index = rest
+                .strip_prefix('[')
+                .and_then(|r| r.split_once(']'))
+                .and_then(|(i, r)| Some((i.parse::<usize>().ok()?, r)));
+            let Some((i, r)) = index else {
+                return Err(format!("{part}: expected an index [N], N >= 0"));
+            };
+            rest = r;
+            let array = node
+                .as_array_mut()
+                .ok_or_else(|| format!("{reached}: expected an array to index with [{i}]"))?;
+            let len = array.len();
+            node = array.get_mut(i).ok_or_else(|| {
+                format!("{reached}[{i}]: expected an index below {len}, the length of {reached}")
+            })?;
+            reached.push_str(&format!("[{i}]"));
         }
     }
     *node = new;
@@ -186,18 +254,56 @@ fn non_negative(field: &str, v: f64) -> Result<(), Problem> {
     }
 }
 
+/// Longest case or step name, in characters.
+const MAX_NAME: usize = 100;
+
+/// A case name is the name of its output directory: 1 to [`MAX_NAME`] ASCII letters, digits and
+/// `.`, `_`, `+`, `-`, not starting with `.` (hidden, or the directory itself or its parent)
+/// or `-` (read as an option on a command line).
+fn check_case_name(name: &str) -> Result<(), Problem> {
+    let allowed = |c: char| c.is_ascii_alphanumeric() || "._+-".contains(c);
+    if name.is_empty()
+        || name.chars().count() > MAX_NAME
+        || !name.chars().all(allowed)
+        || name.starts_with(['.', '-'])
+    {
+        return Err((
+            "name".into(),
+            format!(
+                "expected 1 to {MAX_NAME} of the characters A-Z a-z 0-9 . _ + - not starting \
+                 with . or - (the name of the output directory), got {name:?}"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// A step name labels rows of the CSV output and lines of messages: 1 to [`MAX_NAME`]
+/// characters, none of them a control character (line break, tab), not starting or ending
+/// with white space.
+fn check_step_name(field: &str, name: &str) -> Result<(), Problem> {
+    if name.is_empty()
+        || name.chars().count() > MAX_NAME
+        || name.chars().any(char::is_control)
+        || name.trim() != name
+    {
+        return Err((
+            field.into(),
+            format!(
+                "expected 1 to {MAX_NAME} characters, no control characters (line breaks, \
+                 tabs) and no white space at either end, got {name:?}"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Physical ranges and cross-field consistency.
 ///
 /// # Errors
 /// The first problem as (field path, what was expected).
 pub fn validate(case: &Case) -> Result<(), Problem> {
-    if case.name.trim().is_empty() || case.name.contains(['/', '\\']) || case.name.starts_with('.')
-    {
-        return Err((
-            "name".into(),
-            "expected a non-empty name usable as a directory name".into(),
-        ));
-    }
+    check_case_name(&case.name)?;
     if case.dimension != 2 && case.dimension != 3 {
         return Err((
             "dimension".into(),
@@ -338,9 +444,7 @@ pub fn validate(case: &Case) -> Result<(), Problem> {
                 hold,
                 regularization_time,
             } => {
-                if name.is_empty() {
-                    return Err((f("name"), "expected a non-empty name".into()));
-                }
+                check_step_name(&f("name"), name)?;
                 if *increments == 0 {
                     return Err((f("increments"), "expected at least 1".into()));
                 }
@@ -355,9 +459,7 @@ pub fn validate(case: &Case) -> Result<(), Problem> {
                 hold,
                 adaptive,
             } => {
-                if name.is_empty() {
-                    return Err((f("name"), "expected a non-empty name".into()));
-                }
+                check_step_name(&f("name"), name)?;
                 positive(&f("duration"), *duration)?;
                 positive(&f("dt"), *dt)?;
                 if dt > duration {

@@ -176,7 +176,7 @@ fn overrides_set_nested_fields_and_reject_bad_paths() {
     for bad in ["steps[7].dt=1", "no-equals-sign", "steps[x].dt=1"] {
         assert!(matches!(
             parse_case(SHIPPED, Path::new("c.json"), &[bad.into()]),
-            Err(CaseError::Override(_))
+            Err(CaseError::Override { .. })
         ));
     }
     // A misspelt key is created by the override, then rejected as an unknown field.
