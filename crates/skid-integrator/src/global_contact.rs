@@ -20,7 +20,9 @@
 //! [`crate::coupling::ContactRows::curvature_stiffness`]), so that the first block row is the
 //! exact linearisation of `R - H^T r`. An open candidate has `Phi_r = I`, `Phi_u = 0` (its new
 //! force is zero), a sticking one `H_c dx = -u_c`, a sliding one `u_N = 0` with its friction on
-//! the cone's edge. Nothing requires `K` to be positive definite, and sliding rows make the
+//! the cone's edge (its tangential rows balanced by `T = d d^T + P / f`, see
+//! [`LocalLaw::with_balanced_slide_rows`], which leaves the step unchanged and makes the rows
+//! across the sliding direction symmetric with the force columns). Nothing requires `K` to be positive definite, and sliding rows make the
 //! matrix unsymmetric. Each system is solved, in this order, by GMRES on the LU factors of an
 //! earlier one while they serve, by GMRES preconditioned with the quasi-definite approximation
 //! of [`crate::quasi_definite`] (systems of [`QUASI_DEFINITE_FROM`] equations or more), or by a
@@ -244,8 +246,16 @@ impl GlobalContactSolver {
                 &r.as_slice()[block.clone()],
                 &rows.u.as_slice()[block.clone()],
                 LocalBranch::Frictionless,
-            );
+            )
+            .with_balanced_slide_rows(d);
             open[c] = law.branch == LocalBranch::Open;
+            // the block of S on the candidate's tangential rows (see `crate::quasi_definite`):
+            // across a sliding direction the softened constraint of the balanced rows
+            let slide = law.slide.filter(|_| d == 3);
+            let projector = |t: usize, s: usize| match slide {
+                Some(frame) => f64::from(u8::from(s == t)) - frame.d[t - 1] * frame.d[s - 1],
+                None => 0.0,
+            };
             for t in 0..d {
                 let row = n + c * d + t;
                 let constraint = match law.branch {
@@ -256,18 +266,49 @@ impl GlobalContactSolver {
                 for &eq in &equations {
                     let h = coefficient(c * d + t, eq);
                     push(eq, row, -rho[c] * h);
-                    s_push(row, eq, if constraint { -rho[c] * h } else { 0.0 });
+                    let coupling = if constraint {
+                        -rho[c] * h
+                    } else if t > 0 && slide.is_some() {
+                        -rho[c]
+                            * (1..d)
+                                .map(|s| projector(t, s) * coefficient(c * d + s, eq))
+                                .sum::<f64>()
+                    } else {
+                        0.0
+                    };
+                    s_push(row, eq, coupling);
                     let du: f64 = (0..d)
                         .map(|s| law.d_u[t][s] * coefficient(c * d + s, eq))
                         .sum();
                     push(row, eq, du);
                 }
-                let weight = if constraint {
-                    CONSTRAINT_REGULARIZATION
+                if t > 0 && d == 3 {
+                    // lower triangle of the 2 x 2 tangential block: d d^T + (c + eps) P
+                    for s in 1..=t {
+                        let value = slide.map_or(0.0, |frame| {
+                            let along = frame.d[t - 1] * frame.d[s - 1];
+                            let c_soft = (1.0 - frame.f) / frame.f + CONSTRAINT_REGULARIZATION;
+                            along + c_soft * projector(t, s)
+                        });
+                        let diagonal = if s == t && slide.is_none() {
+                            if constraint {
+                                CONSTRAINT_REGULARIZATION
+                            } else {
+                                1.0
+                            }
+                        } else {
+                            value
+                        };
+                        s_push(row, n + c * d + s, -diagonal * rho[c]);
+                    }
                 } else {
-                    1.0
-                };
-                s_push(row, row, -weight * rho[c]);
+                    let weight = if constraint {
+                        CONSTRAINT_REGULARIZATION
+                    } else {
+                        1.0
+                    };
+                    s_push(row, row, -weight * rho[c]);
+                }
                 let mut right = -law.phi[t];
                 for s in 0..d {
                     push(row, n + c * d + s, law.d_r[t][s] * rho[c]);

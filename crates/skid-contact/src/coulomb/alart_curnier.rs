@@ -30,6 +30,18 @@ pub struct LocalLaw {
     pub d_r: [[f64; 3]; 3],
     /// `dPhi/du` (force per length).
     pub d_u: [[f64; 3]; 3],
+    /// On the slide branch, the sliding direction `d` and `f = mu tau / ||v||` (`< 1`).
+    pub slide: Option<SlideFrame>,
+}
+
+/// The sliding direction `d = v / ||v||` (tangential components) and the ratio
+/// `f = mu tau / ||v||` of a sliding contact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlideFrame {
+    /// `d`, unit length in the first `dim - 1` components.
+    pub d: [f64; 2],
+    /// `f`, in `(0, 1)`.
+    pub f: f64,
 }
 
 /// Branch of the Alart–Curnier function at one contact.
@@ -70,6 +82,7 @@ impl LocalLaw {
             phi: [0.0; 3],
             d_r: [[0.0; 3]; 3],
             d_u: [[0.0; 3]; 3],
+            slide: None,
         };
         let tau = r[0] - rho * u[0];
         if tau < 0.0 || (tau == 0.0 && at_kink == LocalBranch::Open) {
@@ -103,6 +116,7 @@ impl LocalLaw {
             law.branch = LocalBranch::Slide;
             let d = v.map(|c| c / norm);
             let factor = radius / norm;
+            law.slide = Some(SlideFrame { d, f: factor });
             for t in 1..dim {
                 law.phi[t] = r[t] - radius * d[t - 1];
                 law.d_r[t][0] = -mu * d[t - 1];
@@ -115,6 +129,43 @@ impl LocalLaw {
             }
         }
         law
+    }
+
+    /// The law with the tangential rows of a sliding contact multiplied by the invertible
+    /// `T = d d^T + P / f` (unchanged on other branches), which has the same zeros and the
+    /// same Newton step. With `c = (1 - f) / f` the tangential rows become
+    /// `dPhi'_T/dr = [-mu d | d d^T + c P]`, `dPhi'_T/du = [mu rho d | rho P]`: across the
+    /// sliding direction a constraint `rho P du_T` softened by `c rho P dr_T`, symmetric with
+    /// the contact's column `-H_T^T` of the global system, and along it `dr_d = mu dr_N` plus
+    /// the normal coupling that makes friction unsymmetric.
+    #[must_use]
+    pub fn with_balanced_slide_rows(mut self, dim: usize) -> Self {
+        let Some(SlideFrame { d, f }) = self.slide else {
+            return self;
+        };
+        let t_matrix = |t: usize, s: usize| {
+            let delta = f64::from(u8::from(s == t));
+            d[t] * d[s] + (delta - d[t] * d[s]) / f
+        };
+        let tangential = dim - 1;
+        let rows = |m: &[[f64; 3]; 3]| {
+            let mut out = *m;
+            for t in 0..tangential {
+                for col in 0..dim {
+                    out[t + 1][col] = (0..tangential)
+                        .map(|s| t_matrix(t, s) * m[s + 1][col])
+                        .sum();
+                }
+            }
+            out
+        };
+        self.d_r = rows(&self.d_r);
+        self.d_u = rows(&self.d_u);
+        let phi = self.phi;
+        for t in 0..tangential {
+            self.phi[t + 1] = (0..tangential).map(|s| t_matrix(t, s) * phi[s + 1]).sum();
+        }
+        self
     }
 }
 
@@ -180,5 +231,38 @@ mod tests {
         // the convex relaxation's solution lifts off by mu ||u_T||: not a zero of Phi
         let dilated = LocalLaw::evaluate(3, mu, rho, &[2.0, -0.6, -0.8], &[0.25, 0.3, 0.4]);
         assert!(dilated.phi[0].abs() > 0.5);
+    }
+
+    /// The balanced slide rows are `T` times the rows of `Phi` and its derivatives, and take
+    /// the closed form `[-mu d | d d^T + c P]`, `[mu rho d | rho P]` of their documentation;
+    /// other branches are unchanged.
+    #[test]
+    fn balanced_slide_rows_have_the_symmetric_form() {
+        let (mu, rho) = (0.3, 0.7);
+        let (r, u) = ([1.0, 0.2, -0.3], [0.01, 1.5, 0.8]);
+        let law = LocalLaw::evaluate(3, mu, rho, &r, &u);
+        let Some(SlideFrame { d, f }) = law.slide else {
+            panic!("not sliding: {law:?}");
+        };
+        let balanced = law.with_balanced_slide_rows(3);
+        let c = (1.0 - f) / f;
+        for t in 0..2 {
+            assert!((balanced.d_r[t + 1][0] + mu * d[t]).abs() < 1e-14);
+            assert!((balanced.d_u[t + 1][0] - mu * rho * d[t]).abs() < 1e-14);
+            for s in 0..2 {
+                let p = f64::from(u8::from(s == t)) - d[t] * d[s];
+                assert!((balanced.d_r[t + 1][s + 1] - d[t] * d[s] - c * p).abs() < 1e-14);
+                assert!((balanced.d_u[t + 1][s + 1] - rho * p).abs() < 1e-14);
+            }
+            // T phi_T, with T d = d and T e = e / f
+            let e = [-d[1], d[0]];
+            let along: f64 = (0..2).map(|s| d[s] * law.phi[s + 1]).sum();
+            let across: f64 = (0..2).map(|s| e[s] * law.phi[s + 1]).sum();
+            let expected = along * d[t] + across * e[t] / f;
+            assert!((balanced.phi[t + 1] - expected).abs() < 1e-14);
+        }
+        assert_eq!(balanced.d_r[0], law.d_r[0]);
+        let stick = LocalLaw::evaluate(3, mu, rho, &[1.0, 0.1, 0.05], &[0.0, 0.01, 0.0]);
+        assert_eq!(stick.with_balanced_slide_rows(3), stick);
     }
 }
