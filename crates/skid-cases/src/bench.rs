@@ -300,20 +300,20 @@ pub fn run_bench(
                     .join(label)
                     .join(k.to_string());
                 let mut summary = run_case(&level, source, &dir)?;
-                let mut times = vec![summary.wall_time_s];
-                if summary.wall_time_s < REPEAT_BELOW_S {
+                let mut times = vec![summary.cost.wall_time_s];
+                if summary.cost.wall_time_s < REPEAT_BELOW_S {
                     times.clear();
                     let mut timed = Vec::new();
                     for _ in 0..settings.repeats {
                         let s = run_case(&level, source, &dir)?;
-                        times.push(s.wall_time_s);
+                        times.push(s.cost.wall_time_s);
                         timed.push(s);
                     }
                     let middle = median(&times);
                     if let Some(closest) = timed.into_iter().min_by(|a, b| {
-                        (a.wall_time_s - middle)
+                        (a.cost.wall_time_s - middle)
                             .abs()
-                            .total_cmp(&(b.wall_time_s - middle).abs())
+                            .total_cmp(&(b.cost.wall_time_s - middle).abs())
                     }) {
                         summary = closest;
                     }
@@ -325,12 +325,12 @@ pub fn run_bench(
                     status: summary.status.clone(),
                     wall_time_s: median(&times),
                     wall_times_s: times,
-                    assembly_s: summary.assembly_s,
-                    linear_solve_s: summary.linear_solve_s,
-                    contact_solve_s: summary.contact_solve_s,
-                    increments: summary.increments,
-                    newton_iterations: summary.newton_iterations,
-                    contact_fallbacks: summary.contact_fallbacks,
+                    assembly_s: summary.cost.assembly_s,
+                    linear_solve_s: summary.cost.linear_solve_s,
+                    contact_solve_s: summary.cost.contact_solve_s,
+                    increments: summary.cost.increments,
+                    newton_iterations: summary.cost.newton_iterations,
+                    contact_fallbacks: summary.cost.contact_fallbacks,
                     t_stop: summary.t_stop,
                     deceleration: summary.deceleration,
                     deceleration_error: None,

@@ -5,6 +5,7 @@ use serde::Serialize;
 use skid_integrator::{RunError, RunStatistics};
 
 use crate::history::Sample;
+use crate::model_file::summary::RunCost;
 use crate::schema::Case;
 
 /// `summary.json`.
@@ -39,37 +40,9 @@ pub struct Summary {
     pub mean_normal_force_sliding: Option<f64>,
     /// Time reached, s.
     pub final_time: f64,
-    /// Equations (unknowns) of the model.
-    pub equations: usize,
-    /// Contact candidates (slave nodes over all pairs).
-    pub contact_candidates: usize,
-    /// Converged increments.
-    pub increments: usize,
-    /// Newton iterations.
-    pub newton_iterations: usize,
-    /// Conic (clarabel) solves.
-    pub contact_solves: usize,
-    /// De Saxce fixed-point iterations.
-    pub fixed_point_iterations: usize,
-    /// Semismooth Newton steps of the contact solves.
-    pub contact_newton_steps: usize,
-    /// Increments the global contact solve did not converge and the reduced one solved.
-    pub contact_fallbacks: usize,
-    /// Failed attempts answered by a cutback.
-    pub cutbacks: usize,
-    /// Converged increments of adaptive steps taken again shorter for their local error.
-    #[serde(default)]
-    pub error_rejections: usize,
-    /// The failed attempts by cause (e.g. "newton not converged": 3).
-    pub cutback_causes: std::collections::BTreeMap<String, usize>,
-    /// Wall time of the run, s.
-    pub wall_time_s: f64,
-    /// Of which: element loop, loads and contact kinematics, s.
-    pub assembly_s: f64,
-    /// Of which: factorizations and solves, s.
-    pub linear_solve_s: f64,
-    /// Of which: conic solves, s.
-    pub contact_solve_s: f64,
+    /// Cost of the run.
+    #[serde(flatten)]
+    pub cost: RunCost,
     /// Drum kinetic energy lost over the dynamic steps, J.
     pub drum_energy_lost_j: Option<f64>,
     /// Frictional dissipation over the dynamic steps, J.
@@ -226,25 +199,7 @@ pub fn summarize(
         post_stop_max_angle_change: post_angle,
         mean_normal_force_sliding: mean_normal,
         final_time: samples.last().map_or(0.0, |s| s.time),
-        equations: stats.equations,
-        contact_candidates: stats.contact_candidates,
-        increments: stats.increments,
-        newton_iterations: stats.newton_iterations,
-        contact_solves: stats.contact_solves,
-        fixed_point_iterations: stats.fixed_point_iterations,
-        contact_newton_steps: stats.contact_newton_steps,
-        contact_fallbacks: stats.contact_fallbacks,
-        cutbacks: stats.cutbacks,
-        error_rejections: stats.error_rejections,
-        cutback_causes: stats
-            .cutback_causes
-            .iter()
-            .map(|(&k, &n)| (k.to_string(), n))
-            .collect(),
-        wall_time_s: stats.wall_time.as_secs_f64(),
-        assembly_s: stats.timings.assembly.as_secs_f64(),
-        linear_solve_s: stats.timings.linear_solve.as_secs_f64(),
-        contact_solve_s: stats.timings.contact_solve.as_secs_f64(),
+        cost: RunCost::from(stats),
         drum_energy_lost_j: lost,
         friction_work_j: friction,
         energy_balance_error: balance,

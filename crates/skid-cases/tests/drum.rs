@@ -70,7 +70,7 @@ fn drum_spins_down_in_a_straight_line_and_rocks_in_stick_after_the_stop() {
     let path = dir.path().join("history.csv");
     let history = std::fs::read_to_string(&path).expect("history");
     let records = CsvTable::new(&history, &path).expect("header").count();
-    assert_eq!(records, s.increments + 1);
+    assert_eq!(records, s.cost.increments + 1);
     assert!(!dir.path().join("history.csv.partial").exists());
     let written: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(dir.path().join("summary.json")).expect("summary"),
@@ -257,10 +257,10 @@ fn adaptive_increments_land_on_the_stop_with_the_fixed_steps_answer() {
     let (s, dir) = run(&["pad.quasi_static=true", adaptive]);
     assert_benchmark_spin_down(&s);
     assert!(
-        s.increments * 10 < fixed.increments,
+        s.cost.increments * 10 < fixed.cost.increments,
         "{} adaptive increments against {} fixed",
-        s.increments,
-        fixed.increments
+        s.cost.increments,
+        fixed.cost.increments
     );
     let d = relative(s.deceleration, fixed.deceleration);
     assert!(d < 1e-7, "deceleration differs by {d}");

@@ -21,7 +21,11 @@ fn run_briefly(text: &str) -> (Summary, tempfile::TempDir) {
 fn assert_no_cutbacks(text: &str) {
     let (s, _dir) = run_briefly(text);
     assert_eq!(s.status, "completed", "{:?}", s.error);
-    assert_eq!(s.cutbacks, 0, "cutbacks by cause: {:?}", s.cutback_causes);
+    assert_eq!(
+        s.cost.cutbacks, 0,
+        "cutbacks by cause: {:?}",
+        s.cost.cutback_causes
+    );
     // Sliding from the start: omega falls at mu p A R / I = 600 rad/s^2 (the side contacts'
     // tilt and the vibration that friction sets off add about 1 %).
     let decel = s.deceleration.expect("deceleration");
