@@ -229,9 +229,10 @@ fn run_model_in<const D: usize>(
     let mut history =
         ModelRecorder::create(dir, &scene.model).map_err(output(dir.join("history.csv")))?;
     let mut newton = NewtonRecorder::create(dir).map_err(output(dir.join(NEWTON_CSV)))?;
-    let mut observers = ModelObservers {
+    let mut observers = Observers {
         history: &mut history,
         newton: &mut newton,
+        fields: None,
     };
     let (stats, result) = run(&scene.model, &scene.steps, &scene.settings, &mut observers);
     let record = history.finish().map_err(output(dir.join("history.csv")))?;
@@ -251,31 +252,15 @@ fn run_model_in<const D: usize>(
     Ok(summary)
 }
 
-/// The observers of a model-file run: its history and the Newton residuals.
-struct ModelObservers<'a> {
-    history: &'a mut ModelRecorder,
-    newton: &'a mut NewtonRecorder,
-}
-
-impl<const D: usize> Observer<D> for ModelObservers<'_> {
-    fn on_increment(
-        &mut self,
-        model: &Model<D>,
-        report: &IncrementReport<'_>,
-    ) -> std::io::Result<()> {
-        self.history.on_increment(model, report)?;
-        self.newton.on_increment(model, report)
-    }
-}
-
-/// The observers of a run: the history, the Newton residuals and, optionally, the field output.
-struct Observers<'a> {
-    history: &'a mut DrumRecorder,
+/// The observers of a run: its history (the drum's or a model's), the Newton residuals and,
+/// optionally, the field output.
+struct Observers<'a, H> {
+    history: &'a mut H,
     newton: &'a mut NewtonRecorder,
     fields: Option<&'a mut FieldWriter>,
 }
 
-impl<const D: usize> Observer<D> for Observers<'_> {
+impl<const D: usize, H: Observer<D>> Observer<D> for Observers<'_, H> {
     fn on_increment(
         &mut self,
         model: &Model<D>,
