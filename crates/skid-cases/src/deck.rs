@@ -2,7 +2,84 @@
 //!
 //! - [`keywords`]: the keyword layer: keyword blocks with parameters and data lines, comments,
 //!   continuation lines and `*INCLUDE`, each with its file and line.
+//! - [`read`]: the keyword subset read into definitions with the deck's labels and names
+//!   ([`fields`] reads typed parameters and fields, [`mesh`] nodes, elements and sets,
+//!   [`rigid`] analytical and faceted rigid surfaces).
+//! - [`assemble`]: the definitions turned into a model; [`write`]: a model written as a deck.
 //!
-//! The semantic layer (the keyword subset of the drum scenes mapped onto a model) builds on it.
+//! The subset: `*HEADING`, `*NODE`, `*ELEMENT` (CPE4R, C3D8R; R2D2, R3D4, M3D4R, S4R, C3D4
+//! made rigid; MASS, ROTARYI), `*NSET` / `*ELSET` (GENERATE), `*SURFACE` (ELEMENT, NODE,
+//! SEGMENTS, CYLINDER, REVOLUTION), `*RIGID BODY` (REF NODE, ELSET, ANALYTICAL SURFACE,
+//! TIE NSET), `*MATERIAL` with `*HYPERELASTIC` (POLYNOMIAL N=1, MOONEY-RIVLIN, NEO HOOKE),
+//! `*ELASTIC` and `*DENSITY`, `*SOLID SECTION`, `*MEMBRANE SECTION`, `*SHELL SECTION`,
+//! `*MASS`, `*ROTARY INERTIA`, `*SURFACE INTERACTION` with `*FRICTION`, `*CONTACT PAIR`,
+//! `*CONTACT` with `*CONTACT INCLUSIONS, ALL EXTERIOR` and `*CONTACT PROPERTY ASSIGNMENT`,
+//! `*BOUNDARY` (OP=MOD/NEW in steps), `*INITIAL CONDITIONS` (VELOCITY, ROTATING VELOCITY),
+//! `*AMPLITUDE` (defined, not yet usable), `*STEP` (NLGEOM), `*STATIC` and `*DYNAMIC` (DIRECT,
+//! ALPHA), `*DSLOAD` / `*DLOAD` pressures, `*OUTPUT`, `*NODE OUTPUT`, `*CONTACT OUTPUT`,
+//! `*END STEP`, `*INCLUDE`. Anything else is an error at its line.
+//!
+//! How skid reads what the keywords leave open, or what it models differently:
+//! - model-data boundary conditions hold throughout; in a step, zero-valued conditions on a
+//!   reference node hold that degree of freedom for the step (at its value at the step's start;
+//!   `OP=NEW` drops those of earlier steps);
+//! - the loads of the first step are ramped over it when it is static (applied at once when
+//!   dynamic) and held after; later steps must keep them;
+//! - `*DYNAMIC` without `ALPHA` takes the keyword's default `-0.05`;
+//! - `*ELASTIC` is the compressible neo-Hookean solid with the same small-strain moduli;
+//! - rigid membranes and shells are contacted on their mid-surface (zero thickness), rigid
+//!   elements carry no mass (give it with `*MASS` and `*ROTARY INERTIA`);
+//! - lines and quadrilaterals made rigid must form a regular prism (the faceted drum), which is
+//!   treated as axially unbounded, and the slave nodes are checked to lie within its ends;
+//! - a point rotary inertia counts about its body's one free rotation axis;
+//! - general contact makes every node of the part's exterior faces a candidate.
 
+pub mod assemble;
+pub mod fields;
 pub mod keywords;
+pub mod mesh;
+pub mod read;
+pub mod rigid;
+pub mod write;
+
+use std::path::Path;
+
+use keywords::{DeckError, Location, read_deck};
+
+use crate::model_file::ModelSpec;
+
+/// A deck read into a model, with what skid reads differently from the deck's requests.
+#[derive(Clone, Debug)]
+pub struct DeckModel {
+    /// The model.
+    pub model: ModelSpec,
+    /// One note per request skid handles its own way (e.g. output requests), with its line.
+    pub notes: Vec<String>,
+}
+
+/// Whether `path` names a deck (extension `.inp`, any case).
+pub fn is_deck(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("inp"))
+}
+
+/// Reads the deck at `path` (with its includes) into a model named after the file.
+///
+/// # Errors
+/// [`DeckError`] naming the file and line of the first problem.
+pub fn read_model(path: &Path) -> Result<DeckModel, DeckError> {
+    let blocks = read_deck(path)?;
+    let defs = read::read_definitions(&blocks)?;
+    let name = path
+        .file_stem()
+        .map_or_else(|| "deck".to_string(), |s| s.to_string_lossy().into_owned());
+    let deck = Location {
+        file: path.to_path_buf(),
+        line: 1,
+    };
+    let model = assemble::assemble(&defs, &name, &deck)?;
+    Ok(DeckModel {
+        model,
+        notes: defs.notes,
+    })
+}

@@ -9,17 +9,21 @@
 //!   of freedom of its own;
 //! - the back plate: a rigid body whose only free motion is the radial (y) translation.
 
+use std::collections::BTreeMap;
+
 use nalgebra::SVector;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::tetra::TetMesh;
 
+use crate::deck::mesh::ElementKind;
+use crate::deck::write::{RigidElements, write_deck};
 use crate::model_file::spec::ContactPairSpec;
 use crate::model_file::spec::{
     BoundarySpec, Dof, ElementBlockSpec, ElementType, LoadSpec, ModelStepSpec, PartSpec,
     RigidBodySpec, RigidSurfaceSpec, SectionSpec, SlaveSpec, StepBoundarySpec, TieSpec,
 };
 use crate::model_file::{self, MODEL_FORMAT_VERSION, ModelSpec, Scene};
-use crate::schema::{Case, ContactFormulation, DrumSurfaceSpec, StepSpec};
+use crate::schema::{Case, ContactFormulation, DrumSurfaceSpec, FacetElement, StepSpec};
 
 /// Index of the drum among the model's rigid bodies.
 pub const DRUM: usize = 0;
@@ -56,6 +60,49 @@ pub fn model_spec(case: &Case) -> Result<ModelSpec, String> {
         3 => model_spec_in::<3>(case),
         d => Err(format!("dimension must be 2 or 3, got {d}")),
     }
+}
+
+/// The input deck of a validated case: its model file ([`model_spec`]) written with the drum's
+/// own elements (R2D2 lines, R3D4, M3D4R or S4R quadrilaterals across the drum's width, C3D4
+/// tetrahedra) so that the deck describes the idealization, not only its contact surface.
+///
+/// # Errors
+/// A message if the model cannot be generated or written as a deck.
+pub fn deck(case: &Case) -> Result<String, String> {
+    let spec = model_spec(case)?;
+    let half = case.drum.width / 2.0;
+    let elements = match case.drum.surface {
+        DrumSurfaceSpec::Analytic => None,
+        DrumSurfaceSpec::Facets { element, .. } => Some(RigidElements::Facets {
+            kind: match element {
+                FacetElement::R2d2 => ElementKind::R2d2,
+                FacetElement::R3d4 => ElementKind::R3d4,
+                FacetElement::M3d4r => ElementKind::M3d4r,
+                FacetElement::S4r => ElementKind::S4r,
+            },
+            axial_range: [-half, half],
+        }),
+        DrumSurfaceSpec::Tetrahedra {
+            sectors,
+            rings,
+            layers,
+            inner_radius,
+        } => Some(RigidElements::Tetrahedra(
+            TetMesh::annular_drum(
+                case.drum.radius,
+                inner_radius,
+                case.drum.width,
+                [sectors, rings, layers],
+                std::f64::consts::PI / sectors as f64,
+            )
+            .map_err(|e| format!("drum.surface: {e}"))?,
+        )),
+    };
+    let rigid: BTreeMap<String, RigidElements> = elements
+        .into_iter()
+        .map(|e| ("drum".to_string(), e))
+        .collect();
+    write_deck(&spec, &rigid)
 }
 
 fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {

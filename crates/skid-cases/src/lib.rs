@@ -2,9 +2,10 @@
 //!
 //! - [`schema`]: the JSON case-file format;
 //! - [`validate`]: reading a case with field-level error messages and overrides;
-//! - [`deck`]: Abaqus-style input decks (so far their keyword layer);
+//! - [`deck`]: Abaqus-style input decks (the keyword subset of the scenes) read into a model
+//!   file, and models written as decks;
 //! - [`model_file`]: the general model file (any scene) and building it into a model;
-//! - [`drum`]: the drum scene of a case (any idealization, 2D or 3D) as a model file;
+//! - [`drum`]: the drum scene of a case (any idealization, 2D or 3D) as a model file or deck;
 //! - [`history`]: the per-increment history of the drum (`history.csv`);
 //! - [`newton`]: the Newton residuals of every increment (`newton.csv`);
 //! - [`atomic`]: output files that are complete or absent (written aside, then renamed);
@@ -35,7 +36,9 @@ pub mod validate;
 
 pub use batch::{BatchEntry, BatchError, BatchStatus, collect_case_files, run_batch};
 pub use report::{ReportError, ReportOutcome, ReportSources, write_report};
-pub use runner::{RunSummary, default_output_dir, run_case, run_case_file, run_file};
+pub use runner::{
+    RunSummary, default_output_dir, read_deck_model, run_case, run_case_file, run_file,
+};
 pub use schema::Case;
 pub use summary::Summary;
 pub use validate::{CaseError, load_case, parse_case};

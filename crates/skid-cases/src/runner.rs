@@ -16,6 +16,7 @@ use skid_integrator::stepper::{IncrementReport, Observer, run};
 use serde::Serialize;
 
 use crate::atomic::write_atomic;
+use crate::deck::{is_deck, read_model};
 use crate::drum::build;
 use crate::fields::{self, DrumOutline, FieldWriter};
 use crate::history::DrumRecorder;
@@ -62,6 +63,11 @@ pub fn run_file(
     overrides: &[String],
     out_dir: Option<&Path>,
 ) -> Result<RunSummary, CaseError> {
+    if is_deck(path) {
+        let deck = read_deck_model(path, overrides)?;
+        let dir = out_dir.map_or_else(|| Path::new("out").join(&deck.name), Path::to_path_buf);
+        return run_model(&deck, path, &dir).map(RunSummary::Model);
+    }
     // Text that is not a model file (or not text: the case reader names the bad byte's line)
     // is read as a case file.
     let text = match std::fs::read_to_string(path) {
@@ -77,6 +83,22 @@ pub fn run_file(
     let spec = model_file::parse_model(&text, path, overrides)?;
     let dir = out_dir.map_or_else(|| Path::new("out").join(&spec.name), Path::to_path_buf);
     run_model(&spec, path, &dir).map(RunSummary::Model)
+}
+
+/// Reads an input deck into its model with `overrides` applied to the model's fields (as in a
+/// model file); what skid reads differently from the deck's requests is printed to stderr.
+///
+/// # Errors
+/// [`CaseError::Deck`] naming the deck line at fault, or a bad override.
+pub fn read_deck_model(path: &Path, overrides: &[String]) -> Result<ModelSpec, CaseError> {
+    let deck = read_model(path)?;
+    for note in &deck.notes {
+        eprintln!("skid: note: {note}");
+    }
+    if overrides.is_empty() {
+        return Ok(deck.model);
+    }
+    model_file::parse_model(&model_file::to_json(&deck.model), path, overrides)
 }
 
 /// Whether JSON text is a model file; text that is not JSON is left to the parser to report.

@@ -57,6 +57,10 @@ pub enum CaseError {
         /// What is wrong and what was expected.
         message: String,
     },
+    /// An input deck is outside the keyword subset or inconsistent (the error names its file
+    /// and line).
+    #[error("{0}")]
+    Deck(#[from] crate::deck::keywords::DeckError),
     /// The model could not be built.
     #[error("{path}: model: {message}")]
     Model {

@@ -29,10 +29,10 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run one case file or model file; writes history.csv and summary.json, and prints the
-    /// summary as one line of JSON.
+    /// Run one case file, model file or input deck (.inp); writes history.csv and
+    /// summary.json, and prints the summary as one line of JSON.
     Run {
-        /// The case file or model file (JSON).
+        /// The case file or model file (JSON), or the input deck (.inp).
         case: PathBuf,
         /// Output directory [default: out/<case name>].
         #[arg(long)]
@@ -41,14 +41,15 @@ enum Command {
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         overrides: Vec<String>,
     },
-    /// Write the model file of a drum case file (the same run, as a general model).
+    /// Write a case file, model file or deck as a model file (.json) or a deck (.inp), by the
+    /// output's extension: the same run in another form.
     Convert {
-        /// The case file (JSON).
+        /// The case file or model file (JSON), or the input deck (.inp).
         case: PathBuf,
-        /// The model file to write.
+        /// The model file (.json) or deck (.inp) to write.
         #[arg(long, short)]
         out: PathBuf,
-        /// Override a field of the case (repeatable).
+        /// Override a field of the input (repeatable; a deck's fields are its model file's).
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         overrides: Vec<String>,
     },

@@ -1,0 +1,1132 @@
+//! The keyword subset read into definitions that keep the deck's labels and names: model data
+//! before the first `*STEP`, history data in each step. Every keyword and parameter outside the
+//! subset is an error naming its line; [`super::assemble`] turns the definitions into a model.
+
+use std::collections::HashMap;
+
+use super::fields::{
+    allow_parameters, at_most, field, flag, key, label, line_error, real, real_or, required, valued,
+};
+use super::keywords::{Block, DeckError, Location};
+use super::mesh::Mesh;
+use super::rigid::{AnalyticalKind, AnalyticalSurface, read_analytical};
+use crate::schema::MaterialSpec;
+
+/// A face of an element-based surface.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FaceLabel {
+    /// Numbered face `S<k>` of a solid element.
+    Numbered(usize),
+    /// The positive side of a line, membrane, shell or rigid element.
+    Positive,
+    /// Its negative side.
+    Negative,
+    /// No face given: the exterior faces of solid elements, the positive side of others.
+    Exterior,
+}
+
+/// A `*SURFACE`.
+#[derive(Clone, Debug)]
+pub enum SurfaceDef {
+    /// Element faces: element label and face.
+    Faces(Vec<(u64, FaceLabel)>),
+    /// Nodes.
+    Nodes(Vec<u64>),
+    /// An analytical rigid surface.
+    Analytical(AnalyticalSurface),
+}
+
+/// A named definition with its name as written and its keyword line.
+#[derive(Clone, Debug)]
+pub struct Named<T> {
+    /// Name as written.
+    pub name: String,
+    /// The definition.
+    pub value: T,
+    /// Where it is defined.
+    pub location: Location,
+}
+
+/// A `*MATERIAL` and its sub-options.
+#[derive(Clone, Debug, Default)]
+pub struct MaterialDef {
+    /// Constitutive law.
+    pub law: Option<MaterialSpec>,
+    /// Mass density.
+    pub density: Option<f64>,
+}
+
+/// Kinds of section.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SectionKind {
+    /// `*SOLID SECTION`.
+    Solid,
+    /// `*MEMBRANE SECTION`.
+    Membrane,
+    /// `*SHELL SECTION`.
+    Shell,
+}
+
+/// A section: element set, material, thickness.
+#[derive(Clone, Debug)]
+pub struct SectionDef {
+    /// Kind.
+    pub kind: SectionKind,
+    /// Element set name.
+    pub elset: String,
+    /// Material name.
+    pub material: String,
+    /// Thickness (2D out-of-plane, membrane or shell).
+    pub thickness: Option<f64>,
+    /// Where.
+    pub location: Location,
+}
+
+/// A `*RIGID BODY`.
+#[derive(Clone, Debug)]
+pub struct RigidDef {
+    /// Reference node: its label and the name the body takes.
+    pub reference: u64,
+    /// Body name: the reference node set's name, or `body-<label>`.
+    pub name: String,
+    /// Element set made rigid.
+    pub elset: Option<String>,
+    /// Analytical surface carried.
+    pub analytical: Option<String>,
+    /// Node set of the part tied to the body.
+    pub tie: Option<String>,
+    /// Where.
+    pub location: Location,
+}
+
+/// Degrees of freedom (1..=6) held on a node or node set.
+#[derive(Clone, Debug)]
+pub struct BoundaryDef {
+    /// Node label or node set name.
+    pub target: String,
+    /// Degrees of freedom 1..=6.
+    pub dofs: Vec<usize>,
+    /// Where.
+    pub location: Location,
+}
+
+/// An initial condition.
+#[derive(Clone, Debug)]
+pub enum InitialDef {
+    /// `TYPE=VELOCITY`: one component.
+    Velocity {
+        /// Node label or set.
+        target: String,
+        /// Degree of freedom 1..=6.
+        dof: usize,
+        /// Value.
+        value: f64,
+        /// Where.
+        location: Location,
+    },
+    /// `TYPE=ROTATING VELOCITY`: `v = v0 + omega e x (x - a)`, `e = (b - a)/|b - a|`.
+    Rotating {
+        /// Node label or set.
+        target: String,
+        /// Angular speed.
+        omega: f64,
+        /// Translational velocity.
+        velocity: [f64; 3],
+        /// First axis point.
+        a: [f64; 3],
+        /// Second axis point.
+        b: [f64; 3],
+        /// Where.
+        location: Location,
+    },
+}
+
+/// A distributed pressure: on a surface (`*DSLOAD`) or on face `k` of elements (`*DLOAD`).
+#[derive(Clone, Debug)]
+pub struct PressureDef {
+    /// Surface name (`*DSLOAD`) or element label or set (`*DLOAD`).
+    pub target: String,
+    /// Face of `*DLOAD, Pk` (`None` for a surface).
+    pub face: Option<usize>,
+    /// Pressure.
+    pub magnitude: f64,
+    /// Where.
+    pub location: Location,
+}
+
+/// Step procedures.
+#[derive(Clone, Debug)]
+pub enum Procedure {
+    /// `*STATIC, DIRECT`: `initial` increment over `period`.
+    Static {
+        /// Increment.
+        initial: f64,
+        /// Step period.
+        period: f64,
+    },
+    /// `*DYNAMIC, DIRECT`.
+    Dynamic {
+        /// Time increment.
+        dt: f64,
+        /// Duration.
+        period: f64,
+        /// HHT alpha.
+        alpha: f64,
+    },
+}
+
+/// Changes of a step: boundary conditions or loads, with `OP=NEW` (replace) or `OP=MOD`.
+#[derive(Clone, Debug)]
+pub struct Change<T> {
+    /// `OP=NEW`.
+    pub replace: bool,
+    /// Definitions.
+    pub items: Vec<T>,
+}
+
+/// A `*STEP ... *END STEP`.
+#[derive(Clone, Debug)]
+pub struct StepDef {
+    /// Step name.
+    pub name: String,
+    /// Where the `*STEP` line is.
+    pub location: Location,
+    /// Procedure with its keyword line.
+    pub procedure: Option<(Procedure, Location)>,
+    /// Boundary-condition changes in order.
+    pub boundary: Vec<Change<BoundaryDef>>,
+    /// Load changes in order.
+    pub loads: Vec<Change<PressureDef>>,
+    /// `NLGEOM` as given (`None`: absent).
+    pub nlgeom: Option<bool>,
+}
+
+/// General contact: `*CONTACT` with its inclusions and property assignment.
+#[derive(Clone, Debug)]
+pub struct GeneralContactDef {
+    /// `*CONTACT INCLUSIONS, ALL EXTERIOR` given.
+    pub all_exterior: bool,
+    /// Interaction assigned to all pairs.
+    pub interaction: Option<String>,
+    /// Where `*CONTACT` is.
+    pub location: Location,
+}
+
+/// Everything a deck defines, by kind, with its names and lines.
+#[derive(Debug, Default)]
+pub struct Definitions {
+    /// Text of `*HEADING`.
+    pub heading: String,
+    /// Nodes, elements, sets.
+    pub mesh: Mesh,
+    /// Surfaces by key.
+    pub surfaces: HashMap<String, Named<SurfaceDef>>,
+    /// Materials by key.
+    pub materials: HashMap<String, Named<MaterialDef>>,
+    /// Sections in order.
+    pub sections: Vec<SectionDef>,
+    /// Rigid bodies in order.
+    pub rigid_bodies: Vec<RigidDef>,
+    /// `*MASS`: element set and mass.
+    pub masses: Vec<(String, f64, Location)>,
+    /// `*ROTARY INERTIA`: element set and `I11, I22, I33, I12, I13, I23`.
+    pub inertias: Vec<(String, [f64; 6], Location)>,
+    /// Surface interactions by key: friction coefficient (0 without `*FRICTION`).
+    pub interactions: HashMap<String, Named<f64>>,
+    /// `*CONTACT PAIR` lines: interaction, slave surface, master surface.
+    pub pairs: Vec<(String, String, String, Location)>,
+    /// `*CONTACT`.
+    pub general: Option<GeneralContactDef>,
+    /// Model-data boundary conditions.
+    pub boundary: Vec<BoundaryDef>,
+    /// Initial conditions.
+    pub initial: Vec<InitialDef>,
+    /// Amplitudes by key.
+    pub amplitudes: HashMap<String, Location>,
+    /// Steps in order.
+    pub steps: Vec<StepDef>,
+    /// What skid reads differently from the deck's request, one line each with its location.
+    pub notes: Vec<String>,
+}
+
+/// The sub-option context: which keyword the following material or interaction options belong
+/// to.
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum Context {
+    None,
+    Material(String),
+    Interaction(String),
+    Contact,
+}
+
+/// Reads all blocks into [`Definitions`].
+///
+/// # Errors
+/// [`DeckError`] at the first keyword, parameter or data line outside the subset or malformed.
+pub fn read_definitions(blocks: &[Block]) -> Result<Definitions, DeckError> {
+    let mut defs = Definitions::default();
+    let mut context = Context::None;
+    let mut step: Option<StepDef> = None;
+    for block in blocks {
+        if let Some(current) = step.as_mut() {
+            if block.name == "END STEP" {
+                allow_parameters(block, &[])?;
+                defs.steps.extend(step.take());
+                continue;
+            }
+            read_step_block(&mut defs, current, block)?;
+            continue;
+        }
+        context = read_model_block(&mut defs, context, block)?;
+        if block.name == "STEP" {
+            step = Some(start_step(&defs, block)?);
+        }
+    }
+    if let Some(open) = step {
+        return Err(DeckError {
+            location: open.location,
+            message: format!("*STEP {}: no *END STEP closes it", open.name),
+        });
+    }
+    Ok(defs)
+}
+
+fn read_model_block(
+    defs: &mut Definitions,
+    context: Context,
+    block: &Block,
+) -> Result<Context, DeckError> {
+    let sub = |owner: &str| -> Result<String, DeckError> {
+        match (&context, owner) {
+            (Context::Material(m), "MATERIAL") => Ok(m.clone()),
+            (Context::Interaction(i), "SURFACE INTERACTION") => Ok(i.clone()),
+            _ => Err(block.error(format!("must follow a *{owner} and its options"))),
+        }
+    };
+    let mut next = Context::None;
+    match block.name.as_str() {
+        "HEADING" => {
+            allow_parameters(block, &[])?;
+            defs.heading = block
+                .data
+                .iter()
+                .map(|l| l.fields.join(", "))
+                .collect::<Vec<_>>()
+                .join("\n");
+        }
+        "NODE" => defs.mesh.read_nodes(block)?,
+        "ELEMENT" => defs.mesh.read_elements(block)?,
+        "NSET" => defs.mesh.read_set(block, true)?,
+        "ELSET" => defs.mesh.read_set(block, false)?,
+        "SURFACE" => read_surface(defs, block)?,
+        "RIGID BODY" => read_rigid_body(defs, block)?,
+        "MATERIAL" => {
+            allow_parameters(block, &["NAME"])?;
+            let name = required(block, "NAME")?;
+            no_data(block)?;
+            insert_named(&mut defs.materials, block, name, MaterialDef::default())?;
+            next = Context::Material(key(name));
+        }
+        "HYPERELASTIC" | "ELASTIC" | "DENSITY" => {
+            let material = sub("MATERIAL")?;
+            let value = read_material_option(block)?;
+            let def = defs
+                .materials
+                .get_mut(&material)
+                .map(|m| &mut m.value)
+                .ok_or_else(|| block.error("no *MATERIAL open"))?;
+            match value {
+                MaterialOption::Law(law) if def.law.is_none() => def.law = Some(law),
+                MaterialOption::Density(rho) if def.density.is_none() => def.density = Some(rho),
+                _ => return Err(block.error("given twice for this material")),
+            }
+            next = context.clone();
+        }
+        "SOLID SECTION" | "MEMBRANE SECTION" | "SHELL SECTION" => {
+            defs.sections.push(read_section(block)?);
+        }
+        "MASS" | "ROTARY INERTIA" => read_point_inertia(defs, block)?,
+        "SURFACE INTERACTION" => {
+            allow_parameters(block, &["NAME"])?;
+            let name = required(block, "NAME")?;
+            // an optional data line gives the out-of-plane thickness of 2D contact areas,
+            // which node-to-surface forces do not use
+            if block.data.len() > 1 {
+                return Err(
+                    block.error("expected at most one data line (the 2D out-of-plane thickness)")
+                );
+            }
+            insert_named(&mut defs.interactions, block, name, 0.0)?;
+            next = Context::Interaction(key(name));
+        }
+        "FRICTION" => {
+            let interaction = sub("SURFACE INTERACTION")?;
+            allow_parameters(block, &[])?;
+            let [line] = block.data.as_slice() else {
+                return Err(block.error("expected one data line: the friction coefficient"));
+            };
+            at_most(block, line, 1)?;
+            let mu = real(block, line, 0, "friction coefficient")?;
+            if let Some(i) = defs.interactions.get_mut(&interaction) {
+                i.value = mu;
+            }
+        }
+        "CONTACT PAIR" => {
+            allow_parameters(block, &["INTERACTION", "TYPE"])?;
+            if let Some(kind) = valued(block, "TYPE")?
+                && !kind.eq_ignore_ascii_case("NODE TO SURFACE")
+            {
+                return Err(block.error(format!(
+                    "TYPE={kind}: skid's contact is node to surface (TYPE=NODE TO SURFACE)"
+                )));
+            }
+            let interaction = required(block, "INTERACTION")?.to_string();
+            for line in &block.data {
+                at_most(block, line, 2)?;
+                let slave = field(line, 0)
+                    .ok_or_else(|| line_error(block, line, "field 1 (slave surface) is missing"))?;
+                let master = field(line, 1).ok_or_else(|| {
+                    line_error(block, line, "field 2 (master surface) is missing")
+                })?;
+                defs.pairs.push((
+                    interaction.clone(),
+                    slave.to_string(),
+                    master.to_string(),
+                    line.location.clone(),
+                ));
+            }
+        }
+        "CONTACT" => {
+            allow_parameters(block, &[])?;
+            no_data(block)?;
+            if defs.general.is_some() {
+                return Err(block.error("general contact is defined twice"));
+            }
+            defs.general = Some(GeneralContactDef {
+                all_exterior: false,
+                interaction: None,
+                location: block.location.clone(),
+            });
+            next = Context::Contact;
+        }
+        "CONTACT INCLUSIONS" | "CONTACT PROPERTY ASSIGNMENT" => {
+            if context != Context::Contact {
+                return Err(block.error("must follow *CONTACT"));
+            }
+            read_general_option(defs, block)?;
+            next = Context::Contact;
+        }
+        "BOUNDARY" => {
+            allow_parameters(block, &[])?;
+            defs.boundary.extend(read_boundary(block)?);
+        }
+        "INITIAL CONDITIONS" => read_initial(defs, block)?,
+        "AMPLITUDE" => {
+            allow_parameters(block, &["NAME", "DEFINITION", "TIME"])?;
+            let name = required(block, "NAME")?;
+            if defs
+                .amplitudes
+                .insert(key(name), block.location.clone())
+                .is_some()
+            {
+                return Err(block.error(format!("amplitude {name} is defined twice")));
+            }
+        }
+        "STEP" => {}
+        "DSLOAD" | "DLOAD" | "CLOAD" | "STATIC" | "DYNAMIC" | "OUTPUT" | "NODE OUTPUT"
+        | "CONTACT OUTPUT" | "END STEP" => {
+            return Err(block.error("is history data: it belongs inside a *STEP"));
+        }
+        other => return Err(outside_subset(block, other)),
+    }
+    Ok(next)
+}
+
+fn outside_subset(block: &Block, name: &str) -> DeckError {
+    block.error(format!(
+        "keyword *{name} is outside the subset skid reads (see the deck module's documentation)"
+    ))
+}
+
+fn no_data(block: &Block) -> Result<(), DeckError> {
+    match block.data.first() {
+        Some(line) => Err(line_error(block, line, "takes no data lines")),
+        None => Ok(()),
+    }
+}
+
+fn insert_named<T>(
+    map: &mut HashMap<String, Named<T>>,
+    block: &Block,
+    name: &str,
+    value: T,
+) -> Result<(), DeckError> {
+    let named = Named {
+        name: name.trim().to_string(),
+        value,
+        location: block.location.clone(),
+    };
+    if let Some(previous) = map.insert(key(name), named) {
+        return Err(block.error(format!(
+            "{name} is already defined at {}",
+            previous.location
+        )));
+    }
+    Ok(())
+}
+
+enum MaterialOption {
+    Law(MaterialSpec),
+    Density(f64),
+}
+
+/// `*HYPERELASTIC` (`POLYNOMIAL, N=1` or `MOONEY-RIVLIN`: `C10, C01, D1`; `NEO HOOKE`:
+/// `C10, D1`), `*ELASTIC` (`E, nu`, read as the compressible neo-Hookean solid with the same
+/// small-strain shear and bulk moduli: `C10 = E / (4 (1 + nu))`, `C01 = 0`,
+/// `D1 = 6 (1 - 2 nu) / E`), `*DENSITY` (`rho`).
+fn read_material_option(block: &Block) -> Result<MaterialOption, DeckError> {
+    let [line] = block.data.as_slice() else {
+        return Err(block.error("expected one data line"));
+    };
+    match block.name.as_str() {
+        "DENSITY" => {
+            allow_parameters(block, &[])?;
+            at_most(block, line, 1)?;
+            Ok(MaterialOption::Density(real(block, line, 0, "density")?))
+        }
+        "ELASTIC" => {
+            allow_parameters(block, &["TYPE"])?;
+            if let Some(t) = valued(block, "TYPE")?
+                && !t.eq_ignore_ascii_case("ISOTROPIC")
+            {
+                return Err(block.error(format!("TYPE={t}: only ISOTROPIC is read")));
+            }
+            at_most(block, line, 2)?;
+            let e = real(block, line, 0, "Young's modulus")?;
+            let nu = real(block, line, 1, "Poisson's ratio")?;
+            if !(e > 0.0 && nu > -1.0 && nu < 0.5) {
+                return Err(line_error(
+                    block,
+                    line,
+                    format!("expected E > 0 and -1 < nu < 0.5, got E = {e}, nu = {nu}"),
+                ));
+            }
+            Ok(MaterialOption::Law(MaterialSpec::PolynomialN1 {
+                c10: e / (4.0 * (1.0 + nu)),
+                c01: 0.0,
+                d1: 6.0 * (1.0 - 2.0 * nu) / e,
+            }))
+        }
+        _ => {
+            allow_parameters(block, &["POLYNOMIAL", "N", "MOONEY-RIVLIN", "NEO HOOKE"])?;
+            let neo = flag(block, "NEO HOOKE")?;
+            let mooney = flag(block, "MOONEY-RIVLIN")?;
+            let polynomial = flag(block, "POLYNOMIAL")?;
+            if usize::from(neo) + usize::from(mooney) + usize::from(polynomial) != 1 {
+                return Err(block
+                    .error("give exactly one of POLYNOMIAL (with N=1), MOONEY-RIVLIN, NEO HOOKE"));
+            }
+            if polynomial && valued(block, "N")? != Some("1") {
+                return Err(block.error("POLYNOMIAL is read with N=1 only"));
+            }
+            if !polynomial && block.parameter("N").is_some() {
+                return Err(block.error("N= goes with POLYNOMIAL"));
+            }
+            let (c10, c01, d1) = if neo {
+                at_most(block, line, 2)?;
+                (
+                    real(block, line, 0, "C10")?,
+                    0.0,
+                    real(block, line, 1, "D1")?,
+                )
+            } else {
+                at_most(block, line, 3)?;
+                (
+                    real(block, line, 0, "C10")?,
+                    real(block, line, 1, "C01")?,
+                    real(block, line, 2, "D1")?,
+                )
+            };
+            Ok(MaterialOption::Law(MaterialSpec::PolynomialN1 {
+                c10,
+                c01,
+                d1,
+            }))
+        }
+    }
+}
+
+fn read_section(block: &Block) -> Result<SectionDef, DeckError> {
+    let kind = match block.name.as_str() {
+        "SOLID SECTION" => SectionKind::Solid,
+        "MEMBRANE SECTION" => SectionKind::Membrane,
+        _ => SectionKind::Shell,
+    };
+    allow_parameters(block, &["ELSET", "MATERIAL", "OFFSET"])?;
+    if let Some(offset) = valued(block, "OFFSET")?
+        && super::fields::parse_real(offset) != Some(0.0)
+    {
+        return Err(block.error(format!(
+            "OFFSET={offset}: the facets of rigid membranes and shells are contacted on their \
+             mid-surface (zero-thickness surface); offsets are not supported"
+        )));
+    }
+    if kind == SectionKind::Solid && block.parameter("OFFSET").is_some() {
+        return Err(block.error("OFFSET belongs to membrane and shell sections"));
+    }
+    let thickness = match block.data.as_slice() {
+        [] => None,
+        [line] => {
+            at_most(block, line, 1)?;
+            field(line, 0)
+                .map(|_| real(block, line, 0, "thickness"))
+                .transpose()?
+        }
+        _ => return Err(block.error("expected at most one data line (the thickness)")),
+    };
+    Ok(SectionDef {
+        kind,
+        elset: required(block, "ELSET")?.to_string(),
+        material: required(block, "MATERIAL")?.to_string(),
+        thickness,
+        location: block.location.clone(),
+    })
+}
+
+fn read_point_inertia(defs: &mut Definitions, block: &Block) -> Result<(), DeckError> {
+    allow_parameters(block, &["ELSET"])?;
+    let elset = required(block, "ELSET")?.to_string();
+    let [line] = block.data.as_slice() else {
+        return Err(block.error("expected one data line"));
+    };
+    if block.name == "MASS" {
+        at_most(block, line, 1)?;
+        let m = real(block, line, 0, "mass")?;
+        defs.masses.push((elset, m, line.location.clone()));
+    } else {
+        at_most(block, line, 6)?;
+        let mut inertia = [0.0; 6];
+        for (i, v) in inertia.iter_mut().enumerate() {
+            *v = real_or(
+                block,
+                line,
+                i,
+                ["I11", "I22", "I33", "I12", "I13", "I23"][i],
+                0.0,
+            )?;
+        }
+        if line.fields.len() == 1 {
+            // a single value: the planar rotary inertia about z
+            inertia = [0.0, 0.0, inertia[0], 0.0, 0.0, 0.0];
+        }
+        defs.inertias.push((elset, inertia, line.location.clone()));
+    }
+    Ok(())
+}
+
+fn read_surface(defs: &mut Definitions, block: &Block) -> Result<(), DeckError> {
+    let name = required(block, "NAME")?;
+    let kind = valued(block, "TYPE")?
+        .unwrap_or("ELEMENT")
+        .to_ascii_uppercase();
+    let def = match kind.as_str() {
+        "ELEMENT" => {
+            allow_parameters(block, &["NAME", "TYPE"])?;
+            let mut faces = Vec::new();
+            for line in &block.data {
+                at_most(block, line, 2)?;
+                let target = field(line, 0).ok_or_else(|| {
+                    line_error(block, line, "field 1 (element or set) is missing")
+                })?;
+                let elements = defs.mesh.elements_named(target).ok_or_else(|| {
+                    line_error(
+                        block,
+                        line,
+                        format!(
+                            "'{target}' is neither an element nor an element set defined above"
+                        ),
+                    )
+                })?;
+                let face = match field(line, 1).map(str::to_ascii_uppercase) {
+                    None => FaceLabel::Exterior,
+                    Some(f) if f == "SPOS" => FaceLabel::Positive,
+                    Some(f) if f == "SNEG" => FaceLabel::Negative,
+                    Some(f) => f
+                        .strip_prefix('S')
+                        .and_then(|k| k.parse::<usize>().ok())
+                        .filter(|k| (1..=6).contains(k))
+                        .map(FaceLabel::Numbered)
+                        .ok_or_else(|| {
+                            line_error(
+                                block,
+                                line,
+                                format!("field 2: expected a face S1..S6, SPOS or SNEG, got '{f}'"),
+                            )
+                        })?,
+                };
+                faces.extend(elements.into_iter().map(|e| (e, face)));
+            }
+            SurfaceDef::Faces(faces)
+        }
+        "NODE" => {
+            allow_parameters(block, &["NAME", "TYPE"])?;
+            let mut nodes = Vec::new();
+            for line in &block.data {
+                at_most(block, line, 2)?;
+                let target = field(line, 0)
+                    .ok_or_else(|| line_error(block, line, "field 1 (node or set) is missing"))?;
+                nodes.extend(defs.mesh.nodes_named(target).ok_or_else(|| {
+                    line_error(
+                        block,
+                        line,
+                        format!("'{target}' is neither a node nor a node set defined above"),
+                    )
+                })?);
+                if field(line, 1).is_some() && real(block, line, 1, "weight")? != 1.0 {
+                    return Err(line_error(
+                        block,
+                        line,
+                        "node weights other than 1 are not supported",
+                    ));
+                }
+            }
+            SurfaceDef::Nodes(nodes)
+        }
+        "SEGMENTS" => SurfaceDef::Analytical(read_analytical(block, AnalyticalKind::Segments)?),
+        "CYLINDER" => SurfaceDef::Analytical(read_analytical(block, AnalyticalKind::Cylinder)?),
+        "REVOLUTION" => SurfaceDef::Analytical(read_analytical(block, AnalyticalKind::Revolution)?),
+        other => {
+            return Err(block.error(format!(
+                "TYPE={other} is outside the subset (ELEMENT, NODE, SEGMENTS, CYLINDER, REVOLUTION)"
+            )));
+        }
+    };
+    insert_named(&mut defs.surfaces, block, name, def)
+}
+
+fn read_rigid_body(defs: &mut Definitions, block: &Block) -> Result<(), DeckError> {
+    allow_parameters(
+        block,
+        &["REF NODE", "ELSET", "ANALYTICAL SURFACE", "TIE NSET"],
+    )?;
+    no_data(block)?;
+    let reference_text = required(block, "REF NODE")?;
+    let (reference, name) = match super::fields::parse_label(reference_text) {
+        Some(id) => (id, format!("body-{id}")),
+        None => {
+            let set = defs
+                .mesh
+                .node_sets
+                .get(&key(reference_text))
+                .ok_or_else(|| {
+                    block.error(format!(
+                        "REF NODE={reference_text}: no node or node set of that name"
+                    ))
+                })?;
+            let [id] = set.labels.as_slice() else {
+                return Err(block.error(format!(
+                    "REF NODE={reference_text}: the node set must hold exactly one node, it holds {}",
+                    set.labels.len()
+                )));
+            };
+            (*id, set.name.clone())
+        }
+    };
+    if !defs.mesh.nodes.contains_key(&reference) {
+        return Err(block.error(format!("REF NODE: node {reference} is not defined")));
+    }
+    if defs.rigid_bodies.iter().any(|b| b.reference == reference) {
+        return Err(block.error(format!(
+            "node {reference} is already the reference node of another rigid body"
+        )));
+    }
+    defs.rigid_bodies.push(RigidDef {
+        reference,
+        name,
+        elset: valued(block, "ELSET")?.map(str::to_string),
+        analytical: valued(block, "ANALYTICAL SURFACE")?.map(str::to_string),
+        tie: valued(block, "TIE NSET")?.map(str::to_string),
+        location: block.location.clone(),
+    });
+    Ok(())
+}
+
+fn read_general_option(defs: &mut Definitions, block: &Block) -> Result<(), DeckError> {
+    let Some(general) = defs.general.as_mut() else {
+        return Err(block.error("must follow *CONTACT"));
+    };
+    if block.name == "CONTACT INCLUSIONS" {
+        allow_parameters(block, &["ALL EXTERIOR"])?;
+        if !flag(block, "ALL EXTERIOR")? || !block.data.is_empty() {
+            return Err(block.error(
+                "only ALL EXTERIOR (no data lines) is read: general contact between every \
+                 exterior face of the part and every rigid surface",
+            ));
+        }
+        general.all_exterior = true;
+    } else {
+        allow_parameters(block, &[])?;
+        let [line] = block.data.as_slice() else {
+            return Err(block.error("expected one data line: ', , interaction'"));
+        };
+        at_most(block, line, 3)?;
+        if field(line, 0).is_some() || field(line, 1).is_some() {
+            return Err(line_error(
+                block,
+                line,
+                "only the global assignment ', , interaction' (blank surfaces) is read",
+            ));
+        }
+        let interaction = field(line, 2)
+            .ok_or_else(|| line_error(block, line, "field 3 (interaction) is missing"))?;
+        general.interaction = Some(interaction.to_string());
+    }
+    Ok(())
+}
+
+/// Data lines `node or set, first dof[, last dof[, magnitude]]` or `node or set, TYPE` with
+/// `ENCASTRE` (1-6), `PINNED` (1-3), `XSYMM` (1, 5, 6), `YSYMM` (2, 4, 6), `ZSYMM` (3, 4, 5).
+fn read_boundary(block: &Block) -> Result<Vec<BoundaryDef>, DeckError> {
+    let mut out = Vec::new();
+    for line in &block.data {
+        at_most(block, line, 4)?;
+        let target = field(line, 0)
+            .ok_or_else(|| line_error(block, line, "field 1 (node or node set) is missing"))?;
+        let second = field(line, 1)
+            .ok_or_else(|| line_error(block, line, "field 2 (degree of freedom) is missing"))?;
+        let dofs: Vec<usize> = match second.to_ascii_uppercase().as_str() {
+            "ENCASTRE" => (1..=6).collect(),
+            "PINNED" => vec![1, 2, 3],
+            "XSYMM" => vec![1, 5, 6],
+            "YSYMM" => vec![2, 4, 6],
+            "ZSYMM" => vec![3, 4, 5],
+            _ => {
+                let first = label(block, line, 1, "first degree of freedom")? as usize;
+                let last = if field(line, 2).is_some() {
+                    label(block, line, 2, "last degree of freedom")? as usize
+                } else {
+                    first
+                };
+                if !(first <= last && last <= 6) {
+                    return Err(line_error(
+                        block,
+                        line,
+                        format!(
+                            "degrees of freedom {first} to {last}: expected 1 <= first <= last <= 6"
+                        ),
+                    ));
+                }
+                let magnitude = real_or(block, line, 3, "magnitude", 0.0)?;
+                if magnitude != 0.0 {
+                    return Err(line_error(
+                        block,
+                        line,
+                        format!(
+                            "magnitude {magnitude}: prescribed nonzero displacements are not supported yet"
+                        ),
+                    ));
+                }
+                (first..=last).collect()
+            }
+        };
+        out.push(BoundaryDef {
+            target: target.to_string(),
+            dofs,
+            location: line.location.clone(),
+        });
+    }
+    Ok(out)
+}
+
+fn read_initial(defs: &mut Definitions, block: &Block) -> Result<(), DeckError> {
+    allow_parameters(block, &["TYPE", "DEFINITION"])?;
+    let kind = required(block, "TYPE")?.to_ascii_uppercase();
+    if let Some(d) = valued(block, "DEFINITION")?
+        && !d.eq_ignore_ascii_case("COORDINATES")
+    {
+        return Err(block.error(format!("DEFINITION={d}: only COORDINATES is read")));
+    }
+    match kind.as_str() {
+        "VELOCITY" => {
+            for line in &block.data {
+                at_most(block, line, 3)?;
+                let target = field(line, 0)
+                    .ok_or_else(|| line_error(block, line, "field 1 (node or set) is missing"))?;
+                let dof = label(block, line, 1, "degree of freedom")? as usize;
+                if dof > 6 {
+                    return Err(line_error(
+                        block,
+                        line,
+                        format!("degree of freedom {dof}: expected 1 to 6"),
+                    ));
+                }
+                defs.initial.push(InitialDef::Velocity {
+                    target: target.to_string(),
+                    dof,
+                    value: real(block, line, 2, "velocity")?,
+                    location: line.location.clone(),
+                });
+            }
+        }
+        "ROTATING VELOCITY" => {
+            if !block.data.len().is_multiple_of(2) {
+                return Err(block.error(
+                    "expected pairs of data lines: 'node or set, omega, vx, vy, vz' then the \
+                     axis points 'ax, ay, az, bx, by, bz'",
+                ));
+            }
+            for pair in block.data.chunks(2) {
+                let (first, second) = (&pair[0], &pair[1]);
+                at_most(block, first, 5)?;
+                at_most(block, second, 6)?;
+                let target = field(first, 0)
+                    .ok_or_else(|| line_error(block, first, "field 1 (node or set) is missing"))?;
+                let omega = real(block, first, 1, "angular velocity")?;
+                let mut velocity = [0.0; 3];
+                for (i, v) in velocity.iter_mut().enumerate() {
+                    *v = real_or(block, first, 2 + i, ["vx", "vy", "vz"][i], 0.0)?;
+                }
+                let mut axis = [0.0; 6];
+                for (i, v) in axis.iter_mut().enumerate() {
+                    *v = real_or(
+                        block,
+                        second,
+                        i,
+                        ["ax", "ay", "az", "bx", "by", "bz"][i],
+                        0.0,
+                    )?;
+                }
+                defs.initial.push(InitialDef::Rotating {
+                    target: target.to_string(),
+                    omega,
+                    velocity,
+                    a: [axis[0], axis[1], axis[2]],
+                    b: [axis[3], axis[4], axis[5]],
+                    location: first.location.clone(),
+                });
+            }
+        }
+        other => {
+            return Err(block.error(format!(
+                "TYPE={other} is outside the subset (VELOCITY, ROTATING VELOCITY)"
+            )));
+        }
+    }
+    Ok(())
+}
+
+fn start_step(defs: &Definitions, block: &Block) -> Result<StepDef, DeckError> {
+    allow_parameters(block, &["NAME", "NLGEOM", "INC", "AMPLITUDE"])?;
+    if let Some(amplitude) = valued(block, "AMPLITUDE")? {
+        return Err(block.error(format!(
+            "AMPLITUDE={amplitude}: skid ramps loads over the first static step and holds them \
+             after; remove the parameter"
+        )));
+    }
+    if let Some(inc) = valued(block, "INC")?
+        && super::fields::parse_label(inc).is_none()
+    {
+        return Err(block.error(format!("INC={inc}: expected a positive integer")));
+    }
+    let nlgeom = block
+        .parameter("NLGEOM")
+        .map(|_| flag(block, "NLGEOM"))
+        .transpose()?;
+    let name = valued(block, "NAME")?
+        .map_or_else(|| format!("Step-{}", defs.steps.len() + 1), str::to_string);
+    Ok(StepDef {
+        name,
+        location: block.location.clone(),
+        procedure: None,
+        boundary: Vec::new(),
+        loads: Vec::new(),
+        nlgeom,
+    })
+}
+
+fn read_step_block(
+    defs: &mut Definitions,
+    step: &mut StepDef,
+    block: &Block,
+) -> Result<(), DeckError> {
+    let op_new = |block: &Block| -> Result<bool, DeckError> {
+        match valued(block, "OP")? {
+            None => Ok(false),
+            Some(op) if op.eq_ignore_ascii_case("MOD") => Ok(false),
+            Some(op) if op.eq_ignore_ascii_case("NEW") => Ok(true),
+            Some(op) => Err(block.error(format!("OP={op}: expected MOD or NEW"))),
+        }
+    };
+    match block.name.as_str() {
+        "STATIC" | "DYNAMIC" => {
+            if step.procedure.is_some() {
+                return Err(block.error("a step has one procedure"));
+            }
+            let dynamic = block.name == "DYNAMIC";
+            allow_parameters(
+                block,
+                if dynamic {
+                    &["DIRECT", "ALPHA"]
+                } else {
+                    &["DIRECT"]
+                },
+            )?;
+            if !flag(block, "DIRECT")? {
+                return Err(block.error(
+                    "automatic incrementation is not read: add DIRECT (fixed increments of the \
+                     initial size)",
+                ));
+            }
+            let [line] = block.data.as_slice() else {
+                return Err(block.error("expected one data line: 'increment, period'"));
+            };
+            at_most(block, line, 4)?;
+            let increment = real(block, line, 0, "time increment")?;
+            let period = real(block, line, 1, "time period")?;
+            let procedure = if dynamic {
+                Procedure::Dynamic {
+                    dt: increment,
+                    period,
+                    alpha: super::fields::real_parameter(block, "ALPHA")?.unwrap_or(-0.05),
+                }
+            } else {
+                Procedure::Static {
+                    initial: increment,
+                    period,
+                }
+            };
+            step.procedure = Some((procedure, block.location.clone()));
+        }
+        "BOUNDARY" => {
+            allow_parameters(block, &["OP"])?;
+            step.boundary.push(Change {
+                replace: op_new(block)?,
+                items: read_boundary(block)?,
+            });
+        }
+        "DSLOAD" | "DLOAD" => {
+            allow_parameters(block, &["OP"])?;
+            let mut items = Vec::new();
+            for line in &block.data {
+                at_most(block, line, 3)?;
+                let target =
+                    field(line, 0).ok_or_else(|| line_error(block, line, "field 1 is missing"))?;
+                let load = field(line, 1).unwrap_or_default().to_ascii_uppercase();
+                let face = if block.name == "DSLOAD" {
+                    if load != "P" {
+                        return Err(line_error(
+                            block,
+                            line,
+                            format!("load type '{load}': only P (pressure) is read"),
+                        ));
+                    }
+                    None
+                } else {
+                    Some(
+                        load.strip_prefix('P')
+                            .and_then(|k| k.parse::<usize>().ok())
+                            .filter(|k| (1..=6).contains(k))
+                            .ok_or_else(|| {
+                                line_error(
+                                    block,
+                                    line,
+                                    format!("load type '{load}': expected P1..P6 (face pressure)"),
+                                )
+                            })?,
+                    )
+                };
+                items.push(PressureDef {
+                    target: target.to_string(),
+                    face,
+                    magnitude: real(block, line, 2, "magnitude")?,
+                    location: line.location.clone(),
+                });
+            }
+            step.loads.push(Change {
+                replace: op_new(block)?,
+                items,
+            });
+        }
+        "CLOAD" => {
+            return Err(block.error("concentrated loads are not supported yet"));
+        }
+        "OUTPUT" => {
+            allow_parameters(
+                block,
+                &[
+                    "FIELD",
+                    "HISTORY",
+                    "FREQUENCY",
+                    "NUMBER INTERVAL",
+                    "TIME INTERVAL",
+                    "VARIABLE",
+                ],
+            )?;
+            no_data(block)?;
+            if flag(block, "FIELD")? {
+                defs.notes.push(format!(
+                    "{}: *OUTPUT, FIELD: field output of model files is not written yet \
+                     (history.csv and summary.json are)",
+                    block.location
+                ));
+            }
+        }
+        "NODE OUTPUT" | "CONTACT OUTPUT" | "ENERGY OUTPUT" => {
+            allow_parameters(block, &["NSET", "SURFACE", "MASTER", "SLAVE", "VARIABLE"])?;
+            for line in &block.data {
+                if let Some(bad) = line
+                    .fields
+                    .iter()
+                    .find(|f| !f.chars().all(|c| c.is_ascii_alphanumeric()))
+                {
+                    return Err(line_error(
+                        block,
+                        line,
+                        format!("'{bad}' is not an output variable name"),
+                    ));
+                }
+            }
+            defs.notes.push(format!(
+                "{}: *{}: skid writes every body's motion, every contact pair's resultants and the \
+                 energies to history.csv in every increment, whatever is requested",
+                block.location, block.name
+            ));
+        }
+        "STEP" => return Err(block.error("a step cannot start inside another (missing *END STEP)")),
+        other if is_model_keyword(other) => {
+            return Err(block.error("is model data: it belongs before the first *STEP"));
+        }
+        other => return Err(outside_subset(block, other)),
+    }
+    Ok(())
+}
+
+fn is_model_keyword(name: &str) -> bool {
+    matches!(
+        name,
+        "HEADING"
+            | "NODE"
+            | "ELEMENT"
+            | "NSET"
+            | "ELSET"
+            | "SURFACE"
+            | "RIGID BODY"
+            | "MATERIAL"
+            | "HYPERELASTIC"
+            | "ELASTIC"
+            | "DENSITY"
+            | "SOLID SECTION"
+            | "MEMBRANE SECTION"
+            | "SHELL SECTION"
+            | "MASS"
+            | "ROTARY INERTIA"
+            | "SURFACE INTERACTION"
+            | "FRICTION"
+            | "CONTACT PAIR"
+            | "CONTACT"
+            | "CONTACT INCLUSIONS"
+            | "CONTACT PROPERTY ASSIGNMENT"
+            | "INITIAL CONDITIONS"
+            | "AMPLITUDE"
+    )
+}

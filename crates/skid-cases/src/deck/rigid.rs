@@ -1,0 +1,534 @@
+//! Rigid surfaces of a deck in the body frame of their rigid body (origin at the reference
+//! node): analytical surfaces (`*SURFACE, TYPE=SEGMENTS | CYLINDER | REVOLUTION`) and the facets
+//! of rigid elements, each mapped onto the model file's [`RigidSurfaceSpec`] that represents it
+//! exactly, or refused with the reason.
+//!
+//! Orientation (skid's reading of the keyword reference): a 2D profile's outward normal is its
+//! direction of travel turned 90 degrees counter-clockwise, `n = e_z x t` (in the local `x-y`
+//! plane of `TYPE=CYLINDER`, `e_z` its generator; in the `r-z` plane of `TYPE=REVOLUTION`, `r`
+//! playing `x`). A circle contacted from outside is therefore traversed clockwise, and the
+//! cylinder of revolution `r = R` from high to low `z`. The positive side (`SPOS`) of an `R2D2`
+//! line is `e_z x (x_2 - x_1)`, of a quadrilateral the right-hand normal of `1-2-3-4`.
+
+use nalgebra::{Vector2, Vector3};
+use skid_contact::surface::AnalyticCylinder;
+use std::f64::consts::TAU;
+
+use super::fields::{allow_parameters, at_most, field, line_error, real};
+use super::keywords::{Block, DeckError};
+use crate::model_file::spec::RigidSurfaceSpec;
+
+/// One piece of a profile, from the end of the previous one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Piece {
+    /// Straight line to `end`.
+    Line { end: Vector2<f64> },
+    /// Circular arc (under 180 degrees) to `end` about `centre`.
+    Arc {
+        end: Vector2<f64>,
+        centre: Vector2<f64>,
+    },
+}
+
+/// Which analytical surface.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AnalyticalKind {
+    /// 2D profile in global `x-y`.
+    Segments,
+    /// 3D: a local `x-y` profile swept along the local `z` (the generator).
+    Cylinder,
+    /// 3D: an `r-z` profile revolved about the local `z` axis.
+    Revolution,
+}
+
+/// An analytical rigid surface as the deck gives it.
+#[derive(Clone, Debug)]
+pub struct AnalyticalSurface {
+    kind: AnalyticalKind,
+    origin: Vector3<f64>,
+    ex: Vector3<f64>,
+    ey: Vector3<f64>,
+    ez: Vector3<f64>,
+    start: Vector2<f64>,
+    pieces: Vec<Piece>,
+}
+
+/// Reads the data lines of an analytical `*SURFACE` (its `NAME` and `TYPE` parameters are the
+/// caller's).
+///
+/// - `SEGMENTS`: `START, x, y`, then `LINE, x, y` or `CIRCL, x, y, xc, yc` lines.
+/// - `CYLINDER`: `a (3), b (3)` (origin and a point on the local x axis), `c (3)` (a point on
+///   the generator from `a`), then the profile in local `x-y`.
+/// - `REVOLUTION`: `a (3), b (3)` (two points on the symmetry axis), then the profile in
+///   `r-z`.
+pub fn read_analytical(
+    block: &Block,
+    kind: AnalyticalKind,
+) -> Result<AnalyticalSurface, DeckError> {
+    allow_parameters(block, &["NAME", "TYPE", "FILLET RADIUS"])?;
+    if block.parameter("FILLET RADIUS").is_some() {
+        return Err(block.error("FILLET RADIUS is not supported: skid's surfaces have no fillets"));
+    }
+    let mut lines = block.data.iter();
+    let point = |line: &super::keywords::DataLine, first: usize, what: &str| {
+        Ok::<_, DeckError>(Vector3::new(
+            real(block, line, first, &format!("{what} x"))?,
+            real(block, line, first + 1, &format!("{what} y"))?,
+            real(block, line, first + 2, &format!("{what} z"))?,
+        ))
+    };
+    let missing = |what: &str| block.error(format!("expected a data line with {what}"));
+    let (origin, ex, ey, ez) = match kind {
+        AnalyticalKind::Segments => (Vector3::zeros(), Vector3::x(), Vector3::y(), Vector3::z()),
+        AnalyticalKind::Cylinder => {
+            let l1 = lines.next().ok_or_else(|| missing("points a and b"))?;
+            at_most(block, l1, 6)?;
+            let a = point(l1, 0, "a")?;
+            let b = point(l1, 3, "b")?;
+            let l2 = lines.next().ok_or_else(|| missing("point c"))?;
+            at_most(block, l2, 3)?;
+            let c = point(l2, 0, "c")?;
+            let ex = unit(b - a).ok_or_else(|| line_error(block, l1, "points a and b coincide"))?;
+            let ez = unit(c - a).ok_or_else(|| line_error(block, l2, "points a and c coincide"))?;
+            if ex.dot(&ez).abs() > 1e-9 {
+                return Err(line_error(
+                    block,
+                    l2,
+                    "the generator a-c must be perpendicular to the local x axis a-b",
+                ));
+            }
+            (a, ex, ez.cross(&ex), ez)
+        }
+        AnalyticalKind::Revolution => {
+            let l1 = lines.next().ok_or_else(|| missing("points a and b"))?;
+            at_most(block, l1, 6)?;
+            let a = point(l1, 0, "a")?;
+            let b = point(l1, 3, "b")?;
+            let ez = unit(b - a).ok_or_else(|| line_error(block, l1, "points a and b coincide"))?;
+            (a, Vector3::zeros(), Vector3::zeros(), ez)
+        }
+    };
+    let start_line = lines.next().ok_or_else(|| missing("START, x, y"))?;
+    if !field(start_line, 0).is_some_and(|w| w.eq_ignore_ascii_case("START")) {
+        return Err(line_error(block, start_line, "expected START, x, y"));
+    }
+    at_most(block, start_line, 3)?;
+    let start = Vector2::new(
+        real(block, start_line, 1, "start x")?,
+        real(block, start_line, 2, "start y")?,
+    );
+    let mut pieces = Vec::new();
+    for line in lines {
+        let word = field(line, 0).unwrap_or_default().to_ascii_uppercase();
+        let end = || {
+            Ok::<_, DeckError>(Vector2::new(
+                real(block, line, 1, "end x")?,
+                real(block, line, 2, "end y")?,
+            ))
+        };
+        pieces.push(match word.as_str() {
+            "LINE" => {
+                at_most(block, line, 3)?;
+                Piece::Line { end: end()? }
+            }
+            "CIRCL" => {
+                at_most(block, line, 5)?;
+                Piece::Arc {
+                    end: end()?,
+                    centre: Vector2::new(
+                        real(block, line, 3, "centre x")?,
+                        real(block, line, 4, "centre y")?,
+                    ),
+                }
+            }
+            "PARAB" => {
+                return Err(line_error(block, line, "PARAB segments are not supported"));
+            }
+            other => {
+                return Err(line_error(
+                    block,
+                    line,
+                    format!("expected LINE or CIRCL, got '{other}'"),
+                ));
+            }
+        });
+    }
+    if pieces.is_empty() {
+        return Err(block.error("the profile needs at least one LINE or CIRCL after START"));
+    }
+    Ok(AnalyticalSurface {
+        kind,
+        origin,
+        ex,
+        ey,
+        ez,
+        start,
+        pieces,
+    })
+}
+
+fn unit(v: Vector3<f64>) -> Option<Vector3<f64>> {
+    let n = v.norm();
+    (n > 0.0 && n.is_finite()).then(|| v / n)
+}
+
+impl AnalyticalSurface {
+    /// The surface in the frame of a body whose reference node is at `reference`: a closed
+    /// clockwise circle is a [`RigidSurfaceSpec::Cylinder`] about an axis through the
+    /// reference node; a straight profile (lines in one direction) is an unbounded
+    /// [`RigidSurfaceSpec::Plane`] through it; a revolved `r = R` line a cylinder.
+    pub fn spec(&self, reference: &Vector3<f64>) -> Result<RigidSurfaceSpec, String> {
+        match self.kind {
+            AnalyticalKind::Revolution => self.revolution(reference),
+            AnalyticalKind::Segments | AnalyticalKind::Cylinder => self.profile(reference),
+        }
+    }
+
+    /// Global position of local profile point `p` (`SEGMENTS`, `CYLINDER`).
+    fn global(&self, p: &Vector2<f64>) -> Vector3<f64> {
+        self.origin + self.ex * p.x + self.ey * p.y
+    }
+
+    fn profile(&self, reference: &Vector3<f64>) -> Result<RigidSurfaceSpec, String> {
+        let size = self.size();
+        let tol = 1e-9 * size.max(reference.norm());
+        let lines: Vec<Vector2<f64>> = self
+            .pieces
+            .iter()
+            .filter_map(|p| match p {
+                Piece::Line { end } => Some(*end),
+                Piece::Arc { .. } => None,
+            })
+            .collect();
+        let axis_distance = |point: &Vector3<f64>| {
+            let d = point - reference;
+            (d - self.ez * self.ez.dot(&d)).norm()
+        };
+        if lines.len() == self.pieces.len() {
+            // straight profile: every piece in the direction of the first
+            let mut from = self.start;
+            let direction = (lines[0] - self.start)
+                .try_normalize(0.0)
+                .ok_or("the first LINE has zero length")?;
+            for end in &lines {
+                let d = end - from;
+                if d.norm() <= tol || (d.normalize() - direction).norm() > 1e-9 {
+                    return Err(
+                        "a profile of lines must run straight on in one direction (a \
+                                plane); bent profiles are not supported"
+                            .into(),
+                    );
+                }
+                from = *end;
+            }
+            let t = self.ex * direction.x + self.ey * direction.y;
+            let normal = self.ez.cross(&t);
+            let distance = normal.dot(&(self.global(&self.start) - reference));
+            if distance.abs() > tol {
+                return Err(format!(
+                    "the line lies {distance:e} m from the reference node along its normal; \
+                     skid's rigid planes pass through their reference node"
+                ));
+            }
+            return Ok(RigidSurfaceSpec::Plane {
+                normal: normal.into(),
+                tangent: t.into(),
+            });
+        }
+        // circle: arcs about one centre, closing after one clockwise turn
+        let mut from = self.start;
+        let mut turned = 0.0;
+        let mut circle: Option<(Vector2<f64>, f64)> = None;
+        for piece in &self.pieces {
+            let Piece::Arc { end, centre } = piece else {
+                return Err(
+                    "a profile mixing LINE and CIRCL is not supported: give a closed \
+                            circle or straight lines"
+                        .into(),
+                );
+            };
+            let (r0, r1) = ((from - centre).norm(), (end - centre).norm());
+            if (r0 - r1).abs() > tol {
+                return Err(format!(
+                    "an arc's start and end lie at {r0} and {r1} m from its centre"
+                ));
+            }
+            match circle {
+                None => circle = Some((*centre, r0)),
+                Some((c, r)) if (c - centre).norm() > tol || (r - r0).abs() > tol => {
+                    return Err(
+                        "the arcs of a closed profile must share one centre and radius".into(),
+                    );
+                }
+                Some(_) => {}
+            }
+            let a0 = (from - centre).y.atan2((from - centre).x);
+            let a1 = (end - centre).y.atan2((end - centre).x);
+            let mut sweep = a1 - a0;
+            // an arc is under 180 degrees: take the sweep in (-pi, pi]
+            if sweep > TAU / 2.0 {
+                sweep -= TAU;
+            } else if sweep <= -TAU / 2.0 {
+                sweep += TAU;
+            }
+            turned += sweep;
+            from = *end;
+        }
+        let (centre, radius) = circle.ok_or("empty profile")?;
+        if (from - self.start).norm() > tol || ((turned.abs() - TAU).abs() > 1e-9) {
+            return Err(format!(
+                "the arcs must close into one full circle (they turn {:.6} rad and end {:e} m \
+                 from the start)",
+                turned,
+                (from - self.start).norm()
+            ));
+        }
+        if turned > 0.0 {
+            return Err(
+                "the circle is traversed counter-clockwise, so its outward normal \
+                        (direction of travel turned counter-clockwise) points into it; skid's \
+                        circles are contacted from outside: traverse it clockwise"
+                    .into(),
+            );
+        }
+        let offset = axis_distance(&self.global(&centre));
+        if offset > tol {
+            return Err(format!(
+                "the circle's centre lies {offset:e} m off the reference node; skid's rigid \
+                 circles and cylinders are centred on their reference node"
+            ));
+        }
+        Ok(RigidSurfaceSpec::Cylinder {
+            radius,
+            axis: self.ez.into(),
+        })
+    }
+
+    fn revolution(&self, reference: &Vector3<f64>) -> Result<RigidSurfaceSpec, String> {
+        let radius = self.start.x;
+        let tol = 1e-9 * self.size().max(reference.norm());
+        let mut from = self.start;
+        for piece in &self.pieces {
+            let Piece::Line { end } = piece else {
+                return Err(
+                    "a revolved profile must be lines at one radius (a cylinder); \
+                            arcs are not supported"
+                        .into(),
+                );
+            };
+            if (end.x - radius).abs() > tol || end.y >= from.y - tol {
+                return Err(
+                    "a revolved profile must be lines at the one radius r = R, running \
+                            from high to low z (outward normal +r); other surfaces of revolution \
+                            are not supported"
+                        .into(),
+                );
+            }
+            from = *end;
+        }
+        if radius <= 0.0 {
+            return Err(format!("the revolved radius must be > 0, got {radius}"));
+        }
+        let d = self.origin - reference;
+        let offset = (d - self.ez * self.ez.dot(&d)).norm();
+        if offset > tol {
+            return Err(format!(
+                "the axis of revolution passes {offset:e} m from the reference node; skid's \
+                 cylinders turn about their reference node"
+            ));
+        }
+        Ok(RigidSurfaceSpec::Cylinder {
+            radius,
+            axis: self.ez.into(),
+        })
+    }
+
+    fn size(&self) -> f64 {
+        self.pieces
+            .iter()
+            .map(|p| match p {
+                Piece::Line { end } | Piece::Arc { end, .. } => end.norm(),
+            })
+            .fold(self.start.norm() + self.origin.norm(), f64::max)
+    }
+}
+
+/// The rigid surface of facets given outward in skid's convention, in the body frame (2D:
+/// segments whose direction turned clockwise points out; 3D: quadrilaterals counter-clockwise
+/// seen from outside). They must form a regular prism about an axis through the origin: `n`
+/// facets inscribed in one circle, each spanning the same axial range (2D: a regular polygon),
+/// which is the model file's [`RigidSurfaceSpec::FacetedCylinder`]. Returns it with the axial
+/// range (3D) of the facets.
+pub fn prism(
+    facets: &[Vec<Vector3<f64>>],
+    dimension: usize,
+) -> Result<(RigidSurfaceSpec, Option<[f64; 2]>), String> {
+    let n = facets.len();
+    if n < 3 {
+        return Err(format!(
+            "a faceted rigid surface needs at least 3 facets, got {n}"
+        ));
+    }
+    let size = facets
+        .iter()
+        .flatten()
+        .map(|p| p.norm())
+        .fold(0.0, f64::max);
+    let tol = 1e-9 * size;
+    let (axis, range) = if dimension == 2 {
+        (Vector3::z(), None)
+    } else {
+        let normal = |f: &Vec<Vector3<f64>>| (f[2] - f[0]).cross(&(f[3] - f[1]));
+        let n0 = normal(&facets[0]);
+        let axis = facets
+            .iter()
+            .map(|f| n0.cross(&normal(f)))
+            .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+            .and_then(unit)
+            .ok_or("the facets are all parallel: they do not form a prism")?;
+        // the axis's largest component positive
+        let i = axis.iamax();
+        let axis = if axis[i] < 0.0 { -axis } else { axis };
+        let heights: Vec<f64> = facets.iter().flatten().map(|p| p.dot(&axis)).collect();
+        let low = heights.iter().copied().fold(f64::INFINITY, f64::min);
+        let high = heights.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if heights
+            .iter()
+            .any(|h| (h - low).abs() > tol && (h - high).abs() > tol)
+        {
+            return Err("the facets do not all span one axial range: not a single prism".into());
+        }
+        (axis, Some([low, high]))
+    };
+    // in-plane segments, oriented counter-clockwise about the axis
+    let radius = facets
+        .iter()
+        .flatten()
+        .map(|p| (p - axis * axis.dot(p)).norm())
+        .fold(0.0, f64::max);
+    let frame = AnalyticCylinder::new(radius, axis).map_err(|e| e.to_string())?;
+    let b1 = frame.reference_direction();
+    let b2 = axis.cross(&b1);
+    let angle = |p: &Vector3<f64>| b2.dot(p).atan2(b1.dot(p)).rem_euclid(TAU);
+    let step = TAU / n as f64;
+    let mut starts = Vec::with_capacity(n);
+    for (k, f) in facets.iter().enumerate() {
+        let plane: Vec<Vector3<f64>> = f.iter().map(|p| p - axis * axis.dot(p)).collect();
+        for p in &plane {
+            if ((p.norm() - radius).abs()) > tol {
+                return Err(format!(
+                    "facet {k} has a corner at {} m from the axis, not on the circle of radius \
+                     {radius} through the others",
+                    p.norm()
+                ));
+            }
+        }
+        // the two distinct in-plane corners, in the facet's own order
+        let a = plane[0];
+        let b = plane
+            .iter()
+            .copied()
+            .find(|p| (p - a).norm() > tol)
+            .ok_or(format!("facet {k} is degenerate"))?;
+        if plane
+            .iter()
+            .any(|p| (p - a).norm() > tol && (p - b).norm() > tol)
+        {
+            return Err(format!("facet {k} is not parallel to the prism's axis"));
+        }
+        // outward normal of the facet
+        let outward = if dimension == 2 {
+            let t = f[1] - f[0];
+            Vector3::new(t.y, -t.x, 0.0)
+        } else {
+            (f[2] - f[0]).cross(&(f[3] - f[1]))
+        };
+        if outward.dot(&(a + b)) <= 0.0 {
+            return Err(format!(
+                "facet {k}'s normal points towards the axis: skid's faceted rigid surfaces are \
+                 contacted from outside (use the other side, SPOS or SNEG)"
+            ));
+        }
+        let (first, second) = if axis.dot(&a.cross(&b)) > 0.0 {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        let sweep = (angle(&second) - angle(&first)).rem_euclid(TAU);
+        if (sweep - step).abs() > 1e-9 {
+            return Err(format!(
+                "facet {k} spans {sweep:.9} rad; a regular prism of {n} facets spans {step:.9}"
+            ));
+        }
+        starts.push(angle(&first));
+    }
+    starts.sort_by(f64::total_cmp);
+    for (k, pair) in starts.windows(2).enumerate() {
+        if (pair[1] - pair[0] - step).abs() > 1e-9 {
+            return Err(format!(
+                "the facets do not close into one regular polygon (gap after the {k}-th vertex)"
+            ));
+        }
+    }
+    let phase = aligned_phase(starts[0].rem_euclid(step), n);
+    let radius = shortest_decimal(radius);
+    Ok((
+        RigidSurfaceSpec::FacetedCylinder {
+            radius,
+            axis: axis.into(),
+            facets: n,
+            phase,
+        },
+        range,
+    ))
+}
+
+/// The decimal with the fewest significant digits within `1e-15 |v|` of `v` (a deck's
+/// coordinates are roundings of decimal dimensions: a radius recomputed from them is the
+/// dimension up to a few ulps, which this removes).
+fn shortest_decimal(v: f64) -> f64 {
+    (1..=17)
+        .filter_map(|digits| format!("{v:.*e}", digits - 1).parse::<f64>().ok())
+        .find(|d| (d - v).abs() <= 1e-15 * v.abs())
+        .unwrap_or(v)
+}
+
+/// A polygon's first-vertex angle, snapped to the nearest multiple `m pi / (2 n)` (vertex or
+/// facet midpoint on a quarter-facet grid, e.g. the benchmark's `pi / n`) when within
+/// `1e-14` rad: the angle recomputed from rounded vertices is that multiple up to an ulp, and a
+/// faceted drum's spin-down moves by 1e-4 of its stop time for a 1-ulp change of angle or
+/// radius.
+fn aligned_phase(phase: f64, n: usize) -> f64 {
+    let grid = std::f64::consts::PI / (2 * n) as f64;
+    let m = (phase / grid).round();
+    let snapped = m * std::f64::consts::PI / (2 * n) as f64;
+    if (snapped - phase).abs() <= 1e-14 {
+        snapped
+    } else {
+        phase
+    }
+}
+
+/// The rigid surface of triangles given outward (counter-clockwise seen from outside), in the
+/// body frame, with surface coordinates from the cylinder about `axis` through the origin whose
+/// radius reaches the farthest vertex.
+pub fn triangles(
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[usize; 3]>,
+    axis: Vector3<f64>,
+) -> RigidSurfaceSpec {
+    let chart_radius = vertices
+        .iter()
+        .map(|v| {
+            let v = Vector3::from(*v);
+            (v - axis * axis.dot(&v)).norm()
+        })
+        .fold(0.0, f64::max);
+    let chart_radius = shortest_decimal(chart_radius);
+    RigidSurfaceSpec::Triangles {
+        vertices,
+        triangles,
+        chart_radius,
+        chart_axis: axis.into(),
+    }
+}

@@ -1,0 +1,614 @@
+//! A model written as a deck of the keyword subset, which [`super::read_model`] reads back to
+//! the same scene: the part with its sets and surfaces, each rigid body as a reference node with
+//! its point mass and inertia and its surface (analytical, or the rigid elements the caller
+//! gives for faceted and triangulated surfaces), contact, boundary and initial conditions, and
+//! the steps. Numbers are written so that they read back to the same bits.
+//!
+//! Two settings have no keyword and are refused: a static step's regularisation time other
+//! than the default, and adaptive increments. General contact is written as `*CONTACT` with
+//! all exterior faces, so its search distance is not kept (every exterior node becomes a
+//! candidate).
+
+use std::collections::{BTreeMap, HashMap};
+use std::fmt::Write as _;
+
+use nalgebra::Vector3;
+use skid_contact::surface::AnalyticCylinder;
+use skid_fem::tetra::TetMesh;
+
+use super::mesh::ElementKind;
+use crate::model_file::spec::{
+    Dof, LoadSpec, ModelSpec, ModelStepSpec, RigidBodySpec, RigidSurfaceSpec, SlaveSpec,
+};
+use crate::schema::{MaterialSpec, default_regularization_time};
+
+/// Rigid elements that carry a rigid body's faceted or triangulated surface in a deck.
+#[derive(Clone, Debug)]
+pub enum RigidElements {
+    /// The facets of a faceted cylinder as elements of `kind` (R2D2 in 2D; R3D4, M3D4R or S4R
+    /// in 3D) spanning `axial_range` along the axis (3D).
+    Facets {
+        /// Element type.
+        kind: ElementKind,
+        /// Axial extent of the quadrilaterals, body frame (ignored in 2D).
+        axial_range: [f64; 2],
+    },
+    /// A tetrahedral mesh (C3D4) in the body frame whose exterior faces are the surface.
+    Tetrahedra(TetMesh),
+}
+
+/// Numbers as written: the shortest text that reads back to the same bits.
+fn num(v: f64) -> String {
+    format!("{v:?}")
+}
+
+fn list(values: impl IntoIterator<Item = String>) -> String {
+    values.into_iter().collect::<Vec<_>>().join(", ")
+}
+
+/// Writes labels 16 to a line.
+fn label_lines(out: &mut String, labels: impl IntoIterator<Item = usize>) {
+    let labels: Vec<String> = labels.into_iter().map(|l| l.to_string()).collect();
+    for chunk in labels.chunks(16) {
+        let _ = writeln!(out, "{}", chunk.join(", "));
+    }
+}
+
+/// The deck of `spec`; `rigid` gives the elements of bodies (by name) whose surfaces are
+/// faceted or triangulated (a faceted cylinder without them is written as R2D2 in 2D; in 3D
+/// the elements are required).
+///
+/// # Errors
+/// A message naming what the keyword subset cannot express.
+pub fn write_deck(
+    spec: &ModelSpec,
+    rigid: &BTreeMap<String, RigidElements>,
+) -> Result<String, String> {
+    let dim = spec.dimension;
+    let part = &spec.part;
+    let mut out = String::new();
+    let _ = writeln!(out, "*HEADING");
+    for line in spec.description.lines().filter(|l| !l.trim().is_empty()) {
+        let _ = writeln!(out, "{}", line.replace('*', " "));
+    }
+    let _ = writeln!(
+        out,
+        "** Model '{}', written by skid: `skid run` reads it.",
+        spec.name
+    );
+    if part.section.hourglass_scale != 1.0 || part.section.quasi_static {
+        return Err("part.section: hourglass_scale and quasi_static have no keyword".into());
+    }
+    // part
+    let _ = writeln!(out, "**\n** deformable part '{}'\n*NODE", part.name);
+    for (i, x) in part.nodes.iter().enumerate() {
+        let _ = writeln!(out, "{}, {}", i + 1, list(x.iter().map(|v| num(*v))));
+    }
+    let kind = if dim == 2 { "CPE4R" } else { "C3D8R" };
+    let _ = writeln!(out, "*ELEMENT, TYPE={kind}, ELSET={}", part.name);
+    let mut elements = Vec::new();
+    for block in &part.elements {
+        elements.extend(block.connectivity.iter().cloned());
+    }
+    for (e, nodes) in elements.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "{}, {}",
+            e + 1,
+            list(nodes.iter().map(|n| (n + 1).to_string()))
+        );
+    }
+    for (name, nodes) in &part.node_sets {
+        let _ = writeln!(out, "*NSET, NSET={name}");
+        label_lines(&mut out, nodes.iter().map(|n| n + 1));
+    }
+    let solid = if dim == 2 {
+        ElementKind::Cpe4r
+    } else {
+        ElementKind::C3d8r
+    };
+    let mut face_of: HashMap<Vec<usize>, (usize, usize)> = HashMap::new();
+    for (e, nodes) in elements.iter().enumerate() {
+        for k in 1..=solid.face_count() {
+            if let Some(corners) = solid.face(k) {
+                let mut key: Vec<usize> = corners.iter().map(|&c| nodes[c]).collect();
+                key.sort_unstable();
+                face_of.insert(key, (e + 1, k));
+            }
+        }
+    }
+    for (name, faces) in &part.surfaces {
+        let _ = writeln!(out, "*SURFACE, NAME={name}, TYPE=ELEMENT");
+        for face in faces {
+            let mut key = face.clone();
+            key.sort_unstable();
+            let (e, k) = face_of.get(&key).ok_or(format!(
+                "part.surfaces.{name}: a face is not a face of an element"
+            ))?;
+            let _ = writeln!(out, "{e}, S{k}");
+        }
+    }
+    let material = format!("{}-material", part.name);
+    let _ = writeln!(
+        out,
+        "*SOLID SECTION, ELSET={}, MATERIAL={material}",
+        part.name
+    );
+    if dim == 2 {
+        let _ = writeln!(out, "{}", num(part.section.thickness));
+    }
+    let _ = writeln!(out, "*MATERIAL, NAME={material}");
+    match &part.section.material {
+        MaterialSpec::PolynomialN1 { c10, c01, d1 } => {
+            let _ = writeln!(
+                out,
+                "*HYPERELASTIC, POLYNOMIAL, N=1\n{}, {}, {}",
+                num(*c10),
+                num(*c01),
+                num(*d1)
+            );
+        }
+    }
+    let _ = writeln!(out, "*DENSITY\n{}", num(part.section.density));
+
+    // rigid bodies
+    let mut next_node = part.nodes.len() + 1;
+    let mut next_element = elements.len() + 1;
+    let fixed = |body: &str| -> Vec<Dof> {
+        spec.boundary
+            .iter()
+            .filter(|b| b.body.as_deref() == Some(body))
+            .flat_map(|b| b.dofs.iter().copied())
+            .collect()
+    };
+    for body in &spec.rigid_bodies {
+        let reference = next_node;
+        next_node += 1;
+        let _ = writeln!(
+            out,
+            "**\n** rigid body '{}'\n*NODE, NSET={}",
+            body.name, body.name
+        );
+        let _ = writeln!(
+            out,
+            "{reference}, {}",
+            list(body.reference_point.iter().map(|v| num(*v)))
+        );
+        point_inertia(&mut out, body, reference, &mut next_element, dim);
+        let ties: Vec<&str> = spec
+            .ties
+            .iter()
+            .filter(|t| t.body == body.name)
+            .map(|t| t.node_set.as_str())
+            .collect();
+        let tie = match ties.as_slice() {
+            [] => String::new(),
+            [one] => format!(", TIE NSET={one}"),
+            many => {
+                let name = format!("{}-tie", body.name);
+                let _ = writeln!(out, "*NSET, NSET={name}\n{}", many.join(", "));
+                format!(", TIE NSET={name}")
+            }
+        };
+        let c = embed(&body.reference_point);
+        let carrier = match &body.surface {
+            None => String::new(),
+            Some(surface) => surface_deck(
+                &mut out,
+                spec,
+                body,
+                surface,
+                rigid.get(&body.name),
+                &c,
+                (&mut next_node, &mut next_element),
+            )?,
+        };
+        let _ = writeln!(out, "*RIGID BODY, REF NODE={}{carrier}{tie}", body.name);
+    }
+
+    // contact
+    let mut general = Vec::new();
+    for pair in &spec.contact {
+        match &pair.slave {
+            SlaveSpec::NodeSet { name } => {
+                let _ = writeln!(
+                    out,
+                    "**\n*SURFACE INTERACTION, NAME={0}\n*FRICTION\n{1}\n*SURFACE, NAME={0}-slave, TYPE=NODE\n{name}\n*CONTACT PAIR, INTERACTION={0}\n{0}-slave, {2}",
+                    pair.name,
+                    num(pair.mu),
+                    pair.master
+                );
+            }
+            SlaveSpec::General { .. } => general.push(pair),
+        }
+    }
+    if let Some(first) = general.first() {
+        if general.iter().any(|p| p.mu != first.mu) {
+            return Err("general contact pairs with different friction have no keyword".into());
+        }
+        let _ = writeln!(
+            out,
+            "**\n*SURFACE INTERACTION, NAME={0}\n*FRICTION\n{1}\n*CONTACT\n*CONTACT INCLUSIONS, ALL EXTERIOR\n*CONTACT PROPERTY ASSIGNMENT\n, , {0}",
+            first.name,
+            num(first.mu)
+        );
+    }
+
+    // boundary and initial conditions
+    if !spec.boundary.is_empty() {
+        let _ = writeln!(out, "**\n*BOUNDARY");
+        for bc in &spec.boundary {
+            let target = bc
+                .body
+                .as_deref()
+                .or(bc.node_set.as_deref())
+                .unwrap_or_default();
+            for dof in &bc.dofs {
+                let k = dof_number(*dof);
+                let _ = writeln!(out, "{target}, {k}, {k}");
+            }
+        }
+    }
+    for body in &spec.rigid_bodies {
+        initial_conditions(&mut out, body, dim);
+    }
+
+    // steps
+    for (i, step) in spec.steps.iter().enumerate() {
+        let (name, boundary) = match step {
+            ModelStepSpec::Static { name, boundary, .. }
+            | ModelStepSpec::Dynamic { name, boundary, .. } => (name, boundary),
+        };
+        let _ = writeln!(out, "**\n*STEP, NAME={name}, NLGEOM=YES");
+        match step {
+            ModelStepSpec::Static {
+                increments,
+                regularization_time,
+                ..
+            } => {
+                if *regularization_time != default_regularization_time() {
+                    return Err(format!("steps[{i}].regularization_time has no keyword"));
+                }
+                let _ = writeln!(
+                    out,
+                    "*STATIC, DIRECT\n{}, 1.0",
+                    num(1.0 / *increments as f64)
+                );
+            }
+            ModelStepSpec::Dynamic {
+                duration,
+                dt,
+                alpha,
+                adaptive,
+                ..
+            } => {
+                if adaptive.is_some() {
+                    return Err(format!("steps[{i}].adaptive has no keyword in the subset"));
+                }
+                let _ = writeln!(
+                    out,
+                    "*DYNAMIC, DIRECT, ALPHA={}\n{}, {}",
+                    num(*alpha),
+                    num(*dt),
+                    num(*duration)
+                );
+            }
+        }
+        let _ = writeln!(
+            out,
+            "{}",
+            if i == 0 {
+                "*BOUNDARY"
+            } else {
+                "*BOUNDARY, OP=NEW"
+            }
+        );
+        for hold in boundary {
+            let held = fixed(&hold.body);
+            let dofs: Vec<Dof> = match &hold.dofs {
+                Some(d) => d.clone(),
+                None => Dof::all(dim)
+                    .iter()
+                    .copied()
+                    .filter(|d| !held.contains(d))
+                    .collect(),
+            };
+            for dof in dofs {
+                let k = dof_number(dof);
+                let _ = writeln!(out, "{}, {k}, {k}", hold.body);
+            }
+        }
+        if i == 0 && !spec.loads.is_empty() {
+            let _ = writeln!(out, "*DSLOAD");
+            for load in &spec.loads {
+                let LoadSpec::Pressure { surface, pressure } = load;
+                let _ = writeln!(out, "{surface}, P, {}", num(*pressure));
+            }
+        }
+        let _ = writeln!(out, "*END STEP");
+    }
+    Ok(out)
+}
+
+/// A point of 2 or 3 coordinates in 3D (z = 0 in 2D).
+fn embed(x: &[f64]) -> Vector3<f64> {
+    Vector3::from_iterator(x.iter().copied().chain(std::iter::repeat(0.0)).take(3))
+}
+
+fn dof_number(dof: Dof) -> usize {
+    match dof {
+        Dof::X => 1,
+        Dof::Y => 2,
+        Dof::Z => 3,
+        Dof::Rx => 4,
+        Dof::Ry => 5,
+        Dof::Rz => 6,
+    }
+}
+
+/// `MASS` and `ROTARYI` elements at the reference node (3D: an isotropic inertia, so that it
+/// counts the same about whichever axis the body turns).
+fn point_inertia(
+    out: &mut String,
+    body: &RigidBodySpec,
+    reference: usize,
+    next_element: &mut usize,
+    dim: usize,
+) {
+    if body.mass > 0.0 {
+        let _ = writeln!(
+            out,
+            "*ELEMENT, TYPE=MASS, ELSET={0}-mass\n{1}, {reference}\n*MASS, ELSET={0}-mass\n{2}",
+            body.name,
+            next_element,
+            num(body.mass)
+        );
+        *next_element += 1;
+    }
+    if body.rotary_inertia > 0.0 {
+        let i = num(body.rotary_inertia);
+        let values = if dim == 2 {
+            i
+        } else {
+            format!("{i}, {i}, {i}")
+        };
+        let _ = writeln!(
+            out,
+            "*ELEMENT, TYPE=ROTARYI, ELSET={0}-inertia\n{1}, {reference}\n*ROTARY INERTIA, ELSET={0}-inertia\n{values}",
+            body.name, next_element
+        );
+        *next_element += 1;
+    }
+}
+
+/// Writes the surface of `body` (centred at `c`) and returns the `*RIGID BODY` parameter that
+/// attaches it.
+#[allow(clippy::too_many_arguments)]
+fn surface_deck(
+    out: &mut String,
+    spec: &ModelSpec,
+    body: &RigidBodySpec,
+    surface: &RigidSurfaceSpec,
+    elements: Option<&RigidElements>,
+    c: &Vector3<f64>,
+    (next_node, next_element): (&mut usize, &mut usize),
+) -> Result<String, String> {
+    let dim = spec.dimension;
+    let name = &body.name;
+    let p = |v: &Vector3<f64>| list(v.iter().take(dim).map(|x| num(*x)));
+    match surface {
+        RigidSurfaceSpec::Cylinder { radius, axis } => {
+            let r = *radius;
+            if dim == 2 {
+                let _ = writeln!(
+                    out,
+                    "*SURFACE, NAME={name}, TYPE=SEGMENTS\nSTART, {}, {}",
+                    num(c.x + r),
+                    num(c.y)
+                );
+                for (x, y) in [
+                    (c.x, c.y - r),
+                    (c.x - r, c.y),
+                    (c.x, c.y + r),
+                    (c.x + r, c.y),
+                ] {
+                    let _ = writeln!(
+                        out,
+                        "CIRCL, {}, {}, {}, {}",
+                        num(x),
+                        num(y),
+                        num(c.x),
+                        num(c.y)
+                    );
+                }
+            } else {
+                let e = Vector3::from(*axis).normalize();
+                let reach = spec
+                    .part
+                    .nodes
+                    .iter()
+                    .map(|x| (embed(x) - c).norm())
+                    .fold(r, f64::max);
+                let h = 2.0 * reach;
+                let _ = writeln!(
+                    out,
+                    "*SURFACE, NAME={name}, TYPE=REVOLUTION\n{}, {}\nSTART, {}, {}\nLINE, {}, {}",
+                    list(c.iter().map(|x| num(*x))),
+                    list((c + e).iter().map(|x| num(*x))),
+                    num(r),
+                    num(h),
+                    num(r),
+                    num(-h)
+                );
+            }
+            Ok(format!(", ANALYTICAL SURFACE={name}"))
+        }
+        RigidSurfaceSpec::Plane { normal, tangent } => {
+            let (n, t) = (Vector3::from(*normal), Vector3::from(*tangent));
+            let reach = spec
+                .part
+                .nodes
+                .iter()
+                .map(|x| (embed(x) - c).norm())
+                .fold(1.0, f64::max);
+            let l = 2.0 * reach;
+            if dim == 2 {
+                // travel along t whose counter-clockwise normal is n
+                let t = if Vector3::z().cross(&t).dot(&n) > 0.0 {
+                    t
+                } else {
+                    -t
+                };
+                let (a, b) = (c - t * l, c + t * l);
+                let _ = writeln!(
+                    out,
+                    "*SURFACE, NAME={name}, TYPE=SEGMENTS\nSTART, {}\nLINE, {}",
+                    p(&a),
+                    p(&b)
+                );
+            } else {
+                let generator = c + t.cross(&n);
+                let _ = writeln!(
+                    out,
+                    "*SURFACE, NAME={name}, TYPE=CYLINDER\n{}, {}\n{}\nSTART, {}, 0.0\nLINE, {}, 0.0",
+                    list(c.iter().map(|x| num(*x))),
+                    list((c + t).iter().map(|x| num(*x))),
+                    list(generator.iter().map(|x| num(*x))),
+                    num(-l),
+                    num(l)
+                );
+            }
+            Ok(format!(", ANALYTICAL SURFACE={name}"))
+        }
+        RigidSurfaceSpec::FacetedCylinder {
+            radius,
+            axis,
+            facets,
+            phase,
+        } => {
+            let (kind, range) = match elements {
+                Some(RigidElements::Facets { kind, axial_range }) => (*kind, *axial_range),
+                None if dim == 2 => (ElementKind::R2d2, [0.0, 0.0]),
+                _ => {
+                    return Err(format!(
+                        "rigid body {name}: a 3D faceted cylinder is written with its elements and \
+                         axial range"
+                    ));
+                }
+            };
+            let e = Vector3::from(*axis).normalize();
+            let frame = AnalyticCylinder::new(*radius, e).map_err(|err| err.to_string())?;
+            let b1 = frame.reference_direction();
+            let b2 = e.cross(&b1);
+            let n = *facets;
+            let vertex = |k: usize| {
+                let a = phase + std::f64::consts::TAU * k as f64 / n as f64;
+                c + (b1 * a.cos() + b2 * a.sin()) * *radius
+            };
+            let first = *next_node;
+            let _ = writeln!(out, "*NODE");
+            let rings: &[f64] = if dim == 2 { &[0.0] } else { &range };
+            for h in rings {
+                for k in 0..n {
+                    let _ = writeln!(out, "{}, {}", *next_node, p(&(vertex(k) + e * *h)));
+                    *next_node += 1;
+                }
+            }
+            let type_name = match kind {
+                ElementKind::R2d2 => "R2D2",
+                ElementKind::R3d4 => "R3D4",
+                ElementKind::M3d4r => "M3D4R",
+                ElementKind::S4r => "S4R",
+                other => return Err(format!("{other:?} elements cannot carry facets")),
+            };
+            let elset = format!("{name}-facets");
+            let _ = writeln!(out, "*ELEMENT, TYPE={type_name}, ELSET={elset}");
+            for k in 0..n {
+                let next = (k + 1) % n;
+                let nodes = if dim == 2 {
+                    // SPOS (e_z x t) outward: clockwise travel
+                    vec![first + next, first + k]
+                } else {
+                    vec![first + k, first + next, first + n + next, first + n + k]
+                };
+                let _ = writeln!(
+                    out,
+                    "{}, {}",
+                    *next_element,
+                    list(nodes.iter().map(|v| v.to_string()))
+                );
+                *next_element += 1;
+            }
+            if matches!(kind, ElementKind::M3d4r | ElementKind::S4r) {
+                let section = if kind == ElementKind::M3d4r {
+                    "MEMBRANE"
+                } else {
+                    "SHELL"
+                };
+                let _ = writeln!(
+                    out,
+                    "** rigid: the section's thickness and elasticity are not used\n*{section} SECTION, ELSET={elset}, MATERIAL={name}-material\n0.001\n*MATERIAL, NAME={name}-material\n*ELASTIC\n2.0e11, 0.3\n*DENSITY\n0.0"
+                );
+            }
+            let _ = writeln!(out, "*SURFACE, NAME={name}, TYPE=ELEMENT\n{elset}, SPOS");
+            Ok(format!(", ELSET={elset}"))
+        }
+        RigidSurfaceSpec::Triangles { .. } => {
+            let Some(RigidElements::Tetrahedra(mesh)) = elements else {
+                return Err(format!(
+                    "rigid body {name}: a triangulated surface is written with its tetrahedra"
+                ));
+            };
+            let first = *next_node;
+            let _ = writeln!(out, "*NODE");
+            for x in &mesh.nodes {
+                let _ = writeln!(out, "{}, {}", *next_node, p(&(x + c)));
+                *next_node += 1;
+            }
+            let elset = format!("{name}-tets");
+            let _ = writeln!(out, "*ELEMENT, TYPE=C3D4, ELSET={elset}");
+            for t in &mesh.tets {
+                let _ = writeln!(
+                    out,
+                    "{}, {}",
+                    *next_element,
+                    list(t.iter().map(|v| (first + v).to_string()))
+                );
+                *next_element += 1;
+            }
+            let _ = writeln!(
+                out,
+                "** rigid: the section's elasticity is not used\n*SOLID SECTION, ELSET={elset}, MATERIAL={name}-material\n*MATERIAL, NAME={name}-material\n*ELASTIC\n2.0e11, 0.3\n*DENSITY\n0.0\n*SURFACE, NAME={name}, TYPE=ELEMENT\n{elset}"
+            );
+            Ok(format!(", ELSET={elset}"))
+        }
+    }
+}
+
+fn initial_conditions(out: &mut String, body: &RigidBodySpec, dim: usize) {
+    let v = body.initial_velocity.clone().unwrap_or_default();
+    let w = body.initial_angular_velocity.unwrap_or([0.0; 3]);
+    let w = Vector3::from(w);
+    if w.norm() > 0.0 {
+        let c = embed(&body.reference_point);
+        let e = w.normalize();
+        let mut velocity = [0.0; 3];
+        for (i, x) in v.iter().enumerate() {
+            velocity[i] = *x;
+        }
+        let _ = writeln!(
+            out,
+            "*INITIAL CONDITIONS, TYPE=ROTATING VELOCITY\n{}, {}, {}\n{}, {}",
+            body.name,
+            num(w.norm()),
+            list(velocity.iter().map(|x| num(*x))),
+            list(c.iter().map(|x| num(*x))),
+            list((c + e).iter().map(|x| num(*x)))
+        );
+    } else if v.iter().any(|x| *x != 0.0) {
+        let _ = writeln!(out, "*INITIAL CONDITIONS, TYPE=VELOCITY");
+        for (i, x) in v.iter().enumerate().take(dim) {
+            let _ = writeln!(out, "{}, {}, {}", body.name, i + 1, num(*x));
+        }
+    }
+}
