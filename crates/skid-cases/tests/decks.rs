@@ -1,0 +1,332 @@
+//! Input decks: the eight shipped drum decks are what the drum generator writes and run to the
+//! same history as their case files, bit for bit; a deck written by hand in the usual keyword
+//! style reads to the drum's model; rigid surfaces are recognised exactly or refused with the
+//! reason; every keyword, parameter or value outside the subset is an error at its line.
+
+use std::path::{Path, PathBuf};
+
+use skid_cases::csv_out::CsvTable;
+use skid_cases::deck::read_model;
+use skid_cases::drum::{deck, model_spec};
+use skid_cases::model_file::spec::{ModelStepSpec, RigidSurfaceSpec, SlaveSpec};
+use skid_cases::runner::run_model;
+use skid_cases::{RunSummary, load_case, run_file};
+
+fn repo(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(path)
+}
+
+const DRUM_DECKS: [&str; 8] = [
+    "2d-analytic",
+    "2d-r2d2",
+    "3d-analytic",
+    "3d-analytic-general",
+    "3d-r3d4",
+    "3d-m3d4r",
+    "3d-s4r",
+    "3d-c3d4",
+];
+
+/// Every column of a history file, as text.
+fn history(dir: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let path = dir.join("history.csv");
+    let text = std::fs::read_to_string(&path).expect("read history");
+    let table = CsvTable::new(&text, &path).expect("csv header");
+    let header = table.header().map(String::from).collect();
+    let rows = table
+        .map(|row| row.expect("csv row").fields().map(String::from).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn shipped_drum_decks_are_what_the_generator_writes() {
+    for name in DRUM_DECKS {
+        let case = load_case(&repo(&format!("cases/drum/{name}.json")), &[]).expect("case");
+        let written = deck(&case).expect("deck");
+        let shipped =
+            std::fs::read_to_string(repo(&format!("cases/inp/{name}.inp"))).expect("shipped deck");
+        assert_eq!(
+            written, shipped,
+            "cases/inp/{name}.inp is stale: regenerate it with `skid convert cases/drum/{name}.json -o cases/inp/{name}.inp`"
+        );
+    }
+}
+
+/// The first 2 ms of spin-down (20 increments after the preload) of each deck and of its case
+/// file: every history column identical, string for string.
+#[test]
+fn drum_decks_run_to_the_histories_of_their_case_files() {
+    let scratch = tempfile::tempdir().expect("tempdir");
+    let short = ["steps[1].duration=0.002".to_string()];
+    for name in DRUM_DECKS {
+        let deck_dir = scratch.path().join(format!("{name}-deck"));
+        let case_dir = scratch.path().join(format!("{name}-case"));
+        let deck_run = run_file(
+            &repo(&format!("cases/inp/{name}.inp")),
+            &short,
+            Some(&deck_dir),
+        )
+        .expect("deck run");
+        // the case file's scene run as a model file, whose history has the generic columns
+        let case = load_case(&repo(&format!("cases/drum/{name}.json")), &short).expect("case");
+        let case_run = run_model(
+            &model_spec(&case).expect("model"),
+            Path::new(name),
+            &case_dir,
+        )
+        .map(RunSummary::Model)
+        .expect("case run");
+        assert!(matches!(deck_run, RunSummary::Model(_)));
+        assert!(
+            deck_run.error().is_none() && case_run.error().is_none(),
+            "{name}"
+        );
+        let (deck_header, deck_rows) = history(&deck_dir);
+        let (case_header, case_rows) = history(&case_dir);
+        assert_eq!(deck_rows.len(), case_rows.len(), "{name}: increments");
+        assert!(deck_rows.len() > 20, "{name}: {} rows", deck_rows.len());
+        let mut compared = 0;
+        for (j, column) in case_header.iter().enumerate() {
+            let Some(i) = deck_header.iter().position(|c| c == column) else {
+                continue;
+            };
+            compared += 1;
+            for (d, c) in deck_rows.iter().zip(&case_rows) {
+                assert_eq!(d[i], c[j], "{name}: column {column}");
+            }
+        }
+        assert_eq!(
+            compared,
+            case_header.len(),
+            "{name}: columns {deck_header:?}"
+        );
+    }
+}
+
+#[test]
+fn a_deck_written_by_hand_reads_to_the_drum_model() {
+    let hand = read_model(&repo("cases/inp/2d-analytic-by-hand.inp")).expect("deck");
+    let twin = model_spec(&load_case(&repo("cases/drum/2d-analytic.json"), &[]).expect("case"))
+        .expect("model");
+    let (m, t) = (&hand.model, &twin);
+    assert_eq!(m.dimension, 2);
+    assert_eq!(m.part.nodes.len(), t.part.nodes.len());
+    for (a, b) in m.part.nodes.iter().zip(&t.part.nodes) {
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() <= 1e-15, "node {a:?} vs {b:?}");
+        }
+    }
+    assert_eq!(m.part.elements, t.part.elements);
+    assert_eq!(m.part.section, t.part.section);
+    // the generated sets, the included mesh's set and the surfaces
+    assert_eq!(m.part.node_sets["front"], t.part.node_sets["ymin"]);
+    assert_eq!(m.part.node_sets["back"], t.part.node_sets["ymax"]);
+    assert_eq!(m.part.surfaces["pad_back"], t.part.surfaces["ymax"]);
+    let drum = &m.rigid_bodies[0];
+    assert_eq!(drum.name, "drum_ref");
+    assert_eq!((drum.mass, drum.rotary_inertia), (5.0, 0.175));
+    assert_eq!(
+        drum.surface,
+        Some(RigidSurfaceSpec::Cylinder {
+            radius: 0.2,
+            axis: [0.0, 0.0, 1.0]
+        })
+    );
+    assert_eq!(drum.initial_angular_velocity, Some([0.0, 0.0, 60.0]));
+    assert_eq!(m.rigid_bodies[1].reference_point, vec![0.0, 0.25]);
+    assert_eq!(m.ties[0].node_set, "back");
+    assert_eq!(
+        m.loads,
+        t.loads
+            .iter()
+            .map(|l| {
+                let mut l = l.clone();
+                let skid_cases::model_file::spec::LoadSpec::Pressure { surface, .. } = &mut l;
+                *surface = "pad_back".into();
+                l
+            })
+            .collect::<Vec<_>>()
+    );
+    let pair = &m.contact[0];
+    assert_eq!((pair.name.as_str(), pair.mu), ("pad-drum", 0.15));
+    let SlaveSpec::NodeSet { name } = &pair.slave else {
+        panic!("slave {:?}", pair.slave);
+    };
+    assert_eq!(m.part.node_sets[name], t.part.node_sets["ymin"]);
+    match (&m.steps[0], &m.steps[1]) {
+        (
+            ModelStepSpec::Static {
+                increments,
+                boundary,
+                ..
+            },
+            ModelStepSpec::Dynamic {
+                duration,
+                dt,
+                alpha,
+                boundary: dynamic_boundary,
+                ..
+            },
+        ) => {
+            assert_eq!(*increments, 5);
+            assert_eq!(boundary.len(), 1);
+            assert_eq!((*duration, *dt, *alpha), (0.15, 1e-4, -0.3));
+            assert!(dynamic_boundary.is_empty());
+        }
+        other => panic!("steps {other:?}"),
+    }
+    // the output request is not silently ignored
+    assert!(
+        hand.notes.iter().any(|n| n.contains("*NODE OUTPUT")),
+        "{:?}",
+        hand.notes
+    );
+}
+
+/// Writes `text` as a deck in a scratch directory and reads it.
+fn read_text(text: &str) -> Result<skid_cases::deck::DeckModel, String> {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("scene.inp");
+    std::fs::write(&path, text).expect("write deck");
+    read_model(&path).map_err(|e| e.to_string())
+}
+
+/// The hand-written drum deck with `from` replaced by `to` (which must occur).
+fn variant(from: &str, to: &str) -> Result<skid_cases::deck::DeckModel, String> {
+    let mesh = std::fs::read_to_string(repo("cases/inp/2d-pad-mesh.inp")).expect("mesh");
+    let deck = std::fs::read_to_string(repo("cases/inp/2d-analytic-by-hand.inp")).expect("deck");
+    let deck = deck.replace("*include, input=2d-pad-mesh.inp\n", &mesh);
+    assert!(deck.contains(from), "{from}");
+    let deck = deck.replacen(from, to, 1);
+    read_text(&deck)
+}
+
+#[test]
+fn keywords_parameters_and_values_outside_the_subset_are_errors_at_their_line() {
+    let cases: [(&str, &str, &[&str]); 12] = [
+        (
+            "*Density\n",
+            "*Plastic\n 1.\n*Density\n",
+            &["scene.inp:", "*PLASTIC", "outside the subset"],
+        ),
+        (
+            "*Friction\n",
+            "*Friction, rough\n",
+            &["*FRICTION", "ROUGH", "outside the keyword subset"],
+        ),
+        (
+            "type=cpe4r",
+            "type=cpe4",
+            &["TYPE=cpe4", "full integration is not implemented"],
+        ),
+        (
+            " 0.15\n*Contact Pair",
+            " fifteen\n*Contact Pair",
+            &["*FRICTION", "field 1", "'fifteen'"],
+        ),
+        (
+            "drum_ref, 1, 2",
+            "drum_ref, 1, 9",
+            &["*BOUNDARY", "expected 1 <= first <= last <= 6"],
+        ),
+        (
+            "drum_ref, 6, 6\n*Dsload",
+            "drum_ref, 6, 6, 0.1\n*Dsload",
+            &["magnitude 0.1", "not supported yet"],
+        ),
+        ("*Static, direct", "*Static", &["*STATIC", "add DIRECT"]),
+        (
+            "*End Step\n**\n*Step, name=spin-down",
+            "**\n*Step, name=spin-down",
+            &["cannot start inside another"],
+        ),
+        ("nlgeom=yes\n*Static", "nlgeom=no\n*Static", &["NLGEOM=YES"]),
+        (
+            "*Dsload\n",
+            "*Cload\nplate, 2, -1.\n*Dsload\n",
+            &["*CLOAD", "concentrated loads are not supported yet"],
+        ),
+        (
+            "pad_back, P, 0.35e6",
+            "pad_back, P, 0.35e6\n*Dsload\nnowhere, P, 1.",
+            &["*DSLOAD", "no surface named nowhere"],
+        ),
+        (
+            "drum_ref, 60., 0., 0., 0.\n 0., 0., 0., 0., 0., 1.\n",
+            "front, 1, 3.\n",
+            &["*INITIAL CONDITIONS", "pairs of data lines"],
+        ),
+    ];
+    for (from, to, expected) in cases {
+        let message = variant(from, to).expect_err(to);
+        for fragment in expected {
+            assert!(message.contains(fragment), "'{to}': {message}");
+        }
+    }
+}
+
+#[test]
+fn a_circle_traversed_counter_clockwise_faces_inwards_and_is_refused() {
+    let message = variant(
+        "START,  0.2,  0.\nCIRCL,  0., -0.2, 0., 0.\nCIRCL, -0.2,  0., 0., 0.\nCIRCL,  0.,  0.2, 0., 0.\nCIRCL,  0.2,  0., 0., 0.",
+        "START,  0.2,  0.\nCIRCL,  0., 0.2, 0., 0.\nCIRCL, -0.2,  0., 0., 0.\nCIRCL,  0.,  -0.2, 0., 0.\nCIRCL,  0.2,  0., 0., 0.",
+    )
+    .expect_err("inward circle");
+    assert!(
+        message.contains("*SURFACE drum") && message.contains("traverse it clockwise"),
+        "{message}"
+    );
+    let message =
+        variant("CIRCL,  0.2,  0., 0., 0.", "CIRCL,  0.1,  0.1, 0., 0.").expect_err("open circle");
+    assert!(message.contains("lie at"), "{message}");
+}
+
+/// Rigid line elements: a regular polygon is the faceted drum, whatever its orientation in
+/// the plane; a polygon with a short facet or facing inwards is refused.
+#[test]
+fn rigid_lines_form_a_regular_polygon_or_are_refused() {
+    let polygon = |n: usize, phase: f64, inward: bool, squash: f64| {
+        let mut text = String::from("*Node\n");
+        for k in 0..n {
+            let a = phase + std::f64::consts::TAU * k as f64 / n as f64;
+            let r = if k == 1 { 0.2 * squash } else { 0.2 };
+            text.push_str(&format!(
+                "{}, {:?}, {:?}\n",
+                3001 + k,
+                r * a.cos(),
+                r * a.sin()
+            ));
+        }
+        text.push_str("*Element, type=R2D2, elset=facets\n");
+        for k in 0..n {
+            let (a, b) = (3001 + k, 3001 + (k + 1) % n);
+            let (a, b) = if inward { (a, b) } else { (b, a) };
+            text.push_str(&format!("{}, {a}, {b}\n", 4001 + k));
+        }
+        text.push_str("*Surface, name=drum, type=element\nfacets, SPOS\n*Rigid Body, ref node=drum_ref, elset=facets");
+        text
+    };
+    let analytic = "*Surface, name=drum, type=segments\nSTART,  0.2,  0.\nCIRCL,  0., -0.2, 0., 0.\nCIRCL, -0.2,  0., 0., 0.\nCIRCL,  0.,  0.2, 0., 0.\nCIRCL,  0.2,  0., 0., 0.\n*Rigid Body, ref node=drum_ref, analytical surface=drum";
+    let model = variant(analytic, &polygon(24, 0.3, false, 1.0)).expect("regular polygon");
+    match &model.model.rigid_bodies[0].surface {
+        Some(RigidSurfaceSpec::FacetedCylinder {
+            radius,
+            facets,
+            phase,
+            axis,
+        }) => {
+            assert!((radius - 0.2).abs() < 1e-15);
+            assert_eq!((*facets, *axis), (24, [0.0, 0.0, 1.0]));
+            let step = std::f64::consts::TAU / 24.0;
+            assert!((phase - 0.3 % step).abs() < 1e-12, "phase {phase}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let message = variant(analytic, &polygon(24, 0.3, true, 1.0)).expect_err("inward");
+    assert!(message.contains("contacted from outside"), "{message}");
+    let message = variant(analytic, &polygon(24, 0.3, false, 0.9)).expect_err("squashed");
+    assert!(message.contains("not on the circle"), "{message}");
+}
