@@ -64,9 +64,13 @@ pub fn run_file(
     out_dir: Option<&Path>,
 ) -> Result<RunSummary, CaseError> {
     if is_deck(path) {
-        let deck = read_deck_model(path, overrides)?;
-        let dir = out_dir.map_or_else(|| Path::new("out").join(&deck.name), Path::to_path_buf);
-        return run_model(&deck, path, &dir).map(RunSummary::Model);
+        let (spec, notes) = read_deck_model(path, overrides)?;
+        let dir = out_dir.map_or_else(|| Path::new("out").join(&spec.name), Path::to_path_buf);
+        let summary = run_model(&spec, path, &dir)?;
+        for note in &notes {
+            eprintln!("skid: note: {note}");
+        }
+        return Ok(RunSummary::Model(summary));
     }
     // Text that is not a model file (or not text: the case reader names the bad byte's line)
     // is read as a case file.
@@ -86,19 +90,20 @@ pub fn run_file(
 }
 
 /// Reads an input deck into its model with `overrides` applied to the model's fields (as in a
-/// model file); what skid reads differently from the deck's requests is printed to stderr.
+/// model file), with the notes on what skid reads differently from the deck's requests.
 ///
 /// # Errors
 /// [`CaseError::Deck`] naming the deck line at fault, or a bad override.
-pub fn read_deck_model(path: &Path, overrides: &[String]) -> Result<ModelSpec, CaseError> {
+pub fn read_deck_model(
+    path: &Path,
+    overrides: &[String],
+) -> Result<(ModelSpec, Vec<String>), CaseError> {
     let deck = read_model(path)?;
-    for note in &deck.notes {
-        eprintln!("skid: note: {note}");
-    }
     if overrides.is_empty() {
-        return Ok(deck.model);
+        return Ok((deck.model, deck.notes));
     }
-    model_file::parse_model(&model_file::to_json(&deck.model), path, overrides)
+    let model = model_file::parse_model(&model_file::to_json(&deck.model), path, overrides)?;
+    Ok((model, deck.notes))
 }
 
 /// Whether JSON text is a model file; text that is not JSON is left to the parser to report.

@@ -46,7 +46,10 @@ fn convert(input: &Path, overrides: &[String], to_deck: bool) -> Result<String, 
                 "{shown}: is already a deck; write a model file (.json)"
             ));
         }
-        let spec = read_deck_model(input, overrides).map_err(|e| e.to_string())?;
+        let (spec, notes) = read_deck_model(input, overrides).map_err(|e| e.to_string())?;
+        for note in notes {
+            eprintln!("skid: note: {note}");
+        }
         return Ok(to_json(&spec));
     }
     let text = std::fs::read_to_string(input).map_err(|e| format!("{shown}: cannot read: {e}"))?;

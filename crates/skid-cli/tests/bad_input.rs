@@ -65,7 +65,7 @@ fn any_file_named(dir: &Path, name: &str) -> bool {
 
 #[test]
 fn every_case_file_of_the_corpus_has_its_expected_message() {
-    for case in files_with("json") {
+    for case in files_with("json").into_iter().chain(files_with("inp")) {
         assert!(
             case.with_extension("expect").exists(),
             "{} has no .expect",

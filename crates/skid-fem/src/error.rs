@@ -43,7 +43,10 @@ pub enum FemError {
         corner: Option<usize>,
     },
     /// The reference geometry has a non-positive (or non-finite) Jacobian determinant.
-    #[error("degenerate reference element: det J = {det_j}")]
+    #[error(
+        "degenerate reference element: det J = {det_j} (negative: corners in the wrong order, \
+         counter-clockwise expected; zero: a repeated or collinear corner)"
+    )]
     DegenerateElement {
         /// Jacobian determinant of the isoparametric map at the offending point.
         det_j: f64,

@@ -191,6 +191,7 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
             })
         })
         .collect::<Result<Vec<_>, DeckError>>()?;
+    check_held_ties(defs, &part, &bodies)?;
     let (steps, loads) = steps(defs, &part, &bodies, &mut part_spec, deck)?;
     Ok(ModelSpec {
         skid_model: MODEL_FORMAT_VERSION,
@@ -478,6 +479,14 @@ fn rigid_bodies(defs: &Definitions, part: &Part) -> Result<Vec<Body>, DeckError>
                     format!("*RIGID BODY: no element set named {elset}"),
                 )
             })?;
+            if elements.is_empty() {
+                return Err(error(
+                    &def.location,
+                    format!(
+                        "*RIGID BODY: ELSET={elset} holds no elements, so the body has no nodes"
+                    ),
+                ));
+            }
             for e in elements {
                 let kind = defs.mesh.elements[&e].kind;
                 if kind.is_solid() {
@@ -658,6 +667,33 @@ fn apply_model_boundary(
             node_set: Some(name),
             dofs,
         });
+    }
+    Ok(())
+}
+
+/// Refuses a model-data boundary condition on a part node that a `TIE NSET` ties to a rigid
+/// body: the tied node moves with the body, so holding it contradicts the tie.
+fn check_held_ties(defs: &Definitions, part: &Part, bodies: &[Body]) -> Result<(), DeckError> {
+    for body in bodies {
+        let Some(tie) = &body.def.tie else { continue };
+        let tied = defs.mesh.nodes_named(tie).unwrap_or_default();
+        for bc in &defs.boundary {
+            let held = defs.mesh.nodes_named(&bc.target).unwrap_or_default();
+            if let Some(n) = held
+                .iter()
+                .find(|n| part.number.contains_key(n) && tied.contains(n))
+            {
+                return Err(error(
+                    &bc.location,
+                    format!(
+                        "*BOUNDARY: node {n} is held here and tied to rigid body {} by TIE \
+                         NSET={tie} (a tied node moves with its body): hold the body's reference \
+                         node instead",
+                        body.def.name
+                    ),
+                ));
+            }
+        }
     }
     Ok(())
 }

@@ -701,6 +701,17 @@ fn read_surface(defs: &mut Definitions, block: &Block) -> Result<(), DeckError> 
             )));
         }
     };
+    let empty = match &def {
+        SurfaceDef::Faces(faces) => faces.is_empty(),
+        SurfaceDef::Nodes(nodes) => nodes.is_empty(),
+        SurfaceDef::Analytical(_) => false,
+    };
+    if empty {
+        return Err(block.error(format!(
+            "surface {name} has no {}: give its elements or nodes on data lines",
+            if kind == "NODE" { "nodes" } else { "faces" }
+        )));
+    }
     insert_named(&mut defs.surfaces, block, name, def)
 }
 
