@@ -330,3 +330,136 @@ fn rigid_lines_form_a_regular_polygon_or_are_refused() {
     let message = variant(analytic, &polygon(24, 0.3, false, 0.9)).expect_err("squashed");
     assert!(message.contains("not on the circle"), "{message}");
 }
+
+/// A faceted drum narrower than the pad: the prism has no ends, so slave nodes beyond its
+/// facets are refused rather than contacted by an unbounded prism.
+#[test]
+fn slave_nodes_beyond_a_faceted_drum_are_refused() {
+    let deck = std::fs::read_to_string(repo("cases/inp/3d-r3d4.inp")).expect("deck");
+    let narrow = deck
+        .replace(", -0.075\n", ", -0.01\n")
+        .replace(", 0.075\n", ", 0.01\n");
+    assert_ne!(narrow, deck);
+    let message = read_text(&narrow).expect_err("narrow drum");
+    assert!(message.contains("beyond its facets"), "{message}");
+    // the quadrilaterals' other side faces the axis
+    let inward = deck.replace("drum-facets, SPOS", "drum-facets, SNEG");
+    let message = read_text(&inward).expect_err("inward facets");
+    assert!(message.contains("contacted from outside"), "{message}");
+}
+
+/// A block on a rigid line: a straight SEGMENTS profile is a plane through the reference node
+/// with its normal on the left of the travel, `*ELASTIC` gives the neo-Hookean moduli, `*DLOAD`
+/// a face surface, `TYPE=VELOCITY` the body's initial velocity, `ENCASTRE` the held degrees of
+/// freedom; the model runs.
+#[test]
+fn a_block_on_a_rigid_line_maps_every_keyword_onto_the_model() {
+    let deck = "\
+*Heading
+block on a rigid line
+*Node
+1, -0.01, 0.
+2, 0.01, 0.
+3, 0.01, 0.02
+4, -0.01, 0.02
+*Element, type=CPE4R, elset=block
+1, 1, 2, 3, 4
+*Nset, nset=bottom
+1, 2
+*Surface, name=bottom, type=node
+bottom
+*Solid Section, elset=block, material=soft
+0.01
+*Material, name=soft
+*Elastic
+1.0e6, 0.3
+*Density
+1000.
+*Node, nset=ground
+10, 0., 0.
+** travelled towards -x, the normal (travel turned counter-clockwise) points down
+*Surface, name=ground, type=segments
+START, 1., 0.
+LINE, -1., 0.
+*Rigid Body, ref node=ground, analytical surface=ground
+*Element, type=MASS, elset=ground_mass
+20, 10
+*Mass, elset=ground_mass
+0.05
+*Surface Interaction, name=rough
+*Friction
+0.3
+*Contact Pair, interaction=rough
+bottom, ground
+*Boundary
+ground, 2, 2
+ground, 6, 6
+*Initial Conditions, type=velocity
+ground, 1, 0.5
+*Step, name=press, nlgeom
+*Static, direct
+0.25, 1.
+*Dload
+block, P3, 1.e4
+*Boundary
+ground, ENCASTRE
+*End Step
+";
+    let down = read_text(deck).expect("line facing down").model;
+    assert_eq!(
+        down.rigid_bodies[0].surface,
+        Some(RigidSurfaceSpec::Plane {
+            normal: [0.0, -1.0, 0.0],
+            tangent: [-1.0, 0.0, 0.0]
+        })
+    );
+    // ... so the ground contacted from above is traversed towards +x
+    let deck = deck.replace(
+        "START, 1., 0.\nLINE, -1., 0.",
+        "START, -1., 0.\nLINE, 1., 0.",
+    );
+    let read = read_text(&deck);
+    let model = read.expect("block deck").model;
+    let ground = &model.rigid_bodies[0];
+    assert_eq!(
+        ground.surface,
+        Some(RigidSurfaceSpec::Plane {
+            normal: [0.0, 1.0, 0.0],
+            tangent: [1.0, 0.0, 0.0]
+        })
+    );
+    assert_eq!(
+        (ground.mass, ground.initial_velocity.clone()),
+        (0.05, Some(vec![0.5, 0.0]))
+    );
+    let (e, nu) = (1.0e6_f64, 0.3_f64);
+    assert_eq!(
+        model.part.section.material,
+        skid_cases::schema::MaterialSpec::PolynomialN1 {
+            c10: e / (4.0 * (1.0 + nu)),
+            c01: 0.0,
+            d1: 6.0 * (1.0 - 2.0 * nu) / e,
+        }
+    );
+    // face S3 of the quad is its top edge, listed outward
+    assert_eq!(model.part.surfaces["block-P3"], vec![vec![2, 3]]);
+    match &model.steps[0] {
+        ModelStepSpec::Static {
+            increments,
+            boundary,
+            ..
+        } => {
+            assert_eq!(*increments, 4);
+            // ENCASTRE on a 2D body: x (y and rz are held by the model data)
+            assert_eq!(
+                boundary[0].dofs,
+                Some(vec![skid_cases::model_file::spec::Dof::X])
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let summary =
+        skid_cases::runner::run_model(&model, Path::new("block.inp"), dir.path()).expect("runs");
+    assert!(summary.error.is_none(), "{:?}", summary.error);
+}
