@@ -1,5 +1,5 @@
-//! Running many case files in parallel, each into `<out>/<case name>/`, and recording the
-//! outcome of every one in `<out>/batch.json`.
+//! Running many case files, model files and input decks in parallel, each into
+//! `<out>/<name>/`, and recording the outcome of every one in `<out>/batch.json`.
 //!
 //! A case that cannot be read or built, or whose run stops early, is recorded as such and does
 //! not stop the others.
@@ -12,9 +12,10 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::atomic::write_atomic;
-use crate::runner::run_case;
+use crate::deck::is_deck;
+use crate::model_file::{ModelSpec, is_model_file, parse_model};
+use crate::runner::{RunSummary, read_deck_model, run_case, run_model};
 use crate::schema::Case;
-use crate::summary::Summary;
 use crate::validate::load_case;
 
 /// How one case of a batch ended.
@@ -60,7 +61,10 @@ pub struct BatchEntry {
     /// How it ended.
     pub status: BatchStatus,
     /// The run summary, if the run started.
-    pub summary: Option<Summary>,
+    pub summary: Option<RunSummary>,
+    /// What skid read differently from a deck's requests (empty for JSON files).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
     /// Why the case could not be run, or why the run stopped early.
     pub error: Option<String>,
     /// Wall time spent on the case (loading, building, running, writing), s.
@@ -79,7 +83,7 @@ pub enum BatchError {
         source: std::io::Error,
     },
     /// No case file was found in the inputs.
-    #[error("no case files (*.json) in {0}")]
+    #[error("no case files, model files or decks (*.json, *.inp) in {0}")]
     NoCases(String),
     /// The worker threads could not be started.
     #[error("cannot start {jobs} worker threads: {source}")]
@@ -99,8 +103,8 @@ pub enum BatchError {
     },
 }
 
-/// Expands `paths` into case files: a file is taken as is, a directory contributes its `*.json`
-/// files sorted by name.
+/// Expands `paths` into input files: a file is taken as is, a directory contributes its
+/// `*.json` and `*.inp` files sorted by name.
 ///
 /// # Errors
 /// [`BatchError::List`] for a directory that cannot be read, [`BatchError::NoCases`] if nothing
@@ -116,7 +120,9 @@ pub fn collect_case_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, BatchError>
             let mut found = Vec::new();
             for entry in std::fs::read_dir(path).map_err(list)? {
                 let file = entry.map_err(list)?.path();
-                if file.is_file() && file.extension().is_some_and(|e| e == "json") {
+                if file.is_file()
+                    && (file.extension().is_some_and(|e| e == "json") || is_deck(&file))
+                {
                     found.push(file);
                 }
             }
@@ -133,8 +139,26 @@ pub fn collect_case_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, BatchError>
     Ok(files)
 }
 
-/// A case file after loading: the case, or the entry recording why it cannot run.
-type Loaded = Result<Case, BatchEntry>;
+/// A file after loading: what it runs, with its name and notes.
+#[derive(Clone, Debug)]
+enum Input {
+    /// A drum case file.
+    Case(Case),
+    /// A model file or a deck, read into a model.
+    Model(ModelSpec, Vec<String>),
+}
+
+impl Input {
+    fn name(&self) -> &str {
+        match self {
+            Self::Case(case) => &case.name,
+            Self::Model(spec, _) => &spec.name,
+        }
+    }
+}
+
+/// A file after loading: its input, or the entry recording why it cannot run.
+type Loaded = Result<Input, BatchEntry>;
 
 fn error_entry(file: &Path, name: String, error: String, started: Instant) -> BatchEntry {
     BatchEntry {
@@ -142,13 +166,33 @@ fn error_entry(file: &Path, name: String, error: String, started: Instant) -> Ba
         name,
         status: BatchStatus::Error,
         summary: None,
+        notes: Vec::new(),
         error: Some(error),
         wall_time_s: started.elapsed().as_secs_f64(),
     }
 }
 
-/// Loads every file; a case whose name an earlier file already uses cannot run (both would
-/// write the same output directory).
+/// Reads a deck, a model file (JSON declaring `skid_model`) or a case file.
+fn load(file: &Path) -> Result<Input, String> {
+    if is_deck(file) {
+        return read_deck_model(file, &[])
+            .map(|(spec, notes)| Input::Model(spec, notes))
+            .map_err(|e| e.to_string());
+    }
+    if let Ok(text) = std::fs::read_to_string(file)
+        && serde_json::from_str::<serde_json::Value>(&text).is_ok_and(|v| is_model_file(&v))
+    {
+        return parse_model(&text, file, &[])
+            .map(|spec| Input::Model(spec, Vec::new()))
+            .map_err(|e| e.to_string());
+    }
+    load_case(file, &[])
+        .map(Input::Case)
+        .map_err(|e| e.to_string())
+}
+
+/// Loads every file; one whose name an earlier file already uses cannot run (both would write
+/// the same output directory).
 fn load_all(files: &[PathBuf]) -> Vec<(PathBuf, Loaded)> {
     let mut owners: HashMap<String, PathBuf> = HashMap::new();
     files
@@ -159,20 +203,25 @@ fn load_all(files: &[PathBuf]) -> Vec<(PathBuf, Loaded)> {
                 || file.display().to_string(),
                 |s| s.to_string_lossy().into(),
             );
-            let loaded = match load_case(file, &[]) {
-                Err(e) => Err(error_entry(file, stem, e.to_string(), started)),
-                Ok(case) => match owners.get(&case.name) {
+            let loaded = match load(file) {
+                Err(e) => Err(error_entry(file, stem, e, started)),
+                Ok(input) => match owners.get(input.name()) {
                     Some(owner) => {
                         let message = format!(
-                            "case name '{}' is already used by {}",
-                            case.name,
+                            "name '{}' is already used by {}",
+                            input.name(),
                             owner.display()
                         );
-                        Err(error_entry(file, case.name.clone(), message, started))
+                        Err(error_entry(
+                            file,
+                            input.name().to_string(),
+                            message,
+                            started,
+                        ))
                     }
                     None => {
-                        owners.insert(case.name.clone(), file.clone());
-                        Ok(case)
+                        owners.insert(input.name().to_string(), file.clone());
+                        Ok(input)
                     }
                 },
             };
@@ -181,29 +230,49 @@ fn load_all(files: &[PathBuf]) -> Vec<(PathBuf, Loaded)> {
         .collect()
 }
 
-fn run_one(file: &Path, case: &Case, out: &Path) -> BatchEntry {
+fn run_one(file: &Path, input: &Input, out: &Path) -> BatchEntry {
     let started = Instant::now();
-    match run_case(case, file, &out.join(&case.name)) {
-        Ok(summary) => BatchEntry {
-            case_file: file.to_path_buf(),
-            name: case.name.clone(),
-            status: match (&summary.error, case.expect.failure) {
-                (None, _) => BatchStatus::Completed,
-                (Some(_), Some(expected)) if expected.matches(summary.failure.as_deref()) => {
-                    BatchStatus::FailedAsExpected
-                }
-                (Some(_), _) => BatchStatus::Failed,
-            },
-            error: summary.error.clone(),
-            summary: Some(summary),
-            wall_time_s: started.elapsed().as_secs_f64(),
-        },
-        Err(e) => error_entry(file, case.name.clone(), e.to_string(), started),
+    let name = input.name().to_string();
+    let dir = out.join(&name);
+    let (result, expected, notes) = match input {
+        Input::Case(case) => (
+            run_case(case, file, &dir).map(RunSummary::Case),
+            case.expect.failure,
+            Vec::new(),
+        ),
+        Input::Model(spec, notes) => (
+            run_model(spec, file, &dir).map(RunSummary::Model),
+            None,
+            notes.clone(),
+        ),
+    };
+    match result {
+        Ok(summary) => {
+            let failure = match &summary {
+                RunSummary::Case(s) => s.failure.clone(),
+                RunSummary::Model(s) => s.failure.clone(),
+            };
+            BatchEntry {
+                case_file: file.to_path_buf(),
+                name,
+                status: match (summary.error(), expected) {
+                    (None, _) => BatchStatus::Completed,
+                    (Some(_), Some(expected)) if expected.matches(failure.as_deref()) => {
+                        BatchStatus::FailedAsExpected
+                    }
+                    (Some(_), _) => BatchStatus::Failed,
+                },
+                error: summary.error().map(str::to_string),
+                summary: Some(summary),
+                notes,
+                wall_time_s: started.elapsed().as_secs_f64(),
+            }
+        }
+        Err(e) => error_entry(file, name, e.to_string(), started),
     }
 }
 
-/// Runs every case file on a pool of `jobs` threads (0: one per core), each into
-/// `<out>/<case name>/`, calls `progress` as each case ends, and writes `<out>/batch.json`.
+/// Runs every file on a pool of `jobs` threads (0: one per core), each into `<out>/<name>/`, calls `progress` as each case ends, and writes `<out>/batch.json`.
 ///
 /// Returns the entries in the order of `files`.
 ///
@@ -230,7 +299,7 @@ pub fn run_batch(
             .par_iter()
             .map(|(file, loaded)| {
                 let entry = match loaded {
-                    Ok(case) => run_one(file, case, out),
+                    Ok(input) => run_one(file, input, out),
                     Err(entry) => entry.clone(),
                 };
                 progress(&entry);
@@ -311,12 +380,12 @@ mod tests {
         let text = include_str!("../../../cases/hard/2d-pressure-x10.json");
         let file = Path::new("2d-pressure-x10.json");
         let case = crate::validate::parse_case(text, file, &[]).expect("valid case");
-        let entry = run_one(file, &case, dir.path());
+        let entry = run_one(file, &Input::Case(case), dir.path());
         assert_eq!(entry.status, BatchStatus::FailedAsExpected, "{entry:?}");
         assert!(entry.status.as_expected());
         let other = r#"expect.failure="newton_not_converged""#.to_string();
         let case = crate::validate::parse_case(text, file, &[other]).expect("valid case");
-        let entry = run_one(file, &case, dir.path());
+        let entry = run_one(file, &Input::Case(case), dir.path());
         assert_eq!(entry.status, BatchStatus::Failed, "{entry:?}");
         assert!(!entry.status.as_expected());
     }

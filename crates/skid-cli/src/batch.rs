@@ -1,4 +1,4 @@
-//! `skid batch`: runs case files in parallel with a progress bar and lists the outcomes.
+//! `skid batch`: runs case files, model files and decks in parallel with a progress bar and lists the outcomes.
 //!
 //! Exit codes: 0 every case completed; 1 some case could not be run or stopped early; 2 no case
 //! files were found; 3 `batch.json` could not be written.
@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use skid_cases::{BatchEntry, BatchError, BatchStatus, collect_case_files, run_batch};
+use skid_cases::{BatchEntry, BatchError, BatchStatus, RunSummary, collect_case_files, run_batch};
 
 /// The progress bar on stderr; indicatif hides it when stderr is not a terminal.
 fn progress_bar(cases: usize) -> ProgressBar {
@@ -24,11 +24,11 @@ fn progress_bar(cases: usize) -> ProgressBar {
 
 /// One line of the final listing.
 fn line(entry: &BatchEntry, width: usize) -> String {
-    let t_stop = entry
-        .summary
-        .as_ref()
-        .and_then(|s| s.t_stop)
-        .map_or_else(|| "-".to_string(), |t| format!("{t:.6}"));
+    let t_stop = match &entry.summary {
+        Some(RunSummary::Case(s)) => s.t_stop,
+        _ => None,
+    }
+    .map_or_else(|| "-".to_string(), |t| format!("{t:.6}"));
     format!(
         "{:<width$}  {:<18}  t_stop {:>8} s  wall {:>8.2} s",
         entry.name,

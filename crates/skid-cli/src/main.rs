@@ -53,9 +53,10 @@ enum Command {
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         overrides: Vec<String>,
     },
-    /// Run case files in parallel, each into <out>/<case name>/; writes <out>/batch.json.
+    /// Run case files, model files and decks in parallel, each into <out>/<name>/; writes
+    /// <out>/batch.json.
     Batch {
-        /// Case files, or directories whose *.json files are run (sorted by name).
+        /// Files, or directories whose *.json and *.inp files are run (sorted by name).
         #[arg(required = true)]
         paths: Vec<PathBuf>,
         /// Output directory.

@@ -133,7 +133,10 @@ fn a_batch_of_the_corpus_records_every_file_as_an_error_and_runs_none() {
     )
     .expect("json");
     let entries = batch.as_array().expect("array");
-    assert_eq!(entries.len(), files_with("json").len());
+    assert_eq!(
+        entries.len(),
+        files_with("json").len() + files_with("inp").len()
+    );
     for entry in entries {
         assert_eq!(entry["status"], "error", "{entry}");
         assert!(entry["summary"].is_null(), "{entry}");

@@ -83,30 +83,53 @@ fn a_model_error_exits_with_status_2_naming_the_field() {
     assert!(!dir.path().join("run").join("summary.json").exists());
 }
 
+/// A batch runs case files, model files and decks side by side, each into its own directory,
+/// and the model file and the deck of one case give its history.
 #[test]
-fn batch_says_a_model_file_is_not_a_case_file() {
+fn batch_runs_case_files_model_files_and_decks() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let model = dir.path().join("model.json");
-    assert!(
-        skid()
-            .args(["convert", CASE, "-o"])
-            .arg(&model)
-            .status()
-            .expect("converts")
-            .success()
-    );
+    let inputs = dir.path().join("inputs");
+    std::fs::create_dir(&inputs).expect("mkdir");
+    for (to, name) in [("model.json", "as-model"), ("deck.inp", "as-deck")] {
+        let target = inputs.join(to);
+        assert!(
+            skid()
+                .args(["convert", CASE, "-o"])
+                .arg(&target)
+                .args(["--set", &format!("name=\"{name}\"")])
+                .args(["--set", "steps[1].duration=0.001"])
+                .status()
+                .expect("converts")
+                .success()
+        );
+    }
+    // a model file keeps its name; a deck is named after its file
     let out = skid()
         .arg("batch")
-        .arg(&model)
+        .arg(&inputs)
         .arg("--out")
         .arg(dir.path().join("batch"))
         .output()
         .expect("runs");
-    assert!(!out.status.success());
     let all = format!(
         "{}{}",
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-    assert!(all.contains("model file"), "{all}");
+    assert!(out.status.success(), "{all}");
+    let batch: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("batch/batch.json")).expect("batch.json"),
+    )
+    .expect("json");
+    let names: Vec<&str> = batch
+        .as_array()
+        .expect("array")
+        .iter()
+        .map(|e| e["name"].as_str().expect("name"))
+        .collect();
+    assert_eq!(names, ["deck", "as-model"]);
+    let deck = std::fs::read_to_string(dir.path().join("batch/deck/history.csv")).expect("deck");
+    let model =
+        std::fs::read_to_string(dir.path().join("batch/as-model/history.csv")).expect("model");
+    assert_eq!(deck, model);
 }
