@@ -2,6 +2,7 @@
 # The drum validation: builds skid (release); runs every drum idealization of cases/drum and
 # every hard case of cases/hard in parallel, and the convergence study (scripts/convergence.sh);
 # writes the report validation/report.md (benchmark, hard cases, convergence) with its plots;
+# checks that the input decks of cases/inp stop where their case files do (scripts/check_decks.py);
 # and checks the 2D benchmark's convergence in time step, its insensitivity to the pad density,
 # that the conic (clarabel) Coulomb solve gives the run of the default Newton-first one, and
 # that the 2D and 3D spin-downs do not depend on the hourglass stabilisation's stiffness.
@@ -43,4 +44,8 @@ for d in 2d 3d; do
     done
 done
 python3 scripts/check_drum.py "$out" || status=1
+# the input decks of cases/inp against the case files' runs
+rm -rf out/inp
+"$skid" batch cases/inp --out out/inp >/dev/null || status=1
+python3 scripts/check_decks.py out/inp out/drum || status=1
 exit $status

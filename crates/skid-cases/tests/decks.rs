@@ -196,9 +196,9 @@ fn read_text(text: &str) -> Result<skid_cases::deck::DeckModel, String> {
 
 /// The hand-written drum deck with `from` replaced by `to` (which must occur).
 fn variant(from: &str, to: &str) -> Result<skid_cases::deck::DeckModel, String> {
-    let mesh = std::fs::read_to_string(repo("cases/inp/2d-pad-mesh.inp")).expect("mesh");
+    let mesh = std::fs::read_to_string(repo("cases/inp/2d-pad-mesh.inc")).expect("mesh");
     let deck = std::fs::read_to_string(repo("cases/inp/2d-analytic-by-hand.inp")).expect("deck");
-    let deck = deck.replace("*include, input=2d-pad-mesh.inp\n", &mesh);
+    let deck = deck.replace("*include, input=2d-pad-mesh.inc\n", &mesh);
     assert!(deck.contains(from), "{from}");
     let deck = deck.replacen(from, to, 1);
     read_text(&deck)
