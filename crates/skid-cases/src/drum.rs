@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 
 use nalgebra::SVector;
 use skid_fem::mesh::SolidMesh;
-use skid_fem::tetra::TetMesh;
+use skid_fem::tetra::{TetMesh, compact_triangles};
 
 use crate::deck::mesh::ElementKind;
 use crate::deck::write::{RigidElements, write_deck};
@@ -276,21 +276,10 @@ fn drum_surface(case: &Case) -> Result<RigidSurfaceSpec, String> {
                 std::f64::consts::PI / sectors as f64,
             )
             .map_err(|e| format!("drum.surface: {e}"))?;
-            // keep the vertices the exterior faces use, numbered in their original order
-            let faces = mesh.exterior_faces();
-            let mut used = vec![false; mesh.nodes.len()];
-            for &n in faces.iter().flatten() {
-                used[n] = true;
-            }
-            let mut number = vec![0; mesh.nodes.len()];
-            let mut vertices = Vec::new();
-            for (n, _) in used.iter().enumerate().filter(|(_, used)| **used) {
-                number[n] = vertices.len();
-                vertices.push(mesh.nodes[n].into());
-            }
+            let (vertices, triangles) = compact_triangles(&mesh.nodes, &mesh.exterior_faces());
             RigidSurfaceSpec::Triangles {
-                vertices,
-                triangles: faces.iter().map(|t| t.map(|n| number[n])).collect(),
+                vertices: vertices.into_iter().map(Into::into).collect(),
+                triangles,
                 chart_radius: r,
                 chart_axis: axis,
             }

@@ -127,6 +127,28 @@ impl TetMesh {
     }
 }
 
+/// The triangles `faces` of a mesh of `nodes` with only the vertices they use: the vertices
+/// kept in their original order and the faces renumbered onto them.
+pub fn compact_triangles(
+    nodes: &[Vector3<f64>],
+    faces: &[[usize; 3]],
+) -> (Vec<Vector3<f64>>, Vec<[usize; 3]>) {
+    let mut used = vec![false; nodes.len()];
+    for &n in faces.iter().flatten() {
+        used[n] = true;
+    }
+    let mut number = vec![0; nodes.len()];
+    let mut vertices = Vec::new();
+    for (n, _) in used.iter().enumerate().filter(|(_, used)| **used) {
+        number[n] = vertices.len();
+        vertices.push(nodes[n]);
+    }
+    (
+        vertices,
+        faces.iter().map(|t| t.map(|n| number[n])).collect(),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,332 @@
+//! Boundary conditions of a deck (model data on bodies and part nodes, changes per step), its
+//! loads and its steps.
+
+use super::*;
+
+pub(super) fn apply_model_boundary(
+    defs: &Definitions,
+    part: &Part,
+    bodies: &mut [Body],
+    bc: &BoundaryDef,
+    index: usize,
+    node_sets: &mut BTreeMap<String, Vec<usize>>,
+    out: &mut Vec<BoundarySpec>,
+) -> Result<(), DeckError> {
+    let dim = part.dimension;
+    let labels = node_labels(defs, &bc.target, "*BOUNDARY", &bc.location)?;
+    let mut part_nodes = Vec::new();
+    for label in labels {
+        match role(part, bodies, label) {
+            NodeRole::Reference(b) => {
+                let mut dofs = Vec::new();
+                for &k in &bc.dofs {
+                    // a 2D body has no z translation and no in-plane rotations
+                    if dim == 2 && (3..=5).contains(&k) && bc.dofs.len() > 1 {
+                        continue;
+                    }
+                    dofs.push(dof_of(dim, k, &bc.location)?);
+                    bodies[b].fixed.insert(k);
+                }
+                out.push(BoundarySpec {
+                    body: Some(bodies[b].def.name.clone()),
+                    node_set: None,
+                    dofs,
+                });
+            }
+            NodeRole::Part(i) => part_nodes.push(i),
+            NodeRole::Other => {
+                return Err(error(
+                    &bc.location,
+                    format!(
+                        "*BOUNDARY: node {label} is a node of a rigid body but not its reference \
+                         node: hold the reference node"
+                    ),
+                ));
+            }
+        }
+    }
+    if !part_nodes.is_empty() {
+        let mut dofs = Vec::new();
+        for &k in &bc.dofs {
+            match k {
+                1..=3 if k <= dim => dofs.push(dof_of(dim, k, &bc.location)?),
+                // solid nodes have no rotations (ENCASTRE and symmetry conditions name them)
+                4..=6 if bc.dofs.len() > 1 => {}
+                _ => {
+                    return Err(error(
+                        &bc.location,
+                        format!(
+                            "*BOUNDARY: degree of freedom {k} does not exist on the nodes of a {dim}D solid"
+                        ),
+                    ));
+                }
+            }
+        }
+        let name = defs
+            .mesh
+            .node_sets
+            .get(&key(&bc.target))
+            .filter(|s| s.labels.iter().all(|n| part.number.contains_key(n)))
+            .map_or_else(|| format!("boundary-{index}"), |s| s.name.clone());
+        node_sets.insert(name.clone(), part_nodes);
+        out.push(BoundarySpec {
+            body: None,
+            node_set: Some(name),
+            dofs,
+        });
+    }
+    Ok(())
+}
+
+/// Refuses a model-data boundary condition on a part node that a `TIE NSET` ties to a rigid
+/// body: the tied node moves with the body, so holding it contradicts the tie.
+pub(super) fn check_held_ties(
+    defs: &Definitions,
+    part: &Part,
+    bodies: &[Body],
+) -> Result<(), DeckError> {
+    for body in bodies {
+        let Some(tie) = &body.def.tie else { continue };
+        let tied = defs.mesh.nodes_named(tie).unwrap_or_default();
+        for bc in &defs.boundary {
+            let held = defs.mesh.nodes_named(&bc.target).unwrap_or_default();
+            if let Some(n) = held
+                .iter()
+                .find(|n| part.number.contains_key(n) && tied.contains(n))
+            {
+                return Err(error(
+                    &bc.location,
+                    format!(
+                        "*BOUNDARY: node {n} is held here and tied to rigid body {} by TIE \
+                         NSET={tie} (a tied node moves with its body): hold the body's reference \
+                         node instead",
+                        body.def.name
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Steps and the loads they apply: boundary conditions with `OP=MOD` accumulate and `OP=NEW`
+/// replaces those of earlier steps (model-data conditions hold throughout); the loads of the
+/// first step are the model's, and later steps must keep them.
+pub(super) fn steps(
+    defs: &Definitions,
+    part: &Part,
+    bodies: &[Body],
+    part_spec: &mut PartSpec,
+    deck: &Location,
+) -> Result<(Vec<ModelStepSpec>, Vec<LoadSpec>), DeckError> {
+    let dim = part.dimension;
+    if defs.steps.is_empty() {
+        return Err(error(deck, "the deck has no *STEP"));
+    }
+    let mut held: BTreeMap<usize, BTreeSet<usize>> = BTreeMap::new();
+    let mut loads_in_force: Vec<(String, f64)> = Vec::new();
+    let mut first_loads = None;
+    let mut out = Vec::new();
+    for (i, step) in defs.steps.iter().enumerate() {
+        if step.nlgeom == Some(false) || (i == 0 && step.nlgeom.is_none()) {
+            return Err(error(
+                &step.location,
+                "*STEP: skid always accounts for large deformation: give NLGEOM=YES on the first step",
+            ));
+        }
+        for change in &step.boundary {
+            apply_step_boundary(defs, part, bodies, change, &mut held)?;
+        }
+        for change in &step.loads {
+            apply_loads(defs, part, part_spec, change, &mut loads_in_force)?;
+        }
+        match &first_loads {
+            None => first_loads = Some(loads_in_force.clone()),
+            Some(first) if *first != loads_in_force => {
+                return Err(error(
+                    &step.location,
+                    format!(
+                        "*STEP {}: the loads differ from the first step's; skid applies the first \
+                         step's loads (ramped over it if static) and holds them (loads that change \
+                         between steps are not supported yet)",
+                        step.name
+                    ),
+                ));
+            }
+            Some(_) => {}
+        }
+        let boundary = held
+            .iter()
+            .filter_map(|(&b, dofs)| {
+                let dofs: Vec<usize> = dofs
+                    .iter()
+                    .copied()
+                    .filter(|k| !bodies[b].fixed.contains(k))
+                    .collect();
+                (!dofs.is_empty()).then_some((b, dofs))
+            })
+            .map(|(b, dofs)| {
+                Ok(StepBoundarySpec {
+                    body: bodies[b].def.name.clone(),
+                    dofs: Some(
+                        dofs.iter()
+                            .map(|&k| dof_of(dim, k, &step.location))
+                            .collect::<Result<_, _>>()?,
+                    ),
+                })
+            })
+            .collect::<Result<Vec<_>, DeckError>>()?;
+        out.push(step_spec(step, boundary)?);
+    }
+    let loads = first_loads
+        .unwrap_or_default()
+        .into_iter()
+        .map(|(surface, pressure)| LoadSpec::Pressure { surface, pressure })
+        .collect();
+    Ok((out, loads))
+}
+
+pub(super) fn apply_step_boundary(
+    defs: &Definitions,
+    part: &Part,
+    bodies: &[Body],
+    change: &Change<BoundaryDef>,
+    held: &mut BTreeMap<usize, BTreeSet<usize>>,
+) -> Result<(), DeckError> {
+    if change.replace {
+        held.clear();
+    }
+    for bc in &change.items {
+        let labels = node_labels(defs, &bc.target, "*BOUNDARY", &bc.location)?;
+        for label in labels {
+            let NodeRole::Reference(b) = role(part, bodies, label) else {
+                return Err(error(
+                    &bc.location,
+                    format!(
+                        "*BOUNDARY: node {label}: boundary conditions inside steps apply to \
+                         rigid-body reference nodes only so far (give those on the part as model data)"
+                    ),
+                ));
+            };
+            for &k in &bc.dofs {
+                if part.dimension == 2 && (3..=5).contains(&k) && bc.dofs.len() > 1 {
+                    continue;
+                }
+                dof_of(part.dimension, k, &bc.location)?;
+                held.entry(b).or_default().insert(k);
+            }
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn apply_loads(
+    defs: &Definitions,
+    part: &Part,
+    part_spec: &mut PartSpec,
+    change: &Change<PressureDef>,
+    in_force: &mut Vec<(String, f64)>,
+) -> Result<(), DeckError> {
+    if change.replace {
+        in_force.clear();
+    }
+    for load in &change.items {
+        let surface = match load.face {
+            None => {
+                let surface = defs.surfaces.get(&key(&load.target)).ok_or_else(|| {
+                    error(
+                        &load.location,
+                        format!("*DSLOAD: no surface named {}", load.target),
+                    )
+                })?;
+                if !part_spec.surfaces.contains_key(&surface.name) {
+                    return Err(error(
+                        &load.location,
+                        format!(
+                            "*DSLOAD: {} is not a surface of element faces of the deformable part",
+                            surface.name
+                        ),
+                    ));
+                }
+                surface.name.clone()
+            }
+            Some(k) => {
+                let elements = defs.mesh.elements_named(&load.target).ok_or_else(|| {
+                    error(
+                        &load.location,
+                        format!(
+                            "*DLOAD: '{}' is neither an element nor an element set",
+                            load.target
+                        ),
+                    )
+                })?;
+                if elements
+                    .iter()
+                    .any(|e| !defs.mesh.elements[e].kind.is_solid())
+                {
+                    return Err(error(
+                        &load.location,
+                        "*DLOAD: pressures act on the deformable part's elements only",
+                    ));
+                }
+                let faces: Vec<(u64, FaceLabel)> = elements
+                    .into_iter()
+                    .map(|e| (e, FaceLabel::Numbered(k)))
+                    .collect();
+                let name = format!("{}-P{k}", load.target);
+                let corners = solid_faces(defs, part, &faces, &load.location)?;
+                part_spec.surfaces.insert(name.clone(), corners);
+                name
+            }
+        };
+        match in_force.iter_mut().find(|(s, _)| *s == surface) {
+            Some(existing) => existing.1 = load.magnitude,
+            None => in_force.push((surface, load.magnitude)),
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn step_spec(
+    step: &StepDef,
+    boundary: Vec<StepBoundarySpec>,
+) -> Result<ModelStepSpec, DeckError> {
+    let Some((procedure, location)) = &step.procedure else {
+        return Err(error(
+            &step.location,
+            format!("*STEP {}: give *STATIC or *DYNAMIC", step.name),
+        ));
+    };
+    Ok(match procedure {
+        Procedure::Static { initial, period } => {
+            let count = period / initial;
+            let increments = count.round();
+            if !(initial > &0.0 && period > &0.0)
+                || (count - increments).abs() > 1e-9 * count
+                || increments > 1e7
+            {
+                return Err(error(
+                    location,
+                    format!(
+                        "*STATIC: the period {period} must be a whole number (at most 1e7) of \
+                         increments {initial} (skid's static steps take fixed increments)"
+                    ),
+                ));
+            }
+            ModelStepSpec::Static {
+                name: step.name.clone(),
+                increments: increments as usize,
+                regularization_time: default_regularization_time(),
+                boundary,
+            }
+        }
+        Procedure::Dynamic { dt, period, alpha } => ModelStepSpec::Dynamic {
+            name: step.name.clone(),
+            duration: *period,
+            dt: *dt,
+            alpha: *alpha,
+            boundary,
+            adaptive: None,
+        },
+    })
+}
