@@ -41,6 +41,7 @@ import json
 import math
 import os
 import random
+import re
 import shlex
 import shutil
 import subprocess
@@ -512,7 +513,7 @@ def execute(run, args, out_root):
     record["exit_status"] = rc
     record["wall_s"] = round(wall, 4)
     message = stderr.strip()
-    record["message"] = message[-2000:]
+    record["message"] = clean(message[-2000:])
     record["problems"] = []
     if rc is None:
         record["outcome"] = "timeout"
@@ -572,6 +573,35 @@ def diagnosis(rc, message, results):
 # Report
 
 
+# What the sweep's flagged runs were traced to (by hand, rerunning them; see stress.md).
+STATIC_LEDGER_NOTE = (
+    "Verification scenes (model files): their `energy_balance_error` covers the static press "
+    "step too, and there the ledger's energy quadrature is first order in the load "
+    "increment: rerunning seed 99 run 10 (2D block, 12 x 1 mesh, mu 0.4526, 1.731e5 Pa, dt "
+    "1.738e-6 s x 22, alpha 0) with 1, 4, 16 and 64 press increments gives 0.138, 0.0365, "
+    "0.0092 and 0.0023: the residual falls as 1/increments, so the press step's energy "
+    "accounting, not the solution, is what is off; the dynamic step alone balances. The sweep "
+    "draws 1 to 5 press increments, which the shipped file's 4 just pass.")
+
+
+CONTACT_NOTE = (
+    "Contact-law flags: all are verification scenes (block on a sliding plane ground), mostly "
+    "with mu above 1 and time steps near 1e-3 s or more; the closed contacts penetrate the "
+    "plane by up to about 1e-3 of the block size while every Newton check passed. In seed 1 "
+    "run 2 (mu 0, 3.042e5 Pa, dt 8.356e-4 s) the deepest penetration, 1.1e-5 m with all 15 "
+    "contacts closed, comes while the tied plate moves vertically at about 1e-2 m/s, i.e. "
+    "about the normal velocity times one time step: a gap held per increment in rate form "
+    "would drift by that much. Not traced further; a question for the contact formulation "
+    "of dynamic steps (and why a massless plate on a quasi-static block oscillates).")
+
+
+def clean(text):
+    """A message without the machine's paths: the case file relative to the repository, a
+    run directory as OUT/run-NNNN."""
+    text = re.sub(r"/\S*?/(cases/)", r"\1", text)
+    return re.sub(r"/\S*/(run-\d{4}/)", r"OUT/\1", text)
+
+
 def table(header, rows):
     out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     out += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
@@ -616,6 +646,8 @@ def write_report(records, args, total_wall, results):
         },
         "records": records,
     }
+    for r in records:
+        r["message"] = clean(r["message"])
     results.mkdir(parents=True, exist_ok=True)
     (results / "stress.json").write_text(json.dumps(doc, indent=1) + "\n")
 
@@ -707,7 +739,51 @@ def write_report(records, args, total_wall, results):
     md += ["## Crashes and silently wrong runs", ""]
     if not bad:
         md += ["None."]
-    for r in bad:
+    energy = [r for r in bad if r["outcome"] == "silently wrong" and energy_only(r["problems"])]
+    other = [r for r in bad if r not in energy]
+    if energy:
+        def at_rest(r):
+            return r["kind"] == "drum" and r["params"]["speed"] == 0.0
+
+        def alpha0_ok(r):
+            c = r.get("alpha0_check", {})
+            return c.get("exit_status") == 0 and not c.get("problems")
+
+        def in_play_ok(r):
+            v = r["measures"].get("energy_vs_in_play")
+            return v is not None and v <= ENERGY_LIMIT
+
+        md += [f"### {len(energy)} completed runs whose only failed check is the energy "
+               "balance", "",
+               "What they have in common (counted by the script):",
+               f"- {sum(at_rest(r) for r in energy)} are drum runs with the drum at rest "
+               "(omega0 = 0): summary.json divides round-off by round-off "
+               "(`energy_balance_error` is defined whenever the drum's energy change exceeds a "
+               "millionth of its initial kinetic energy, which is 0), giving ratios like 1e11 "
+               "for a residual of 1e-14 J. A defect of the summary, not of the solution;",
+               f"- {sum(alpha0_ok(r) for r in energy if not at_rest(r))} of the others pass "
+               "every check when rerun with HHT alpha = 0 (column alpha = 0): their residual is "
+               "the numerical dissipation of HHT at alpha < 0, which the energy ledger does "
+               "not count, so it shows as an unbalanced energy at large time steps;",
+               f"- {sum(in_play_ok(r) for r in energy if not at_rest(r))} of the others are "
+               "within 5 % of all the energy in play (the pad's strain energy and the work of "
+               "the pressure, the scale the model files' `energy_balance_error` uses): the "
+               "drum cases' ratio has the drum's energy loss as denominator, which is small "
+               "when the drum sticks, barely turns or meets no friction on a faceted surface.",
+               f"- {sum(r['kind'] == 'verification' for r in energy)} are verification "
+               "scenes. " + STATIC_LEDGER_NOTE, ""]
+        md += table(["run", "scene", "measure", "error", "residual / energy in play",
+                     "alpha", "alpha = 0: error", "parameters", "reproduce"],
+                    [[r["index"], r["scene"], r["measures"]["energy_measure"],
+                      fmt(r["measures"]["energy_error"]),
+                      fmt(r["measures"].get("energy_vs_in_play")), r["params"]["alpha"],
+                      fmt(r.get("alpha0_check", {}).get("energy_error"))
+                      + ("" if alpha0_ok(r) or "alpha0_check" not in r else " (fails)"),
+                      describe(r), f"`{r['reproduce'][0]}`"] for r in energy])
+        md += [""]
+    if any(p.startswith("contact law") for r in other for p in r["problems"]):
+        md += ["### Runs breaking the contact law", "", CONTACT_NOTE, ""]
+    for r in other:
         md += [f"### run {r['index']}: {r['scene']}, {r['outcome']}", "",
                f"- parameters: {describe(r)}",
                f"- exit status {r['exit_status']}, {r['wall_s']:.2f} s"]
@@ -740,7 +816,15 @@ def main():
     ap.add_argument("--timeout", type=float, default=60.0, help="seconds per run")
     ap.add_argument("--results", type=Path, default=ROOT / "validation",
                     help="where stress.json and stress.md go")
+    ap.add_argument("--report-only", action="store_true",
+                    help="rewrite stress.md from the stress.json in --results, running nothing")
     args = ap.parse_args()
+    if args.report_only:
+        doc = json.loads((args.results / "stress.json").read_text())
+        args.runs, args.seed, args.jobs = doc["runs"], doc["seed"], doc["jobs"]
+        args.timeout = doc["timeout_s"]
+        bad = write_report(doc["records"], args, doc["total_wall_s"], args.results)
+        return 1 if bad else 0
     if not SKID.exists():
         sys.exit(f"{SKID} not found: build it with `cargo build --release -p skid-cli`")
     out_root = args.out or Path(tempfile.mkdtemp(prefix="skid-stress-"))
