@@ -50,7 +50,8 @@ pub struct Summary {
     /// `|drum energy lost - friction work - other work| / drum energy lost`, where the other
     /// work is the change of the pad's kinetic, strain and hourglass energy minus the work of
     /// the pressure and of the normal contact forces. `None` when the drum loses less than a
-    /// millionth of its initial kinetic energy (frictionless runs): the ratio has no meaning
+    /// millionth of its initial kinetic energy (frictionless runs, or a drum starting at rest,
+    /// `omega0 = 0`): the ratio has no meaning
     /// there, and `energy_balance_residual_j` says how well energy is conserved.
     pub energy_balance_error: Option<f64>,
     /// The numerator of `energy_balance_error`, J (signed: positive when energy is lost to
@@ -168,7 +169,8 @@ pub fn summarize(
         lost = Some(drum_lost);
         friction = Some(d_friction);
         residual_j = Some(residual);
-        balance = (drum_lost.abs() > 1e-6 * initial_drum_energy)
+        // A drum at rest has no energy to lose: round-off over round-off is no ratio.
+        balance = (initial_drum_energy > 0.0 && drum_lost.abs() > 1e-6 * initial_drum_energy)
             .then(|| residual.abs() / drum_lost.abs());
     }
     let max_hourglass_ratio = (!dynamic.is_empty()).then(|| {
@@ -283,5 +285,24 @@ mod tests {
         assert_eq!(s.error.as_deref(), Some("boom"));
         assert_eq!(s.failure.as_deref(), Some("invalid"));
         assert!((s.deceleration.expect("fit over the run") - 600.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_drum_starting_at_rest_has_no_energy_balance_ratio() {
+        // Found by scripts/stress.py: with omega0 = 0 the drum's energy lost is round-off
+        // (-6e-26 J) and the ratio came out as 2e11.
+        let mut case = case();
+        case.drum.omega0 = 0.0;
+        let mut samples = vec![Sample::default(); 3];
+        for (k, s) in samples.iter_mut().enumerate() {
+            s.time = k as f64 * 1e-5;
+            s.dynamic = k > 0;
+            s.omega = [0.0, -2.5e-16, 8e-13][k];
+            s.mechanical_energy = 0.1 + 1e-14 * k as f64;
+        }
+        let s = summarize(&case, &samples, &RunStatistics::default(), None);
+        assert_eq!(s.energy_balance_error, None);
+        let residual = s.energy_balance_residual_j.expect("residual");
+        assert!(residual.abs() < 1e-13, "{residual}");
     }
 }
