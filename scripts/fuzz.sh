@@ -7,7 +7,8 @@
 #   scripts/fuzz.sh [CPU_MINUTES_PER_TARGET [TARGET...]]
 #
 # CPU_MINUTES_PER_TARGET defaults to 10; the targets default to all four. CASES sets the inputs
-# per round (default 2000). A failing round keeps its minimal input's seed in
+# per round (default 2000); PROFILE the cargo profile of the test binary (default release;
+# `dev` reuses the binary of `cargo test`). A failing round keeps its minimal input's seed in
 # crates/skid-cases/proptest-regressions/fuzz_inputs/<target>.txt (replayed first by every
 # later run, so commit it with the fix) and its log in out/fuzz/<target>-<round>.log.
 # Prints per target: CPU time, rounds, cases run, inputs tried (shrinking included), failing
@@ -25,7 +26,8 @@ budget=$(awk -v m="$minutes" 'BEGIN { printf "%d", m * 60 }')
 out=out/fuzz
 mkdir -p "$out"
 
-binary=$(cargo test --release -p skid-cases --test fuzz_inputs --no-run --message-format=json |
+profile=${PROFILE:-release}
+binary=$(cargo test --profile "$profile" -p skid-cases --test fuzz_inputs --no-run --message-format=json |
     sed -n 's/.*"executable":"\([^"]*fuzz_inputs[^"]*\)".*/\1/p' | tail -n 1)
 if [ -z "$binary" ]; then
     echo "fuzz: cannot find the fuzz_inputs test binary" >&2
