@@ -354,7 +354,7 @@ fn mutate(mut text: Vec<u8>, mutation: &Mutation) -> Vec<u8> {
         Mutation::Scale(n, factor) => on_value(&text, n, |node| {
             if let Some(x) = node.as_f64() {
                 let scaled = x * factor;
-                *node = if node.is_u64() && scaled >= 0.0 && scaled < 1.8e19 {
+                *node = if node.is_u64() && (0.0..1.8e19).contains(&scaled) {
                     Value::from(scaled as u64)
                 } else {
                     serde_json::Number::from_f64(scaled).map_or(Value::Null, Value::Number)
@@ -417,9 +417,7 @@ fn mutated_seed() -> impl Strategy<Value = (usize, Vec<Mutation>)> {
 }
 
 fn apply_all(seed: &str, mutations: &[Mutation]) -> Vec<u8> {
-    mutations
-        .iter()
-        .fold(seed.as_bytes().to_vec(), |text, m| mutate(text, m))
+    mutations.iter().fold(seed.as_bytes().to_vec(), mutate)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -890,12 +888,10 @@ fn deck_keywords() {
             prop::collection::vec(deck_mutation(), 0..4),
         ),
         |(main_changes, part_changes)| {
-            let text = main_changes
-                .iter()
-                .fold(SEED_DECK.to_string(), |t, m| mutate_deck(t, m));
+            let text = main_changes.iter().fold(SEED_DECK.to_string(), mutate_deck);
             let part_text = part_changes
                 .iter()
-                .fold("*NODE\n5, 0.0, 0.3\n".to_string(), |t, m| mutate_deck(t, m));
+                .fold("*NODE\n5, 0.0, 0.3\n".to_string(), mutate_deck);
             let lines = |t: &str| t.lines().count();
             let files = [
                 (main.as_path(), lines(&text)),
