@@ -25,7 +25,8 @@ use skid_cases::bench::{BenchMethod, BenchSettings};
 struct Cli {
     /// Threads of each sparse factorization and solve: 1 sequential (the default; the
     /// systems are small, so threads inside one factorization cost more than they save), 0 one
-    /// per core, N that many. Results at 1 thread are bit-identical from run to run; `skid
+    /// per core, N that many. Results at 1 thread are bit-identical from run to run; with more,
+    /// the factorizations sum in another order and results agree to round-off only. `skid
     /// batch --jobs` sets how many cases run at once.
     #[arg(long, global = true, default_value_t = 1, value_name = "N")]
     threads: usize,
