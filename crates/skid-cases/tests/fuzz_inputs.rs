@@ -429,7 +429,8 @@ fn check_case_error(error: &CaseError, path: &Path) -> Result<(), TestCaseError>
         CaseError::Parse { field, message, .. } | CaseError::Invalid { field, message, .. } => {
             (message.as_str(), field.as_str())
         }
-        CaseError::Override { spec, message, .. } => (message.as_str(), spec.as_str()),
+        // The override is quoted as given, which may be empty (`--set ''`).
+        CaseError::Override { message, .. } => (message.as_str(), "--set"),
         CaseError::Model { message, .. } => (message.as_str(), "model"),
         other => {
             return Err(TestCaseError::fail(format!(
