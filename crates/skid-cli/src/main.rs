@@ -23,8 +23,26 @@ use skid_cases::bench::{BenchMethod, BenchSettings};
     about = "Implicit FE solver for frictional contact with rigid bodies"
 )]
 struct Cli {
+    /// Threads of each sparse factorization and solve: 1 sequential (the default; the
+    /// systems are small, so threads inside one factorization cost more than they save), 0 one
+    /// per core, N that many. Results at 1 thread are bit-identical from run to run; with more,
+    /// the factorizations sum in another order and results agree to round-off only. `skid
+    /// batch --jobs` sets how many cases run at once.
+    #[arg(long, global = true, default_value_t = 1, value_name = "N")]
+    threads: usize,
     #[command(subcommand)]
     command: Command,
+}
+
+/// The parallelism of faer's factorizations for `--threads threads`: [`faer::Par::Seq`] for 1,
+/// [`faer::Par::Rayon`] with one thread per core for 0, with `threads` threads otherwise (the
+/// work runs on rayon's pool: the global one, or the batch's pool within `skid batch`).
+fn factorization_parallelism(threads: usize) -> faer::Par {
+    match threads {
+        1 => faer::Par::Seq,
+        0 => faer::Par::rayon(std::thread::available_parallelism().map_or(1, |n| n.get())),
+        n => faer::Par::rayon(n),
+    }
 }
 
 #[derive(Subcommand)]
@@ -120,8 +138,9 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    // The systems are small: threads inside one factorization cost more than they save.
-    faer::set_global_parallelism(faer::Par::Seq);
+    // The library reads faer's parallelism wherever it factorizes; it is set once, here, from
+    // the command line, before any run starts.
+    faer::set_global_parallelism(factorization_parallelism(cli.threads));
     match cli.command {
         Command::Batch { paths, out, jobs } => batch::run(&paths, &out, jobs.unwrap_or(0)),
         Command::Report {

@@ -18,7 +18,9 @@ pub(super) enum Segment {
 }
 
 /// Formats a path as case files and overrides write it: `steps[1].adaptive.min_dt`; the empty
-/// path is `(top level)`.
+/// path is `(top level)`; a key that is empty or holds one of `.[]"`, white space or a control
+/// character is written as a JSON string (`pad."".x`), so that every path is readable and
+/// unambiguous.
 pub(super) fn path_text(path: &[Segment]) -> String {
     if path.is_empty() {
         return "(top level)".into();
@@ -30,7 +32,15 @@ pub(super) fn path_text(path: &[Segment]) -> String {
                 if !text.is_empty() {
                     text.push('.');
                 }
-                text.push_str(key);
+                let plain = !key.is_empty()
+                    && !key
+                        .chars()
+                        .any(|c| ".[]\"".contains(c) || c.is_whitespace() || c.is_control());
+                if plain {
+                    text.push_str(key);
+                } else {
+                    text.push_str(&serde_json::Value::String(key.clone()).to_string());
+                }
             }
             Segment::Index(i) => text.push_str(&format!("[{i}]")),
         }
@@ -301,6 +311,23 @@ mod tests {
         ];
         assert_eq!(path_text(&path), "steps[1].adaptive.min_dt");
         assert_eq!(path_text(&[]), "(top level)");
+    }
+
+    #[test]
+    fn keys_that_are_empty_or_not_plain_are_quoted() {
+        // Found by fuzzing: an unknown empty key at the top level had the empty path.
+        assert_eq!(path_text(&[Segment::Key(String::new())]), "\"\"");
+        let path = [
+            Segment::Key("pad".into()),
+            Segment::Key("a.b".into()),
+            Segment::Key("x y".into()),
+        ];
+        assert_eq!(path_text(&path), "pad.\"a.b\".\"x y\"");
+        let e = to_typed::<crate::schema::ElementCounts>(
+            &parse_json("{\"circumferential\": 1, \"radial\": 1, \"\": 1}").expect("json"),
+        )
+        .expect_err("unknown field");
+        assert_eq!(path_text(&e.0), "\"\"");
     }
 
     #[test]
