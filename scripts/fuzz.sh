@@ -6,7 +6,7 @@
 #
 #   scripts/fuzz.sh [CPU_MINUTES_PER_TARGET [TARGET...]]
 #
-# CPU_MINUTES_PER_TARGET defaults to 10; the targets default to all four. CASES sets the inputs
+# CPU_MINUTES_PER_TARGET defaults to 10; the targets default to all five. CASES sets the inputs
 # per round (default 2000); PROFILE the cargo profile of the test binary (default release;
 # `dev` reuses the binary of `cargo test`). A failing round keeps its minimal input's seed in
 # crates/skid-cases/proptest-regressions/fuzz_inputs/<target>.txt (replayed first by every
@@ -19,7 +19,7 @@ minutes=${1:-10}
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-    targets=(case_files overrides model_files deck_keywords)
+    targets=(case_files overrides model_files deck_keywords deck_models)
 fi
 cases=${CASES:-2000}
 budget=$(awk -v m="$minutes" 'BEGIN { printf "%d", m * 60 }')

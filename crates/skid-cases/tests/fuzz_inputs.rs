@@ -937,3 +937,50 @@ fn mutations_change_the_seeds_and_keep_them_readable_when_structural() {
     assert!(case.is_ok(), "{case:?}");
     assert!(parse_case(&raw, Path::new("t.json"), &[]).is_err());
 }
+
+/// The shipped decks (the hand-written 2D one with its mesh inlined, the faceted 2D and 3D
+/// ones) mutated and read into a model by the keyword subset's semantics, and the model built:
+/// a model, or a deck error at a line of the file, or a model error naming a field.
+#[test]
+fn deck_models() {
+    let inp = repository().join("cases/inp");
+    let read = |name: &str| std::fs::read_to_string(inp.join(name)).expect("deck");
+    let seeds = [
+        read("2d-analytic-by-hand.inp").replace(
+            "*include, input=2d-pad-mesh.inc\n",
+            &read("2d-pad-mesh.inc"),
+        ),
+        read("2d-r2d2.inp"),
+        read("3d-r3d4.inp"),
+    ];
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("scene.inp");
+    fuzz(
+        "deck_models",
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/proptest-regressions/fuzz_inputs/deck_models.txt"
+        ),
+        (0..seeds.len(), prop::collection::vec(deck_mutation(), 1..6)),
+        |(seed, changes)| {
+            let text = changes.iter().fold(seeds[seed].clone(), mutate_deck);
+            std::fs::write(&path, &text).expect("write");
+            match skid_cases::deck::read_model(&path) {
+                Ok(deck) => {
+                    let spec = deck.model;
+                    let built = match spec.dimension {
+                        2 => build::<2>(&spec).map(drop),
+                        _ => build::<3>(&spec).map(drop),
+                    };
+                    if let Err(e) = built {
+                        prop_assert!(!e.message.trim().is_empty(), "empty message: {e:?}");
+                    }
+                }
+                Err(error) => {
+                    check_deck_error(&error, &[(path.as_path(), text.lines().count())], &path)?;
+                }
+            }
+            Ok(())
+        },
+    );
+}
