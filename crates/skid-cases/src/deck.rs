@@ -75,7 +75,7 @@ pub fn read_model(path: &Path) -> Result<DeckModel, DeckError> {
         .map_or_else(|| "deck".to_string(), |s| s.to_string_lossy().into_owned());
     let deck = Location {
         file: path.to_path_buf(),
-        line: 1,
+        line: 0,
     };
     let model = assemble::assemble(&defs, &name, &deck)?;
     Ok(DeckModel {

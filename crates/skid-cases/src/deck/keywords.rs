@@ -24,13 +24,17 @@ use std::path::{Path, PathBuf};
 pub struct Location {
     /// File.
     pub file: PathBuf,
-    /// Line number, from 1.
+    /// Line number, from 1 (0: the file as a whole).
     pub line: usize,
 }
 
 impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}", self.file.display(), self.line)
+        if self.line == 0 {
+            write!(f, "{}", self.file.display())
+        } else {
+            write!(f, "{}:{}", self.file.display(), self.line)
+        }
     }
 }
 
