@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use crate::atomic::write_atomic;
 use crate::deck::is_deck;
-use crate::model_file::{ModelSpec, is_model_file, parse_model};
+use crate::model_file::{ModelSpec, declares_model, parse_model};
 use crate::runner::{RunSummary, read_deck_model, run_case, run_model};
 use crate::schema::Case;
 use crate::validate::load_case;
@@ -180,7 +180,7 @@ fn load(file: &Path) -> Result<Input, String> {
             .map_err(|e| e.to_string());
     }
     if let Ok(text) = std::fs::read_to_string(file)
-        && serde_json::from_str::<serde_json::Value>(&text).is_ok_and(|v| is_model_file(&v))
+        && declares_model(&text)
     {
         return parse_model(&text, file, &[])
             .map(|spec| Input::Model(spec, Vec::new()))

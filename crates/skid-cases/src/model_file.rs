@@ -25,10 +25,10 @@ pub use spec::{MODEL_FORMAT_VERSION, ModelSpec};
 
 use crate::validate::{CaseError, parse_document};
 
-/// Whether a parsed JSON document is a model file (it declares `skid_model`) rather than a
-/// drum case file.
-pub fn is_model_file(value: &Value) -> bool {
-    value.get("skid_model").is_some()
+/// Whether text is a model file: JSON that declares `skid_model` (rather than a drum case
+/// file); text that is not JSON is not, and is left to the parser that reads it to report.
+pub fn declares_model(text: &str) -> bool {
+    serde_json::from_str::<Value>(text).is_ok_and(|v| v.get("skid_model").is_some())
 }
 
 /// Parses model-file text with `overrides` applied (`path` is only used in messages). Names

@@ -22,7 +22,7 @@ use crate::fields::{self, DrumOutline, FieldWriter};
 use crate::history::DrumRecorder;
 use crate::model_file::history::ModelRecorder;
 use crate::model_file::summary::{ModelSummary, summarize as summarize_model};
-use crate::model_file::{self, ModelSpec, is_model_file};
+use crate::model_file::{self, ModelSpec, declares_model};
 use crate::newton::{NEWTON_CSV, NewtonRecorder};
 use crate::schema::Case;
 use crate::summary::{Summary, summarize};
@@ -104,11 +104,6 @@ pub fn read_deck_model(
     }
     let model = model_file::parse_model(&model_file::to_json(&deck.model), path, overrides)?;
     Ok((model, deck.notes))
-}
-
-/// Whether JSON text is a model file; text that is not JSON is left to the parser to report.
-fn declares_model(text: &str) -> bool {
-    serde_json::from_str::<serde_json::Value>(text).is_ok_and(|v| is_model_file(&v))
 }
 
 /// Default output directory of a case: `out/<case name>`.

@@ -110,7 +110,7 @@ pub fn load_case(path: &Path, overrides: &[String]) -> Result<Case, CaseError> {
 /// # Errors
 /// [`CaseError`] naming the field at fault.
 pub fn parse_case(text: &str, path: &Path, overrides: &[String]) -> Result<Case, CaseError> {
-    if serde_json::from_str::<Value>(text).is_ok_and(|v| crate::model_file::is_model_file(&v)) {
+    if crate::model_file::declares_model(text) {
         return Err(CaseError::Invalid {
             path: path.to_path_buf(),
             field: "skid_model".into(),

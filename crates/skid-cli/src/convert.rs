@@ -15,7 +15,7 @@ use skid_cases::atomic::write_atomic;
 use skid_cases::deck::is_deck;
 use skid_cases::deck::write::write_deck;
 use skid_cases::drum::{deck, model_spec};
-use skid_cases::model_file::{is_model_file, parse_model, to_json};
+use skid_cases::model_file::{declares_model, parse_model, to_json};
 use skid_cases::{load_case, read_deck_model};
 
 /// Writes `input` (with `overrides`) to `out` as a model file or a deck; running the output
@@ -53,9 +53,7 @@ fn convert(input: &Path, overrides: &[String], to_deck: bool) -> Result<String, 
         return Ok(to_json(&spec));
     }
     let text = std::fs::read_to_string(input).map_err(|e| format!("{shown}: cannot read: {e}"))?;
-    let declares_model =
-        serde_json::from_str::<serde_json::Value>(&text).is_ok_and(|v| is_model_file(&v));
-    if declares_model {
+    if declares_model(&text) {
         if !to_deck {
             return Err(format!(
                 "{shown}: is already a model file; write a deck (.inp)"

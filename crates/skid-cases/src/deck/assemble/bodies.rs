@@ -97,6 +97,20 @@ pub(super) fn rigid_bodies(defs: &Definitions, part: &Part) -> Result<Vec<Body>,
             ));
         }
     }
+    // point elements elsewhere than at a reference node
+    for e in &defs.mesh.element_order {
+        let el = &defs.mesh.elements[e];
+        if matches!(el.kind, ElementKind::Mass | ElementKind::RotaryI)
+            && !bodies.iter().any(|b| b.def.reference == el.nodes[0])
+        {
+            return Err(error(
+                &el.location,
+                format!(
+                    "element {e}: point masses and inertias sit at rigid-body reference nodes only"
+                ),
+            ));
+        }
+    }
     Ok(bodies)
 }
 
@@ -155,20 +169,6 @@ pub(super) fn body_spec(
             }
             if el.nodes[0] == body.def.reference {
                 inertia += Matrix3::new(i[0], i[3], i[4], i[3], i[1], i[5], i[4], i[5], i[2]);
-            }
-        }
-    }
-    // point elements elsewhere than at a reference node
-    for kind in [ElementKind::Mass, ElementKind::RotaryI] {
-        for e in &defs.mesh.element_order {
-            let el = &defs.mesh.elements[e];
-            if el.kind == kind && !defs.rigid_bodies.iter().any(|b| b.reference == el.nodes[0]) {
-                return Err(error(
-                    &el.location,
-                    format!(
-                        "element {e}: point masses and inertias sit at rigid-body reference nodes only"
-                    ),
-                ));
             }
         }
     }

@@ -19,11 +19,7 @@ pub(super) fn apply_model_boundary(
         match role(part, bodies, label) {
             NodeRole::Reference(b) => {
                 let mut dofs = Vec::new();
-                for &k in &bc.dofs {
-                    // a 2D body has no z translation and no in-plane rotations
-                    if dim == 2 && (3..=5).contains(&k) && bc.dofs.len() > 1 {
-                        continue;
-                    }
+                for k in body_dofs(dim, &bc.dofs) {
                     dofs.push(dof_of(dim, k, &bc.location)?);
                     bodies[b].fixed.insert(k);
                 }
@@ -208,10 +204,7 @@ pub(super) fn apply_step_boundary(
                     ),
                 ));
             };
-            for &k in &bc.dofs {
-                if part.dimension == 2 && (3..=5).contains(&k) && bc.dofs.len() > 1 {
-                    continue;
-                }
+            for k in body_dofs(part.dimension, &bc.dofs) {
                 dof_of(part.dimension, k, &bc.location)?;
                 held.entry(b).or_default().insert(k);
             }
@@ -329,4 +322,13 @@ pub(super) fn step_spec(
             adaptive: None,
         },
     })
+}
+
+/// The degrees of freedom (1..=6) of a boundary condition that apply to a rigid body in
+/// dimension `dim`: a 2D body has no z translation and no in-plane rotations, so a range or a
+/// named condition (ENCASTRE, symmetry) drops 3 to 5; a single one of them stays, to be refused.
+fn body_dofs(dim: usize, dofs: &[usize]) -> impl Iterator<Item = usize> + '_ {
+    dofs.iter()
+        .copied()
+        .filter(move |k| !(dim == 2 && (3..=5).contains(k) && dofs.len() > 1))
 }
