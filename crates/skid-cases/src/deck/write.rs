@@ -190,19 +190,13 @@ pub fn write_deck(
                 format!(", TIE NSET={name}")
             }
         };
-        let c = embed(&body.reference_point);
-        let carrier = match &body.surface {
-            None => String::new(),
-            Some(surface) => surface_deck(
-                &mut out,
-                spec,
-                body,
-                surface,
-                rigid.get(&body.name),
-                &c,
-                (&mut next_node, &mut next_element),
-            )?,
-        };
+        let carrier = surface_deck(
+            &mut out,
+            spec,
+            body,
+            rigid.get(&body.name),
+            (&mut next_node, &mut next_element),
+        )?;
         let _ = writeln!(out, "*RIGID BODY, REF NODE={}{carrier}{tie}", body.name);
     }
 
@@ -381,18 +375,19 @@ fn point_inertia(
     }
 }
 
-/// Writes the surface of `body` (centred at `c`) and returns the `*RIGID BODY` parameter that
-/// attaches it.
-#[allow(clippy::too_many_arguments)]
+/// Writes the surface of `body`, if it has one, and returns the `*RIGID BODY` parameter that
+/// attaches it (empty without a surface).
 fn surface_deck(
     out: &mut String,
     spec: &ModelSpec,
     body: &RigidBodySpec,
-    surface: &RigidSurfaceSpec,
     elements: Option<&RigidElements>,
-    c: &Vector3<f64>,
     (next_node, next_element): (&mut usize, &mut usize),
 ) -> Result<String, String> {
+    let Some(surface) = &body.surface else {
+        return Ok(String::new());
+    };
+    let c = &embed(&body.reference_point);
     let dim = spec.dimension;
     let name = &body.name;
     let p = |v: &Vector3<f64>| list(v.iter().take(dim).map(|x| num(*x)));
