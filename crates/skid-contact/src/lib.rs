@@ -23,7 +23,8 @@ pub mod surface;
 pub mod triangles;
 
 pub use coulomb::{
-    CoulombSettings, CoulombSolution, FrictionProblem, natural_map_error, solve_coulomb,
+    CoulombSettings, CoulombSolution, FrictionProblem, natural_map_error, natural_map_length_error,
+    solve_coulomb,
 };
 pub use error::ContactError;
 pub use facets::FacetedCylinder;

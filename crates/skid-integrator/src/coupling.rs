@@ -22,7 +22,9 @@
 //! repeated.
 
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
-use skid_contact::coulomb::{CoulombSettings, CoulombSolution, FrictionProblem, solve_coulomb};
+use skid_contact::coulomb::{
+    CoulombSettings, CoulombSolution, FrictionProblem, natural_map_length_error, solve_coulomb,
+};
 use skid_contact::error::ContactError;
 use skid_contact::kinematics::{
     ContactKinematics, RotatingFrame, evaluate, gap_discrete_gradient, slip_increment,
@@ -205,6 +207,7 @@ pub fn contact_step(
     residual: &DVector<f64>,
     warm: &DVector<f64>,
     length: f64,
+    length_tolerance: f64,
     settings: &CoulombSettings,
     reuse: Option<Factorization>,
     timings: &mut Timings,
@@ -267,7 +270,7 @@ pub fn contact_step(
             q: &q,
             mu: &mu,
         };
-        let solution = solve_contact_forces(&problem, &warm_near, settings);
+        let solution = solve_to_length(&problem, &warm_near, settings, length_tolerance);
         // Failed solves cost time too: count it before reporting the failure.
         timings.contact_solve += clock.elapsed();
         let solution = solution.map_err(IncrementFailure::Contact)?;
@@ -306,6 +309,60 @@ pub fn contact_step(
         }
         current = Some((factor, dx0));
     }
+}
+
+/// Smallest relative tolerance [`solve_to_length`] asks of the Coulomb solver: near round-off
+/// of the natural map, which the semismooth Newton refinement reaches in a step or two.
+const TIGHTEST_COULOMB_TOLERANCE: f64 = 1e-15;
+
+/// How often [`solve_to_length`] tightens the relative tolerance.
+const MAX_TIGHTENINGS: usize = 3;
+
+/// [`solve_contact_forces`] to a relative error within `settings.tolerance` and a length error
+/// ([`natural_map_length_error`]) within `length_tolerance` (m).
+///
+/// The relative error weighs each contact by its inverse compliance; when the Delassus operator
+/// holds a compliance far above the others (a body held only by its contacts, whose tangent a
+/// small mass shift regularises), a relative `1e-8` leaves penetrations of micrometres. The
+/// solve is then repeated from its own forces with the relative tolerance scaled by
+/// `length_tolerance / error` (halved, at least [`TIGHTEST_COULOMB_TOLERANCE`]), at most
+/// [`MAX_TIGHTENINGS`] times. Whatever it reaches is returned: the Newton iteration judges the
+/// contact law at the new kinematics in lengths and rejects what is not good enough.
+///
+/// # Errors
+/// The Coulomb solver's failure.
+fn solve_to_length(
+    problem: &FrictionProblem,
+    warm: &DVector<f64>,
+    settings: &CoulombSettings,
+    length_tolerance: f64,
+) -> Result<CoulombSolution, ContactError> {
+    let mut solution = solve_contact_forces(problem, warm, settings)?;
+    let mut tolerance = settings.tolerance;
+    for _ in 0..MAX_TIGHTENINGS {
+        let error = natural_map_length_error(problem, &solution.r, &solution.u);
+        if error <= length_tolerance || tolerance <= TIGHTEST_COULOMB_TOLERANCE {
+            break;
+        }
+        tolerance = (0.5 * tolerance * length_tolerance / error).max(TIGHTEST_COULOMB_TOLERANCE);
+        let tighter = CoulombSettings {
+            tolerance,
+            ..settings.clone()
+        };
+        let refined = solve_contact_forces(problem, &solution.r, &tighter)?;
+        let counts = (
+            solution.conic_solves + refined.conic_solves,
+            solution.fixed_point_iterations + refined.fixed_point_iterations,
+            solution.newton_steps + refined.newton_steps,
+        );
+        solution = refined;
+        (
+            solution.conic_solves,
+            solution.fixed_point_iterations,
+            solution.newton_steps,
+        ) = counts;
+    }
+    Ok(solution)
 }
 
 /// Solves the exact Coulomb law `problem` for all its contacts, handing the solver only the
@@ -671,6 +728,7 @@ mod tests {
                 &residual,
                 &warm,
                 length,
+                1e-9 * length,
                 &settings,
                 reuse,
                 &mut timings,

@@ -620,6 +620,7 @@ mod tests {
             &residual,
             &warm,
             1e3,
+            1e-9 * 1e3,
             &settings,
             None,
             &mut timings,

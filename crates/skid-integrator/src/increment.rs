@@ -255,7 +255,7 @@ fn solve_increment_with<const D: usize>(
     let mut halvings = 0;
     // The factorization of the last contact step (see the contact step below).
     let mut reusable = None;
-    // The candidates' weights of the global contact step, fixed for the increment so that the
+    // The candidates' weights of the contact law residual, fixed for the increment so that the
     // law residual measures every iterate alike (see `crate::global_contact`).
     let mut weights: Option<Vec<f64>> = None;
 
@@ -333,7 +333,9 @@ fn solve_increment_with<const D: usize>(
             );
             let contact_residual = match forces {
                 _ if rows.is_empty() => 0.0,
-                LastForces::Linearised { u, .. } => (&rows.u - u).amax() / length,
+                LastForces::Linearised { r, u, rho } => {
+                    (&rows.u - u).amax().max(law_residual(&rows, r, rho)) / length
+                }
                 LastForces::Law { r, rho } => law_residual(&rows, r, rho) / length,
             };
             counters.residuals.push((force_residual, contact_residual));
@@ -376,6 +378,7 @@ fn solve_increment_with<const D: usize>(
             last = Some(LastForces::Linearised {
                 r: DVector::zeros(0),
                 u: DVector::zeros(0),
+                rho: Vec::new(),
             });
             dx
         } else if method == ContactSolve::Global {
@@ -404,6 +407,10 @@ fn solve_increment_with<const D: usize>(
                 .last()
                 .is_some_and(|&(force, _)| force <= newton.force_tolerance);
             let mut reuse = reusable.take().filter(|_| forces_converged);
+            if weights.is_none() {
+                let k = assembler.lower_triangle()?;
+                weights = Some(contact_weights(k.as_ref(), &rows));
+            }
             let ((dx, solution, factor), _) =
                 assembler.with_mass_shift(shift_mass, shift_start, held, |a| {
                     contact_step(
@@ -412,6 +419,7 @@ fn solve_increment_with<const D: usize>(
                         &residual,
                         &warm,
                         length,
+                        newton.contact_tolerance * length,
                         &settings.coulomb,
                         reuse.take(),
                         timings,
@@ -425,6 +433,7 @@ fn solve_increment_with<const D: usize>(
             last = Some(LastForces::Linearised {
                 r: solution.r,
                 u: solution.u,
+                rho: weights.clone().unwrap_or_default(),
             });
             dx
         };
@@ -437,19 +446,33 @@ fn solve_increment_with<const D: usize>(
         last_step = Some(dx);
         halvings = 0;
     }
-    // The loop returns from inside: either converged or at the last convergence check.
+    // The loop returns from inside, converged or at the last convergence check, unless its
+    // last iterations went to halving steps that fold an element: report the last residuals
+    // that were measured.
+    let (force_residual, contact_residual) = counters
+        .residuals
+        .last()
+        .copied()
+        .unwrap_or((f64::NAN, f64::NAN));
     Err(IncrementFailure::NewtonNotConverged {
         iterations: max_iterations,
-        force_residual: f64::NAN,
-        contact_residual: f64::NAN,
+        force_residual,
+        contact_residual,
     })
 }
 
 /// The contact forces of a Newton step and how the next iterate's contact state is judged.
 enum LastForces {
     /// A reduced step: the forces `r` satisfy the Coulomb law with the linearised local
-    /// quantities `u`; the contact residual is how far the actual ones are from `u`.
-    Linearised { r: DVector<f64>, u: DVector<f64> },
+    /// quantities `u`; the contact residual is how far the actual ones are from `u`, or the
+    /// law's own residual at the new kinematics with the increment's weights `rho` (as for
+    /// [`LastForces::Law`]) if that is larger: the Coulomb solver's relative tolerance does not
+    /// bound the penetration where one compliance dominates the Delassus operator.
+    Linearised {
+        r: DVector<f64>,
+        u: DVector<f64>,
+        rho: Vec<f64>,
+    },
     /// A global step: the contact residual is the law's own residual at the new kinematics
     /// with the forces `r` and the increment's weights `rho`.
     Law { r: DVector<f64>, rho: Vec<f64> },
@@ -580,8 +603,19 @@ fn finish<const D: usize>(
         });
         let tangential = Vector2::from_fn(|c, _| if c + 1 < d { force(c + 1) } else { 0.0 });
         let gap = rows.u[k * d];
-        friction -= tangential.dot(&slip);
-        normal_work += force(0) * (gap - old.gap);
+        // The work of the contact forces over the increment: in a dynamic increment `r` is the
+        // mean force of the impulse; a static increment ramps the forces from `old` to `r`
+        // along with the load, so the trapezoidal rule (as for the external work) keeps the
+        // ledger's error of order 1/increments^2 rather than 1/increments.
+        let (mean_tangential, mean_normal) = match kind {
+            IncrementKind::Static { .. } => (
+                0.5 * (tangential + old.tangential_force),
+                0.5 * (force(0) + old.normal_force),
+            ),
+            IncrementKind::Dynamic { .. } => (tangential, force(0)),
+        };
+        friction -= mean_tangential.dot(&slip);
+        normal_work += mean_normal * (gap - old.gap);
         contacts.push(ContactPointState {
             pair: old.pair,
             node: old.node,

@@ -39,9 +39,12 @@ pub struct EnergyLedger {
     pub hourglass: f64,
     /// Work of the external loads, trapezoidal rule over increments.
     pub external_work: f64,
-    /// Frictional dissipation `sum -r_T . Delta s` (>= 0 for the Coulomb law).
+    /// Frictional dissipation `sum -r_T . Delta s`, `r_T` the mean force of a dynamic increment
+    /// (each term >= 0 for the Coulomb law) or the mean of the start and end forces of a static
+    /// one (trapezoidal rule, as the loads ramp).
     pub friction_dissipation: f64,
-    /// Work of the normal contact forces `sum r_N Delta g` (zero for a persistent contact).
+    /// Work of the normal contact forces `sum r_N Delta g`, `r_N` taken as for the friction
+    /// (zero for a persistent contact).
     pub normal_work: f64,
 }
 

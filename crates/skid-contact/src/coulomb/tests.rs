@@ -641,3 +641,61 @@ fn zero_tangential_compliance_slides_with_the_given_slip() {
     assert!((s.r[1] + 300.0).abs() < 1e-6 * 300.0, "{}", s.r);
     assert!(s.u[0].abs() < 1e-12 && (s.u[1] - 2e-3).abs() < 1e-15);
 }
+
+/// Two frictionless contacts under one floating body: the compliance `c` of the body's free
+/// mode (common to both contacts) dwarfs the local one `e`. Forces that balance the load but
+/// shift `dr` from one contact to the other leave a penetration `e dr` at the first and the
+/// second open by as much while loaded. With `e dr` as large as the whole local deformation
+/// `e r`, the relative error is below the solver's default `1e-8` (it compares `rho e dr` with
+/// `rho |q|`); the length error is the penetration itself.
+#[test]
+fn the_length_error_sees_a_penetration_the_relative_error_hides() {
+    let (c, e) = (1e6, 1e-3);
+    // rows [N1, T1, N2, T2]; the tangential rows are decoupled with compliance e
+    let w = DMatrix::from_row_slice(
+        4,
+        4,
+        &[
+            c + e,
+            0.0,
+            c,
+            0.0, //
+            0.0,
+            e,
+            0.0,
+            0.0, //
+            c,
+            0.0,
+            c + e,
+            0.0, //
+            0.0,
+            0.0,
+            0.0,
+            e,
+        ],
+    );
+    let q = DVector::from_vec(vec![-1.0, 0.0, -1.0, 0.0]);
+    let mu = [0.0, 0.0];
+    let problem = FrictionProblem {
+        dim: 2,
+        w: &w,
+        q: &q,
+        mu: &mu,
+    };
+    // exact: r_1 = r_2 = 1 / (2c + e), both gaps closed
+    let exact = 1.0 / (2.0 * c + e);
+    let dr = 0.5 * exact;
+    let r = DVector::from_vec(vec![exact - dr, 0.0, exact + dr, 0.0]);
+    let u = &w * &r + &q;
+    let penetration = e * dr;
+    assert_relative_eq!(u[0], -penetration, max_relative = 1e-6);
+    assert_relative_eq!(u[2], penetration, max_relative = 1e-6);
+    let relative = natural_map_error(&problem, &r, &u);
+    let length = natural_map_length_error(&problem, &r, &u);
+    assert!(relative < 1e-8, "relative error {relative}");
+    assert_relative_eq!(length, penetration, max_relative = 1e-6);
+    // at the exact forces both vanish to round-off
+    let r = DVector::from_vec(vec![exact, 0.0, exact, 0.0]);
+    let u = &w * &r + &q;
+    assert!(natural_map_length_error(&problem, &r, &u) < 1e-3 * penetration);
+}
