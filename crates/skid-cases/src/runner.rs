@@ -140,7 +140,7 @@ pub fn run_file(
 #[derive(Debug)]
 pub enum Resumed {
     /// The run was continued to its end; its summary.
-    Continued(RunSummary),
+    Continued(Box<RunSummary>),
     /// The run had already ended: its `summary.json`, untouched.
     AlreadyEnded(serde_json::Value),
 }
@@ -149,6 +149,8 @@ pub enum Resumed {
 /// input as run stored beside it (`case.json` or `model.json`), to the outputs the
 /// uninterrupted run writes. With `input` (a file and its overrides), that input must be the
 /// one the run was started with. The restart interval is `restart_every`, or the run's own.
+/// A run that has ended (its `summary.json` written) is not run again:
+/// [`Resumed::AlreadyEnded`].
 ///
 /// # Errors
 /// [`CaseError::Resume`] if `dir` holds no run, no restart file, or one that does not fit the
@@ -232,12 +234,12 @@ pub fn resume_run(
             3 => run_in::<3>(&case, &source, dir, every, start),
             _ => run_in::<2>(&case, &source, dir, every, start),
         }
-        .map(|s| Resumed::Continued(RunSummary::Case(s))),
+        .map(|s| Resumed::Continued(Box::new(RunSummary::Case(s)))),
         Input::Model(spec, _) => match spec.dimension {
             3 => run_model_in::<3>(&spec, &source, dir, every, start),
             _ => run_model_in::<2>(&spec, &source, dir, every, start),
         }
-        .map(|s| Resumed::Continued(RunSummary::Model(s))),
+        .map(|s| Resumed::Continued(Box::new(RunSummary::Model(s)))),
     }
 }
 
