@@ -24,7 +24,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::atomic::write_atomic;
 use crate::report::{ReportError, e_slide, load_run};
-use crate::runner::run_case;
+use crate::runner::run_case_with;
 use crate::schema::{AdaptiveSpec, Case, ContactSolveSpec, StepSpec};
 use crate::validate::CaseError;
 
@@ -299,13 +299,14 @@ pub fn run_bench(
                     .join(&case.name)
                     .join(label)
                     .join(k.to_string());
-                let mut summary = run_case(&level, source, &dir)?;
+                // no restart files: the wall times are the solver's
+                let mut summary = run_case_with(&level, source, &dir, 0)?;
                 let mut times = vec![summary.cost.wall_time_s];
                 if summary.cost.wall_time_s < REPEAT_BELOW_S {
                     times.clear();
                     let mut timed = Vec::new();
                     for _ in 0..settings.repeats {
-                        let s = run_case(&level, source, &dir)?;
+                        let s = run_case_with(&level, source, &dir, 0)?;
                         times.push(s.cost.wall_time_s);
                         timed.push(s);
                     }

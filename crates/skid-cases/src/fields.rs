@@ -76,6 +76,18 @@ struct Last {
     written: bool,
 }
 
+/// What a [`FieldWriter`] carries to a restart point: the frames written and whether the last
+/// state seen (the restart point's) has a frame.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FieldMemory {
+    /// Times of the frames written (frame `i` at `times[i]`).
+    pub times: Vec<f64>,
+    /// Whether the last state seen ended an increment of a static step.
+    pub last_in_static_step: bool,
+    /// Whether the last state seen has been written as a frame.
+    pub last_written: bool,
+}
+
 /// Observer writing the field frames into `<out>/fields/` (see the module documentation).
 pub struct FieldWriter {
     dir: PathBuf,
@@ -135,6 +147,38 @@ impl FieldWriter {
             times: Vec::new(),
             last: None,
         })
+    }
+
+    /// Continues the field output of an interrupted run in `<out>/fields/` as it stood at a
+    /// restart point: `memory` and `state`, the restart point's state. Frames written after the
+    /// restart point are written again, the same, under the same numbers.
+    ///
+    /// # Errors
+    /// As [`Self::create`].
+    pub fn reopen(
+        out: &Path,
+        interval: f64,
+        drum: DrumOutline,
+        memory: FieldMemory,
+        state: State,
+    ) -> io::Result<Self> {
+        let mut writer = Self::create(out, interval, drum)?;
+        writer.times = memory.times;
+        writer.last = Some(Last {
+            state,
+            in_static_step: memory.last_in_static_step,
+            written: memory.last_written,
+        });
+        Ok(writer)
+    }
+
+    /// What this writer carries to a restart point (see [`FieldMemory`]).
+    pub fn memory(&self) -> FieldMemory {
+        FieldMemory {
+            times: self.times.clone(),
+            last_in_static_step: self.last.as_ref().is_some_and(|l| l.in_static_step),
+            last_written: self.last.as_ref().is_none_or(|l| l.written),
+        }
     }
 
     /// Writes the frame of the end of the run (the last converged state) unless it has been

@@ -14,7 +14,7 @@ use std::path::Path;
 use skid_integrator::Model;
 use skid_integrator::stepper::{IncrementReport, Observer};
 
-use crate::csv_out::PartialCsv;
+use crate::csv_out::{CsvMark, PartialCsv};
 use crate::drum::{BACK_PLATE, DRUM};
 use crate::model_file::history::pair_totals;
 
@@ -45,7 +45,7 @@ pub const COLUMNS: [&str; 22] = [
 ];
 
 /// What the summary needs of one converged increment.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Sample {
     /// Time, s.
     pub time: f64,
@@ -92,6 +92,26 @@ impl DrumRecorder {
             csv: PartialCsv::create(&dir.join("history.csv"), &COLUMNS)?,
             samples: Vec::new(),
         })
+    }
+
+    /// Continues the history of an interrupted run: `dir/history.csv.partial` reopened at
+    /// `mark` ([`PartialCsv::reopen`]), with the samples up to that point.
+    ///
+    /// # Errors
+    /// As [`PartialCsv::reopen`].
+    pub fn reopen(dir: &Path, mark: &CsvMark, samples: Vec<Sample>) -> std::io::Result<Self> {
+        Ok(Self {
+            csv: PartialCsv::reopen(&dir.join("history.csv"), mark)?,
+            samples,
+        })
+    }
+
+    /// Flushes the rows so far to disk and returns the file's mark, for a restart point.
+    ///
+    /// # Errors
+    /// I/O errors.
+    pub fn mark(&mut self) -> std::io::Result<CsvMark> {
+        self.csv.mark()
     }
 
     /// Flushes and renames the file to `history.csv`.

@@ -12,7 +12,8 @@
 //! - [`csv_out`]: CSV tables, written quoted and complete-or-absent, read by column name;
 //! - [`summary`]: stop time, spin-down straightness, post-stop motion, energy balance;
 //! - [`fields`]: ParaView field output (VTU frames and a PVD collection);
-//! - [`runner`]: running one case into an output directory;
+//! - [`runner`]: running one case into an output directory, or resuming an interrupted run;
+//! - [`restart`]: the restart files an interrupted run is resumed from;
 //! - [`batch`]: running many cases in parallel;
 //! - [`mod@bench`]: the cost of a case beside its error over a ladder of time steps;
 //! - [`report`]: the validation report: the benchmark runs, the hard cases, the convergence
@@ -29,6 +30,7 @@ pub mod history;
 pub mod model_file;
 pub mod newton;
 pub mod report;
+pub mod restart;
 pub mod runner;
 pub mod schema;
 pub mod summary;
@@ -37,7 +39,8 @@ pub mod validate;
 pub use batch::{BatchEntry, BatchError, BatchStatus, collect_case_files, run_batch};
 pub use report::{ReportError, ReportOutcome, ReportSources, write_report};
 pub use runner::{
-    RunSummary, default_output_dir, read_deck_model, run_case, run_case_file, run_file,
+    Resumed, RunSummary, default_output_dir, read_deck_model, resume_run, run_case, run_case_file,
+    run_file,
 };
 pub use schema::Case;
 pub use summary::Summary;

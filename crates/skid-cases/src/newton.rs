@@ -15,7 +15,7 @@ use std::path::Path;
 use skid_integrator::Model;
 use skid_integrator::stepper::{IncrementReport, Observer};
 
-use crate::csv_out::PartialCsv;
+use crate::csv_out::{CsvMark, PartialCsv};
 
 /// File name of the Newton residual history.
 pub const NEWTON_CSV: &str = "newton.csv";
@@ -45,6 +45,25 @@ impl NewtonRecorder {
         Ok(Self {
             csv: PartialCsv::create(&dir.join(NEWTON_CSV), &COLUMNS)?,
         })
+    }
+
+    /// Continues the residual history of an interrupted run: `dir/newton.csv.partial`
+    /// reopened at `mark` ([`PartialCsv::reopen`]).
+    ///
+    /// # Errors
+    /// As [`PartialCsv::reopen`].
+    pub fn reopen(dir: &Path, mark: &CsvMark) -> std::io::Result<Self> {
+        Ok(Self {
+            csv: PartialCsv::reopen(&dir.join(NEWTON_CSV), mark)?,
+        })
+    }
+
+    /// Flushes the rows so far to disk and returns the file's mark, for a restart point.
+    ///
+    /// # Errors
+    /// I/O errors.
+    pub fn mark(&mut self) -> std::io::Result<CsvMark> {
+        self.csv.mark()
     }
 
     /// Flushes and renames the file to `newton.csv`.

@@ -69,6 +69,14 @@ pub enum CaseError {
         /// What is wrong.
         message: String,
     },
+    /// An interrupted run cannot be resumed: no restart file, or one that does not fit.
+    #[error("{dir}: cannot resume: {message}")]
+    Resume {
+        /// The run directory.
+        dir: PathBuf,
+        /// Why not.
+        message: String,
+    },
     /// Results could not be written.
     #[error("{path}: cannot write: {source}")]
     Output {

@@ -9,6 +9,7 @@ use skid_cases::csv_out::CsvTable;
 use skid_cases::deck::read_model;
 use skid_cases::drum::{deck, model_spec};
 use skid_cases::model_file::spec::{ModelStepSpec, RigidSurfaceSpec, SlaveSpec};
+use skid_cases::restart::DEFAULT_RESTART_EVERY;
 use skid_cases::runner::run_model;
 use skid_cases::{RunSummary, load_case, run_file};
 
@@ -68,6 +69,7 @@ fn drum_decks_run_to_the_histories_of_their_case_files() {
             &repo(&format!("cases/inp/{name}.inp")),
             &short,
             Some(&deck_dir),
+            DEFAULT_RESTART_EVERY,
         )
         .expect("deck run");
         // the case file's scene run as a model file, whose history has the generic columns

@@ -8,6 +8,7 @@ use serde_json::{Value, json};
 use skid_cases::csv_out::CsvTable;
 use skid_cases::drum::model_spec;
 use skid_cases::model_file::{self, ModelSpec, SpecError, parse_model, to_json};
+use skid_cases::restart::DEFAULT_RESTART_EVERY;
 use skid_cases::{RunSummary, load_case, run_case_file, run_file};
 use skid_integrator::stepper::{IncrementReport, Observer, run};
 
@@ -113,8 +114,13 @@ fn a_case_and_its_model_file_give_bit_identical_runs() {
         let spec = model_spec(&load_case(&path, &overrides).expect("case")).expect("model");
         let model_path = dir.path().join("model.json");
         std::fs::write(&model_path, to_json(&spec)).expect("write model");
-        let summary =
-            run_file(&model_path, &[], Some(&dir.path().join("model"))).expect("model runs");
+        let summary = run_file(
+            &model_path,
+            &[],
+            Some(&dir.path().join("model")),
+            DEFAULT_RESTART_EVERY,
+        )
+        .expect("model runs");
         assert!(
             matches!(summary, RunSummary::Model(_)),
             "{name}: run as a model file"
@@ -145,7 +151,7 @@ fn a_block_on_a_sliding_ground_brakes_it_at_exactly_mu_n_over_m() {
             "cases/verification/{dim}d-block-on-sliding-ground.json"
         ));
         let dir = tempfile::tempdir().expect("tempdir");
-        let summary = run_file(&path, &[], Some(dir.path())).expect("runs");
+        let summary = run_file(&path, &[], Some(dir.path()), DEFAULT_RESTART_EVERY).expect("runs");
         assert_eq!(summary.error(), None, "{dim}D");
         let table = Columns::read(&dir.path().join("history.csv"));
         let col = |name: &str| table.numbers(name);

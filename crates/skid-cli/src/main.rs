@@ -50,14 +50,24 @@ enum Command {
     /// Run one case file, model file or input deck (.inp); writes history.csv and
     /// summary.json, and prints the summary as one line of JSON.
     Run {
-        /// The case file or model file (JSON), or the input deck (.inp).
-        case: PathBuf,
+        /// The case file or model file (JSON), or the input deck (.inp); with --resume,
+        /// optional (if given, it must be the input the run was started with).
+        #[arg(required_unless_present = "resume")]
+        case: Option<PathBuf>,
         /// Output directory [default: out/<case name>].
-        #[arg(long)]
+        #[arg(long, conflicts_with = "resume")]
         out: Option<PathBuf>,
         /// Override a field of the case, e.g. `--set steps[1].dt=1e-4` (repeatable).
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         overrides: Vec<String>,
+        /// Continue the interrupted run in DIR from its restart file (restart.json) with the
+        /// input stored there; the outputs are those of the uninterrupted run.
+        #[arg(long, value_name = "DIR")]
+        resume: Option<PathBuf>,
+        /// Write the restart file every N converged increments, and at the start and the end
+        /// of each step (0: no restart file) [default: 100; with --resume, the run's own].
+        #[arg(long, value_name = "N")]
+        restart_every: Option<usize>,
     },
     /// Write a case file, model file or deck as a model file (.json) or a deck (.inp), by the
     /// output's extension: the same run in another form.
@@ -164,9 +174,28 @@ fn main() -> ExitCode {
         }
         Command::Run {
             case,
+            overrides,
+            resume: Some(dir),
+            restart_every,
+            ..
+        } => {
+            if case.is_none() && !overrides.is_empty() {
+                eprintln!("skid: --set needs the input it applies to");
+                return ExitCode::from(2);
+            }
+            run::resume(&dir, case.as_deref(), &overrides, restart_every)
+        }
+        Command::Run {
+            case: Some(case),
             out,
             overrides,
-        } => run::run(&case, &overrides, out.as_deref()),
+            resume: None,
+            restart_every,
+        } => run::run(&case, &overrides, out.as_deref(), restart_every),
+        Command::Run { case: None, .. } => {
+            eprintln!("skid run: the input file is missing");
+            ExitCode::from(2)
+        }
         Command::Convert {
             case,
             out,

@@ -49,6 +49,7 @@ use faer::sparse::linalg::matmul::sparse_dense_matmul;
 use faer::sparse::{Argsort, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat};
 use faer::{Accum, Conj, MatRef};
 use nalgebra::DVector;
+use serde::{Deserialize, Serialize};
 use skid_contact::coulomb::alart_curnier::{LocalBranch, LocalLaw};
 
 use crate::coupling::{ContactRows, contact_coordinates};
@@ -147,12 +148,39 @@ fn sparse_times(a: SparseColMatRef<'_, usize, f64>, x: &DVector<f64>, out: &mut 
 pub struct GlobalContactSolver {
     analysed: Option<Analysed>,
     factors: Option<Factors>,
+    /// The compressed values of the matrix `factors` factorize (of the analysed pattern): what
+    /// [`GlobalContactSolver::restore`] factorizes again to continue a run exactly.
+    factored_values: Option<Vec<f64>>,
     /// The last GMRES on `factors` failed: skip them until the next factorization.
     factors_stale: bool,
     /// The quasi-definite preconditioner.
     quasi_definite: QuasiDefinite,
     /// Symbolic analyses performed.
     pub analyses: usize,
+}
+
+/// What a [`GlobalContactSolver`] carries from one increment to the next and that changes its
+/// results: the last LU factorization, which preconditions GMRES on later systems. Rebuilt
+/// from the matrix it factorized, the factors are the same bits (the factorization is
+/// deterministic at one thread), so a run continued from a checkpoint takes the same path.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct GlobalSolverMemory {
+    /// The factorized matrix, if any: its dimension, the entries `(row, column)` of its pattern
+    /// as assembled (duplicates included, in order) and its compressed values.
+    pub factored: Option<FactoredMatrix>,
+    /// Whether those factors have stopped serving as a preconditioner.
+    pub stale: bool,
+}
+
+/// A matrix of the global contact system that was factorized (see [`GlobalSolverMemory`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FactoredMatrix {
+    /// Number of rows and columns.
+    pub dim: usize,
+    /// Entries `(row, column)` as assembled, duplicates included.
+    pub entries: Vec<(usize, usize)>,
+    /// Values of the compressed (duplicates summed) matrix, column by column.
+    pub values: Vec<f64>,
 }
 
 /// The result of [`GlobalContactSolver::step`].
@@ -165,6 +193,69 @@ pub struct GlobalStep {
 }
 
 impl GlobalContactSolver {
+    /// What this solver carries into the next increment (see [`GlobalSolverMemory`]).
+    pub fn memory(&self) -> GlobalSolverMemory {
+        let factored = self
+            .analysed
+            .as_ref()
+            .zip(self.factored_values.as_ref())
+            .filter(|_| self.factors.is_some())
+            .map(|(analysed, values)| FactoredMatrix {
+                dim: analysed.symbolic.nrows(),
+                entries: analysed.pairs.iter().map(|p| (p.row, p.col)).collect(),
+                values: values.clone(),
+            });
+        GlobalSolverMemory {
+            factored,
+            stale: self.factors_stale,
+        }
+    }
+
+    /// A solver in the state `memory` describes: the pattern analysed and the matrix
+    /// factorized again.
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] if the entries do not form a pattern of `dim` rows,
+    /// the values do not fit it, or the factorization fails.
+    pub fn restore(memory: &GlobalSolverMemory) -> Result<Self, IncrementFailure> {
+        let mut solver = Self::default();
+        if let Some(m) = &memory.factored {
+            if m.entries.iter().any(|&(i, j)| i >= m.dim || j >= m.dim) {
+                return Err(IncrementFailure::linear(
+                    SYSTEM,
+                    LinearFailure::Structure("restored entries outside the matrix".into()),
+                ));
+            }
+            let pairs = m.entries.iter().map(|&(i, j)| Pair::new(i, j)).collect();
+            let zeros = vec![0.0; m.entries.len()];
+            solver.assemble(m.dim, pairs, &zeros)?;
+            let symbolic = solver
+                .analysed
+                .as_ref()
+                .map(|a| a.symbolic.clone())
+                .ok_or_else(|| {
+                    IncrementFailure::linear(SYSTEM, LinearFailure::Structure("no pattern".into()))
+                })?;
+            if symbolic.row_idx().len() != m.values.len() {
+                return Err(IncrementFailure::linear(
+                    SYSTEM,
+                    LinearFailure::Structure(format!(
+                        "restored matrix has {} values for {} entries",
+                        m.values.len(),
+                        symbolic.row_idx().len()
+                    )),
+                ));
+            }
+            if m.values.iter().any(|v| !v.is_finite()) {
+                return Err(IncrementFailure::linear(SYSTEM, LinearFailure::NonFinite));
+            }
+            let matrix = SparseColMat::new(symbolic, m.values.clone());
+            solver.factorize(matrix.as_ref())?;
+        }
+        solver.factors_stale = memory.stale;
+        Ok(solver)
+    }
+
     /// Solves the linearised system of the module documentation at the current iterate: `k` is
     /// the lower triangle of the effective tangent (with the contact curvature of `r` and the
     /// held equations replaced by identity rows), `rows` the contact rows at the iterate,
@@ -446,6 +537,7 @@ impl GlobalContactSolver {
             )
             .map_err(|e| fail(&e))?;
         self.factors = Some(Factors { symbolic, numeric });
+        self.factored_values = Some(matrix.val().to_vec());
         self.factors_stale = false;
         Ok(())
     }
@@ -476,6 +568,7 @@ impl GlobalContactSolver {
                 .map_err(|e| fail("analysis", &e))?;
             self.analyses += 1;
             self.factors = None;
+            self.factored_values = None;
             self.analysed = Some(Analysed {
                 pairs,
                 symbolic,

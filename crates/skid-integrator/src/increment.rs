@@ -89,7 +89,7 @@ pub enum IncrementKind {
 }
 
 /// Wall time spent in the parts of the Newton loop.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Timings {
     /// Element loop, loads and contact kinematics.
     pub assembly: Duration,

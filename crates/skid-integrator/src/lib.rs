@@ -41,5 +41,6 @@ pub use error::{IncrementFailure, LinearFailure, ModelError, RunError};
 pub use model::{ContactPair, Model, PressureLoad, SolidPart, Tie};
 pub use state::State;
 pub use stepper::{
-    Adaptive, IncrementReport, Observer, RunStatistics, Settings, Step, StepKind, run,
+    Adaptive, Checkpoint, IncrementReport, Observer, RunStatistics, Settings, Step, StepKind,
+    resume, run,
 };

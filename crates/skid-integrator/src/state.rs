@@ -1,9 +1,10 @@
 //! The solution state at the end of a converged increment.
 
 use nalgebra::{DVector, Vector2};
+use serde::{Deserialize, Serialize};
 
 /// State of one contact candidate (slave node of a pair) at the end of an increment.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ContactPointState {
     /// Contact pair index.
     pub pair: usize,
@@ -29,7 +30,7 @@ impl ContactPointState {
 }
 
 /// Energies and work accumulated since the start of the run (J).
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EnergyLedger {
     /// Kinetic energy `1/2 v^T M v` (solid, plates and drums).
     pub kinetic: f64,
@@ -49,7 +50,7 @@ pub struct EnergyLedger {
 }
 
 /// Solution at the end of an increment.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct State {
     /// Physical time, s (static steps take none).
     pub time: f64,

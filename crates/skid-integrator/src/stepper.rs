@@ -12,17 +12,25 @@
 //! local error is estimated, an increment whose error exceeds the tolerance is taken again
 //! shorter, and the next size follows from the error (see [`Adaptive`]); an increment also ends
 //! where a spinning rigid body's angular velocity would reach zero (the stop of a braked drum).
+//!
+//! A run can be continued from a [`Checkpoint`]: the state after a converged increment with the
+//! stepper's position in its step, the counters so far and what the solver carries from one
+//! increment to the next. An observer asks for checkpoints ([`Observer::wants_checkpoint`]);
+//! [`resume`] continues from one and reports the same increments, with the same bits, as the
+//! uninterrupted run would have after it (at one factorization thread). Where checkpoints are
+//! stored is the caller's business.
 
 use std::time::{Duration, Instant};
 
 use nalgebra::DVector;
+use serde::{Deserialize, Serialize};
 use skid_contact::coulomb::CoulombSettings;
 
 use crate::assembly::{Assembler, external_forces};
 use crate::coupling::contact_rows;
 use crate::dof::EquationKind;
 use crate::error::{IncrementFailure, RunError};
-use crate::global_contact::GlobalContactSolver;
+use crate::global_contact::{GlobalContactSolver, GlobalSolverMemory};
 use crate::hht::Hht;
 use crate::increment::{
     ContactSolve, IncrementCounters, IncrementKind, NewtonSettings, Timings, Workspace,
@@ -137,6 +145,29 @@ enum Verdict {
 }
 
 impl AdaptiveRun {
+    /// The memory of an adaptive step with `control`, as a checkpoint left it (`None`: at the
+    /// step's start, over `n` equations).
+    fn new(control: Adaptive, memory: Option<&AdaptiveMemory>, n: usize) -> Self {
+        Self {
+            control,
+            mean_acceleration: memory
+                .and_then(|m| m.mean_acceleration.as_ref())
+                .map(|a| DVector::from_column_slice(a)),
+            stopped: memory.map_or_else(|| vec![false; n], |m| m.stopped.clone()),
+        }
+    }
+
+    /// This memory, for a checkpoint.
+    fn memory(&self) -> AdaptiveMemory {
+        AdaptiveMemory {
+            mean_acceleration: self
+                .mean_acceleration
+                .as_ref()
+                .map(|a| a.as_slice().to_vec()),
+            stopped: self.stopped.clone(),
+        }
+    }
+
     /// Judges the converged increment of size `h` from `start` to `end` (see [`Adaptive`]): its
     /// error measure decides whether it is kept and the next size, which is then shortened to
     /// end where a spinning body would stop.
@@ -312,10 +343,182 @@ pub trait Observer<const D: usize> {
         model: &Model<D>,
         report: &IncrementReport<'_>,
     ) -> std::io::Result<()>;
+
+    /// Whether to receive a [`Checkpoint`] of the run as it stands after the increment just
+    /// reported (asked after every [`Self::on_increment`]); `boundary` is true for the initial
+    /// state and the last increment of each step. A checkpoint copies the state, so the default
+    /// asks for none.
+    fn wants_checkpoint(&mut self, boundary: bool) -> bool {
+        let _ = boundary;
+        false
+    }
+
+    /// Receives the checkpoint [`Self::wants_checkpoint`] asked for.
+    ///
+    /// # Errors
+    /// An I/O error stops the run.
+    fn on_checkpoint(&mut self, model: &Model<D>, checkpoint: &Checkpoint) -> std::io::Result<()> {
+        let _ = (model, checkpoint);
+        Ok(())
+    }
+}
+
+/// What the solver carries from one increment to the next that changes later results: a run
+/// continued from a [`Checkpoint`] starts from it instead of from an empty workspace.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SolverMemory {
+    /// Equations the tangent's factorization eliminates last (grown by the reduced contact
+    /// step, see [`crate::sparse`]).
+    pub trailing: Vec<usize>,
+    /// The global contact system's last factorization.
+    pub global: GlobalSolverMemory,
+}
+
+impl SolverMemory {
+    /// The memory of `workspace`.
+    fn of(workspace: &Workspace) -> Self {
+        Self {
+            trailing: workspace.assembler.trailing().to_vec(),
+            global: workspace.global.memory(),
+        }
+    }
+}
+
+/// An adaptive step's memory in a [`Checkpoint`] (see [`Adaptive`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AdaptiveMemory {
+    /// Mean acceleration `abar` of the last accepted increment, per equation (none before the
+    /// first increment of the step).
+    pub mean_acceleration: Option<Vec<f64>>,
+    /// Per equation: whether its rotation has stopped in this step.
+    pub stopped: Vec<bool>,
+}
+
+/// Where the stepper stands within a step after a converged increment.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StepPosition {
+    /// Load factor at the start of the step.
+    pub start_load_factor: f64,
+    /// Time at the start of the step, s.
+    pub start_time: f64,
+    /// Fraction of the step done, in [0, 1].
+    pub progress: f64,
+    /// Size of the next increment, as a fraction of the step.
+    pub size: f64,
+    /// Successful increments since the last cutback or growth of the size.
+    pub successes: usize,
+    /// Converged increments of the step so far.
+    pub increment: usize,
+    /// An adaptive step's memory (`None` for a step of fixed increments).
+    pub adaptive: Option<AdaptiveMemory>,
+}
+
+/// A run as it stands after a converged increment or at its initial state: everything
+/// [`resume`] needs to continue it as the uninterrupted run continues.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Checkpoint {
+    /// The converged state.
+    pub state: State,
+    /// Index of the current step.
+    pub step: usize,
+    /// Position within that step (`None`: it has not begun).
+    pub position: Option<StepPosition>,
+    /// Totals of the run so far (the wall times included).
+    pub statistics: RunStatistics,
+    /// What the solver carries into the next increment.
+    pub solver: SolverMemory,
+}
+
+impl Checkpoint {
+    /// Checks that this checkpoint belongs to a run of `model` over `steps`: sizes of every
+    /// vector, the contact candidates, the step index, the position.
+    ///
+    /// # Errors
+    /// [`RunError::Invalid`] saying what does not fit.
+    pub fn check<const D: usize>(&self, model: &Model<D>, steps: &[Step]) -> Result<(), RunError> {
+        let bad = |what: String| Err(RunError::Invalid(format!("checkpoint: {what}")));
+        let n = model.dofs().len();
+        let s = &self.state;
+        for (name, v) in [
+            ("x", &s.x),
+            ("v", &s.v),
+            ("a", &s.a),
+            ("net_force", &s.net_force),
+            ("external_force", &s.external_force),
+            ("contact_reaction", &s.contact_reaction),
+        ] {
+            if v.len() != n {
+                return bad(format!(
+                    "state.{name} has {} entries, the model {n} equations",
+                    v.len()
+                ));
+            }
+        }
+        let candidates: Vec<(usize, usize)> = model
+            .contacts()
+            .iter()
+            .enumerate()
+            .flat_map(|(p, pair)| pair.nodes.iter().map(move |&node| (p, node)))
+            .collect();
+        let held: Vec<(usize, usize)> = s.contacts.iter().map(|c| (c.pair, c.node)).collect();
+        if held != candidates {
+            return bad("the contact candidates are not the model's".into());
+        }
+        if s.warm_forces.len() != candidates.len() * D {
+            return bad(format!(
+                "{} warm-start forces for {} candidates in {D}D",
+                s.warm_forces.len(),
+                candidates.len()
+            ));
+        }
+        if self.solver.trailing.iter().any(|&eq| eq >= n) {
+            return bad("an equation eliminated last is not the model's".into());
+        }
+        if self.step > steps.len() || (self.step == steps.len() && self.position.is_some()) {
+            return bad(format!(
+                "step {} of a run of {} steps",
+                self.step,
+                steps.len()
+            ));
+        }
+        let Some(position) = &self.position else {
+            return Ok(());
+        };
+        let adaptive = matches!(
+            steps[self.step].kind,
+            StepKind::Dynamic {
+                adaptive: Some(_),
+                ..
+            }
+        );
+        if !(position.progress.is_finite()
+            && (0.0..=1.0 + 1e-9).contains(&position.progress)
+            && position.size.is_finite()
+            && position.size > 0.0)
+        {
+            return bad(format!(
+                "progress {} and size {} of the step",
+                position.progress, position.size
+            ));
+        }
+        match (&position.adaptive, adaptive) {
+            (None, false) => Ok(()),
+            (Some(m), true)
+                if m.stopped.len() == n
+                    && m.mean_acceleration.as_ref().is_none_or(|a| a.len() == n) =>
+            {
+                Ok(())
+            }
+            _ => bad(format!(
+                "the adaptive memory does not fit step '{}'",
+                steps[self.step].name
+            )),
+        }
+    }
 }
 
 /// Totals of a run.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct RunStatistics {
     /// Equations (unknowns) of the model.
     pub equations: usize,
@@ -340,7 +543,7 @@ pub struct RunStatistics {
     /// tolerance of an adaptive step ([`Adaptive`]).
     pub error_rejections: usize,
     /// The failed attempts by kind of failure ([`IncrementFailure::kind`]).
-    pub cutback_causes: std::collections::BTreeMap<&'static str, usize>,
+    pub cutback_causes: std::collections::BTreeMap<String, usize>,
     /// Time spent in the parts of Newton (all attempts).
     pub timings: Timings,
     /// Wall time of the whole run.
@@ -495,64 +698,174 @@ pub fn run<const D: usize>(
     settings: &Settings,
     observer: &mut dyn Observer<D>,
 ) -> (RunStatistics, Result<State, RunError>) {
-    let clock = Instant::now();
-    let mut stats = RunStatistics {
-        equations: model.dofs().len(),
-        contact_candidates: model.contacts().iter().map(|p| p.nodes.len()).sum(),
-        ..RunStatistics::default()
-    };
-    let result = run_steps(model, steps, settings, observer, &mut stats);
-    stats.wall_time = clock.elapsed();
-    (stats, result)
+    run_from(model, steps, settings, observer, None)
 }
 
-fn run_steps<const D: usize>(
+/// Continues the run of `steps` from `checkpoint` (taken from a run of the same model, steps
+/// and settings), reporting the increments after it to `observer` as the uninterrupted run
+/// reports them; the initial state is not reported again. The statistics go on from the
+/// checkpoint's (its wall time included).
+///
+/// Returns as [`run`]; a checkpoint that does not fit the model or the steps stops the run with
+/// [`RunError::Invalid`].
+pub fn resume<const D: usize>(
     model: &Model<D>,
     steps: &[Step],
     settings: &Settings,
     observer: &mut dyn Observer<D>,
-    stats: &mut RunStatistics,
-) -> Result<State, RunError> {
-    validate_steps(model, steps)?;
-    let starts_static = matches!(
-        steps.first().map(|s| &s.kind),
-        Some(StepKind::Static { .. })
-    );
-    let fail_initial = |cause| RunError::StepFailed {
-        step: "initial".into(),
-        increment: 0,
-        time: 0.0,
-        size: 0.0,
-        cutbacks: 0,
-        cause,
-    };
-    let mut state =
-        initial_state(model, if starts_static { 0.0 } else { 1.0 }).map_err(fail_initial)?;
-    let mut workspace = Workspace {
-        assembler: Assembler::new(model).map_err(|e| RunError::Invalid(e.to_string()))?,
-        global: GlobalContactSolver::default(),
-    };
-    let none = IncrementCounters::default();
-    observer.on_increment(
-        model,
-        &IncrementReport {
-            step: "initial",
-            dynamic: false,
-            increment: 0,
-            size: 0.0,
-            state: &state,
-            counters: &none,
-        },
-    )?;
+    checkpoint: &Checkpoint,
+) -> (RunStatistics, Result<State, RunError>) {
+    run_from(model, steps, settings, observer, Some(checkpoint))
+}
 
-    let n = model.dofs().len();
-    for step in steps {
+/// [`run`] from the start (`checkpoint` `None`) or [`resume`] from a checkpoint.
+fn run_from<const D: usize>(
+    model: &Model<D>,
+    steps: &[Step],
+    settings: &Settings,
+    observer: &mut dyn Observer<D>,
+    checkpoint: Option<&Checkpoint>,
+) -> (RunStatistics, Result<State, RunError>) {
+    let clock = Instant::now();
+    let mut stats = match checkpoint {
+        Some(c) => c.statistics.clone(),
+        None => RunStatistics {
+            equations: model.dofs().len(),
+            contact_candidates: model.contacts().iter().map(|p| p.nodes.len()).sum(),
+            ..RunStatistics::default()
+        },
+    };
+    let earlier = stats.wall_time;
+    let mut run = Run {
+        model,
+        settings,
+        observer,
+        clock,
+        earlier,
+    };
+    let result = run.steps(steps, &mut stats, checkpoint);
+    stats.wall_time = earlier + clock.elapsed();
+    (stats, result)
+}
+
+/// A run in progress: what every increment uses, and the wall time so far.
+struct Run<'a, const D: usize> {
+    model: &'a Model<D>,
+    settings: &'a Settings,
+    observer: &'a mut dyn Observer<D>,
+    /// Started when this process took up the run.
+    clock: Instant,
+    /// Wall time of the run before this process took it up.
+    earlier: Duration,
+}
+
+impl<const D: usize> Run<'_, D> {
+    /// Hands the observer a checkpoint if it wants one after the increment just reported.
+    fn offer_checkpoint(
+        &mut self,
+        boundary: bool,
+        make: impl FnOnce() -> Checkpoint,
+    ) -> Result<(), RunError> {
+        if self.observer.wants_checkpoint(boundary) {
+            let mut checkpoint = make();
+            checkpoint.statistics.wall_time = self.earlier + self.clock.elapsed();
+            self.observer.on_checkpoint(self.model, &checkpoint)?;
+        }
+        Ok(())
+    }
+
+    /// The steps from the start, or from `checkpoint`.
+    fn steps(
+        &mut self,
+        steps: &[Step],
+        stats: &mut RunStatistics,
+        checkpoint: Option<&Checkpoint>,
+    ) -> Result<State, RunError> {
+        let model = self.model;
+        validate_steps(model, steps)?;
+        let mut assembler = Assembler::new(model).map_err(|e| RunError::Invalid(e.to_string()))?;
+        let (mut state, first_step, mut position) = match checkpoint {
+            Some(c) => {
+                c.check(model, steps)?;
+                (c.state.clone(), c.step, c.position.clone())
+            }
+            None => {
+                let starts_static = matches!(
+                    steps.first().map(|s| &s.kind),
+                    Some(StepKind::Static { .. })
+                );
+                let fail_initial = |cause| RunError::StepFailed {
+                    step: "initial".into(),
+                    increment: 0,
+                    time: 0.0,
+                    size: 0.0,
+                    cutbacks: 0,
+                    cause,
+                };
+                let state = initial_state(model, if starts_static { 0.0 } else { 1.0 })
+                    .map_err(fail_initial)?;
+                (state, 0, None)
+            }
+        };
+        let global = match checkpoint {
+            Some(c) => {
+                let invalid = |e: IncrementFailure| {
+                    RunError::Invalid(format!("checkpoint: solver memory: {e}"))
+                };
+                assembler
+                    .eliminate_last(&c.solver.trailing)
+                    .map_err(invalid)?;
+                GlobalContactSolver::restore(&c.solver.global).map_err(invalid)?
+            }
+            None => GlobalContactSolver::default(),
+        };
+        let mut workspace = Workspace { assembler, global };
+        if checkpoint.is_none() {
+            let none = IncrementCounters::default();
+            self.observer.on_increment(
+                model,
+                &IncrementReport {
+                    step: "initial",
+                    dynamic: false,
+                    increment: 0,
+                    size: 0.0,
+                    state: &state,
+                    counters: &none,
+                },
+            )?;
+            self.offer_checkpoint(true, || Checkpoint {
+                state: state.clone(),
+                step: 0,
+                position: None,
+                statistics: stats.clone(),
+                solver: SolverMemory::of(&workspace),
+            })?;
+        }
+        for (index, step) in steps.iter().enumerate().skip(first_step) {
+            let at = position.take();
+            state = self.step(index, step, state, at, &mut workspace, stats)?;
+        }
+        Ok(state)
+    }
+
+    /// Step `index` from its start (`position` `None`, `state` the end of the previous step)
+    /// or from `position` within it; returns the state at its end.
+    fn step(
+        &mut self,
+        index: usize,
+        step: &Step,
+        mut state: State,
+        position: Option<StepPosition>,
+        workspace: &mut Workspace,
+        stats: &mut RunStatistics,
+    ) -> Result<State, RunError> {
+        let model = self.model;
+        let settings = self.settings;
+        let n = model.dofs().len();
         let mut held = vec![false; n];
         for eq in step.held.iter().flat_map(|h| h.equations(model)) {
             held[eq] = true;
         }
-        let lambda0 = state.load_factor;
-        let t0 = state.time;
         let (nominal, span, adaptive) = match step.kind {
             StepKind::Static { increments, .. } => (1.0 / increments as f64, 1.0, None),
             StepKind::Dynamic {
@@ -560,24 +873,34 @@ fn run_steps<const D: usize>(
                 dt,
                 adaptive,
                 ..
-            } => {
-                state.a = consistent_acceleration(model, &state, &held);
-                (dt / duration, duration, adaptive)
-            }
+            } => (dt / duration, duration, adaptive),
         };
+        if position.is_none() && matches!(step.kind, StepKind::Dynamic { .. }) {
+            state.a = consistent_acceleration(model, &state, &held);
+        }
         // With adaptive increments the size may shrink to `min_dt`.
         let smallest =
             adaptive.map_or(nominal * settings.cutback.min_fraction, |a| a.min_dt / span);
-        let mut adaptive = adaptive.map(|control| AdaptiveRun {
-            control,
-            mean_acceleration: None,
-            stopped: vec![false; n],
+        let memory = position.as_ref().and_then(|p| p.adaptive.as_ref());
+        let mut adaptive = adaptive.map(|control| AdaptiveRun::new(control, memory, n));
+        let StepPosition {
+            start_load_factor: lambda0,
+            start_time: t0,
+            mut progress,
+            mut size,
+            mut successes,
+            mut increment,
+            ..
+        } = position.unwrap_or(StepPosition {
+            start_load_factor: state.load_factor,
+            start_time: state.time,
+            progress: 0.0,
+            size: nominal,
+            successes: 0,
+            increment: 0,
+            adaptive: None,
         });
-        let mut progress = 0.0;
-        let mut size = nominal;
         let mut consecutive_failures = 0;
-        let mut successes = 0;
-        let mut increment = 0;
         while progress < 1.0 - 1e-12 {
             let dp = size.min(1.0 - progress);
             let kind = match step.kind {
@@ -595,7 +918,7 @@ fn run_steps<const D: usize>(
             };
             match solve_increment(
                 model,
-                &mut workspace,
+                workspace,
                 &state,
                 kind,
                 &held,
@@ -627,7 +950,7 @@ fn run_steps<const D: usize>(
                     stats.fixed_point_iterations += counters.fixed_point_iterations;
                     stats.contact_newton_steps += counters.contact_newton_steps;
                     stats.contact_fallbacks += counters.contact_fallbacks;
-                    observer.on_increment(
+                    self.observer.on_increment(
                         model,
                         &IncrementReport {
                             step: &step.name,
@@ -646,10 +969,28 @@ fn run_steps<const D: usize>(
                         size = (size * settings.cutback.growth_factor).min(nominal);
                         successes = 0;
                     }
+                    self.offer_checkpoint(progress >= 1.0 - 1e-12, || Checkpoint {
+                        state: state.clone(),
+                        step: index,
+                        position: Some(StepPosition {
+                            start_load_factor: lambda0,
+                            start_time: t0,
+                            progress,
+                            size,
+                            successes,
+                            increment,
+                            adaptive: adaptive.as_ref().map(AdaptiveRun::memory),
+                        }),
+                        statistics: stats.clone(),
+                        solver: SolverMemory::of(workspace),
+                    })?;
                 }
                 Err(cause) => {
                     stats.cutbacks += 1;
-                    *stats.cutback_causes.entry(cause.kind()).or_default() += 1;
+                    *stats
+                        .cutback_causes
+                        .entry(cause.kind().to_string())
+                        .or_default() += 1;
                     consecutive_failures += 1;
                     successes = 0;
                     let cut = dp * settings.cutback.factor;
@@ -673,6 +1014,6 @@ fn run_steps<const D: usize>(
                 }
             }
         }
+        Ok(state)
     }
-    Ok(state)
 }

@@ -7,7 +7,10 @@ mod common;
 use nalgebra::Vector3;
 use skid_contact::plane::RigidPlane;
 use skid_integrator::increment::ContactSolve;
-use skid_integrator::stepper::{IncrementReport, Observer, Settings, Step, StepKind, run};
+use skid_integrator::stepper::{
+    Adaptive, Checkpoint, IncrementReport, Observer, RunStatistics, Settings, Step, StepKind,
+    resume, run,
+};
 use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie};
 
 const MU: f64 = 0.3;
@@ -301,4 +304,172 @@ fn global_and_reduced_solves_give_the_same_run() {
         worst_force <= 1e-4 * force_scale && worst_position <= 1e-7 * WIDTH,
         "forces differ by {worst_force:e} N, positions by {worst_position:e} m"
     );
+}
+
+/// Records every reported state and takes a checkpoint after every increment.
+struct Checkpointing {
+    states: Vec<State>,
+    checkpoints: Vec<Checkpoint>,
+}
+
+impl<const D: usize> Observer<D> for Checkpointing {
+    fn on_increment(&mut self, _: &Model<D>, r: &IncrementReport<'_>) -> std::io::Result<()> {
+        self.states.push(r.state.clone());
+        Ok(())
+    }
+
+    fn wants_checkpoint(&mut self, _boundary: bool) -> bool {
+        true
+    }
+
+    fn on_checkpoint(&mut self, _: &Model<D>, checkpoint: &Checkpoint) -> std::io::Result<()> {
+        self.checkpoints.push(checkpoint.clone());
+        Ok(())
+    }
+}
+
+/// A state as JSON: the shortest decimals that read back to each value's bits, so equal text
+/// is equal bits.
+fn bits(state: &State) -> String {
+    serde_json::to_string(state).expect("state as JSON")
+}
+
+/// The counters of `stats` (its wall times zeroed).
+fn counters(stats: &RunStatistics) -> RunStatistics {
+    RunStatistics {
+        timings: Default::default(),
+        wall_time: Default::default(),
+        ..stats.clone()
+    }
+}
+
+#[test]
+fn a_run_resumed_from_any_checkpoint_continues_bit_for_bit() {
+    // below mu N the block sticks through a preload and two dynamic steps; above, it slides
+    // through the dynamic steps alone (no static equilibrium)
+    for (side_force, first) in [(4.0, 0), (15.0, 1)] {
+        resumes_bit_for_bit(side_force, first);
+    }
+}
+
+/// Every third checkpoint of a run with `side_force` over the steps from `first` on (a preload,
+/// a dynamic step, an adaptive one) resumed: the same states, bits and counters.
+fn resumes_bit_for_bit(side_force: f64, first: usize) {
+    let (model, _) = block(side_force);
+    let mut steps = vec![
+        Step {
+            name: "preload".into(),
+            kind: StepKind::Static {
+                increments: 3,
+                regularization_time: 1e-2,
+            },
+            held: vec![],
+        },
+        Step {
+            name: "push".into(),
+            kind: StepKind::Dynamic {
+                duration: 4e-4,
+                dt: 2e-5,
+                alpha: -0.1,
+                adaptive: None,
+            },
+            held: vec![],
+        },
+        Step {
+            name: "adaptive".into(),
+            kind: StepKind::Dynamic {
+                duration: 4e-4,
+                dt: 2e-5,
+                alpha: -0.1,
+                adaptive: Some(Adaptive {
+                    tolerance: 1e-7,
+                    min_dt: 1e-6,
+                    max_dt: 1e-4,
+                }),
+            },
+            held: vec![],
+        },
+    ];
+    steps.drain(..first);
+    for method in METHODS {
+        let settings = Settings {
+            contact_solve: method,
+            ..Settings::default()
+        };
+        let mut whole = Checkpointing {
+            states: Vec::new(),
+            checkpoints: Vec::new(),
+        };
+        let (stats, result) = run(&model, &steps, &settings, &mut whole);
+        let end = result.expect("run completes");
+        // one checkpoint per reported state (the initial one included)
+        assert_eq!(whole.checkpoints.len(), whole.states.len());
+        assert!(
+            whole.states.len() > 25,
+            "{method:?}: {}",
+            whole.states.len()
+        );
+        for (k, checkpoint) in whole.checkpoints.iter().enumerate().step_by(3) {
+            // through its text, as a restart file holds it
+            let text = serde_json::to_string(checkpoint).expect("checkpoint as JSON");
+            let checkpoint: Checkpoint = serde_json::from_str(&text).expect("read back");
+            assert_eq!(bits(&checkpoint.state), bits(&whole.states[k]));
+            let mut rest = Checkpointing {
+                states: Vec::new(),
+                checkpoints: Vec::new(),
+            };
+            let (resumed, result) = resume(&model, &steps, &settings, &mut rest, &checkpoint);
+            let resumed_end = result.expect("resumed run completes");
+            assert_eq!(
+                rest.states.len(),
+                whole.states.len() - k - 1,
+                "{method:?} at {k}"
+            );
+            for (a, b) in rest.states.iter().zip(&whole.states[k + 1..]) {
+                assert_eq!(bits(a), bits(b), "{method:?}: resumed at {k}");
+            }
+            assert_eq!(bits(&resumed_end), bits(&end), "{method:?}: resumed at {k}");
+            assert_eq!(
+                counters(&resumed),
+                counters(&stats),
+                "{method:?}: resumed at {k}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_checkpoint_of_another_model_is_refused_not_a_panic() {
+    let (model, _) = block(15.0);
+    let steps = vec![Step {
+        name: "push".into(),
+        kind: StepKind::Dynamic {
+            duration: 1e-4,
+            dt: 2e-5,
+            alpha: -0.1,
+            adaptive: None,
+        },
+        held: vec![],
+    }];
+    let mut whole = Checkpointing {
+        states: Vec::new(),
+        checkpoints: Vec::new(),
+    };
+    let settings = Settings::default();
+    let (_, result) = run(&model, &steps, &settings, &mut whole);
+    result.expect("run completes");
+    let mut shorter = whole.checkpoints[2].clone();
+    shorter.state.x = shorter.state.x.rows(0, 3).into_owned();
+    let mut late = whole.checkpoints[2].clone();
+    late.step = 5;
+    let mut wrong_solver = whole.checkpoints[2].clone();
+    if let Some(m) = wrong_solver.solver.global.factored.as_mut() {
+        m.values.pop();
+    }
+    wrong_solver.solver.trailing = vec![usize::MAX];
+    for bad in [shorter, late, wrong_solver] {
+        let (_, result) = resume(&model, &steps, &settings, &mut Record(Vec::new()), &bad);
+        let error = result.expect_err("refused");
+        assert!(error.to_string().contains("checkpoint"), "{error}");
+    }
 }

@@ -18,7 +18,7 @@ use skid_integrator::state::EnergyLedger;
 use skid_integrator::stepper::{IncrementReport, Observer};
 use skid_integrator::{Model, State};
 
-use crate::csv_out::PartialCsv;
+use crate::csv_out::{CsvMark, PartialCsv};
 
 /// File name of the history.
 pub const HISTORY_CSV: &str = "history.csv";
@@ -28,7 +28,7 @@ pub const HISTORY_CSV: &str = "history.csv";
 const SLIDING_TOLERANCE: f64 = 1e-6;
 
 /// Resultants of one contact pair in one state.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PairTotals {
     /// Sum of the normal forces, N.
     pub normal_force: f64,
@@ -118,7 +118,7 @@ pub fn columns<const D: usize>(model: &Model<D>) -> Vec<String> {
 }
 
 /// A rigid body's motion in one state.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BodyState {
     /// Body name.
     pub name: String,
@@ -158,7 +158,7 @@ pub fn body_states<const D: usize>(model: &Model<D>, state: &State) -> Vec<BodyS
 }
 
 /// What a run's summary needs of its history.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct RunRecord {
     /// Time of the last converged state, s.
     pub final_time: f64,
@@ -197,6 +197,31 @@ impl ModelRecorder {
             csv: PartialCsv::create(&dir.join(HISTORY_CSV), &names)?,
             record: RunRecord::default(),
         })
+    }
+
+    /// Continues the history of an interrupted run: `dir/history.csv.partial` reopened at
+    /// `mark` ([`PartialCsv::reopen`]), with the record up to that point.
+    ///
+    /// # Errors
+    /// As [`PartialCsv::reopen`].
+    pub fn reopen(dir: &Path, mark: &CsvMark, record: RunRecord) -> std::io::Result<Self> {
+        Ok(Self {
+            csv: PartialCsv::reopen(&dir.join(HISTORY_CSV), mark)?,
+            record,
+        })
+    }
+
+    /// Flushes the rows so far to disk and returns the file's mark, for a restart point.
+    ///
+    /// # Errors
+    /// I/O errors.
+    pub fn mark(&mut self) -> std::io::Result<CsvMark> {
+        self.csv.mark()
+    }
+
+    /// The record so far, for a restart point.
+    pub fn record(&self) -> &RunRecord {
+        &self.record
     }
 
     /// Flushes and renames the file to `history.csv`.

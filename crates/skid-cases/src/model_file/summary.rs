@@ -56,11 +56,7 @@ impl From<&RunStatistics> for RunCost {
             contact_fallbacks: stats.contact_fallbacks,
             cutbacks: stats.cutbacks,
             error_rejections: stats.error_rejections,
-            cutback_causes: stats
-                .cutback_causes
-                .iter()
-                .map(|(&k, &n)| (k.to_string(), n))
-                .collect(),
+            cutback_causes: stats.cutback_causes.clone(),
             wall_time_s: stats.wall_time.as_secs_f64(),
             assembly_s: stats.timings.assembly.as_secs_f64(),
             linear_solve_s: stats.timings.linear_solve.as_secs_f64(),
