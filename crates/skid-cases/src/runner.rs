@@ -16,8 +16,8 @@ use skid_integrator::stepper::{IncrementReport, Observer, run};
 use serde::Serialize;
 
 use crate::atomic::write_atomic;
+use crate::check::{case_scene, model_scene};
 use crate::deck::{is_deck, read_model};
-use crate::drum::build;
 use crate::fields::{self, DrumOutline, FieldWriter};
 use crate::history::DrumRecorder;
 use crate::model_file::history::ModelRecorder;
@@ -143,10 +143,7 @@ pub fn run_case(case: &Case, source: &Path, dir: &Path) -> Result<Summary, CaseE
 }
 
 fn run_in<const D: usize>(case: &Case, source: &Path, dir: &Path) -> Result<Summary, CaseError> {
-    let scene = build::<D>(case).map_err(|message| CaseError::Model {
-        path: source.to_path_buf(),
-        message,
-    })?;
+    let scene = case_scene::<D>(case, source)?;
     let output = |path: PathBuf| move |source| CaseError::Output { path, source };
     clear_outputs(dir)?;
     write_atomic(
@@ -221,12 +218,6 @@ pub fn run_model(spec: &ModelSpec, source: &Path, dir: &Path) -> Result<ModelSum
         field: field.into(),
         message,
     };
-    if spec.output.field_interval.is_some() {
-        return Err(invalid(
-            "output.field_interval",
-            "ParaView field output is written for drum case files only so far; remove it".into(),
-        ));
-    }
     match spec.dimension {
         2 => run_model_in::<2>(spec, source, dir),
         3 => run_model_in::<3>(spec, source, dir),
@@ -239,11 +230,7 @@ fn run_model_in<const D: usize>(
     source: &Path,
     dir: &Path,
 ) -> Result<ModelSummary, CaseError> {
-    let scene = model_file::build::<D>(spec).map_err(|e| CaseError::Invalid {
-        path: source.to_path_buf(),
-        field: e.field,
-        message: e.message,
-    })?;
+    let scene = model_scene::<D>(spec, source)?;
     let output = |path: PathBuf| move |source| CaseError::Output { path, source };
     clear_outputs(dir)?;
     write_atomic(&dir.join(MODEL_JSON), model_file::to_json(spec))
