@@ -28,9 +28,9 @@ fn entry_args<'a>(command: &'a str, entry: &'a common::Entry) -> Vec<&'a std::ff
 #[test]
 fn every_bad_input_fails_check_with_the_message_of_run() {
     let entries = common::entries();
-    assert_eq!(
-        entries.len(),
-        common::files_with("json").len() + common::files_with("inp").len()
+    assert!(
+        entries.len() >= common::files_with("json").len() + common::files_with("inp").len(),
+        "every file of the corpus has an entry"
     );
     for entry in &entries {
         let cwd = tempfile::tempdir().expect("tempdir");
