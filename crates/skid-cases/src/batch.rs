@@ -1,6 +1,12 @@
 //! Running many case files, model files and input decks in parallel, each into
 //! `<out>/<name>/`, and recording the outcome of every one in `<out>/batch.json`.
 //!
+//! A sweep file ([`crate::sweep`]) contributes one run per combination of its parameters, each
+//! with its `parameters.json` beside its outputs. A batch may run one [`Shard`] of its runs:
+//! the runs are numbered in input order (a sweep's in its order) and shard `I` of `N` takes
+//! those whose position is `I - 1` modulo `N`, so that `N` shards started alike run every run
+//! once between them.
+//!
 //! A case that cannot be read or built, or whose run stops early, is recorded as such and does
 //! not stop the others.
 
@@ -16,7 +22,11 @@ use crate::deck::is_deck;
 use crate::model_file::{ModelSpec, declares_model, parse_model};
 use crate::runner::{RunSummary, read_deck_model, run_case, run_model};
 use crate::schema::Case;
+use crate::sweep::{SweepRun, declares_sweep, load_sweep};
 use crate::validate::load_case;
+
+/// The parameters of a sweep run, written into its output directory.
+pub const PARAMETERS_JSON: &str = "parameters.json";
 
 /// How one case of a batch ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -67,8 +77,90 @@ pub struct BatchEntry {
     pub notes: Vec<String>,
     /// Why the case could not be run, or why the run stopped early.
     pub error: Option<String>,
+    /// The sweep run this is, with its parameters (absent for a file run as it is).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep: Option<SweepRun>,
     /// Wall time spent on the case (loading, building, running, writing), s.
     pub wall_time_s: f64,
+}
+
+/// The part of a batch one invocation runs: shard `index` (from 1) of `count`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    /// Which shard, from 1 to `count`.
+    pub index: usize,
+    /// How many shards the runs are dealt into.
+    pub count: usize,
+}
+
+impl Shard {
+    /// The whole batch: shard 1 of 1.
+    pub const ALL: Shard = Shard { index: 1, count: 1 };
+
+    /// Shard `index` of `count`.
+    ///
+    /// # Errors
+    /// What was expected, unless `1 <= index <= count`.
+    pub fn new(index: usize, count: usize) -> Result<Self, String> {
+        if count == 0 || index == 0 || index > count {
+            return Err(format!(
+                "expected a shard I/N with 1 <= I <= N, got {index}/{count}"
+            ));
+        }
+        Ok(Self { index, count })
+    }
+
+    /// Reads `I/N`, e.g. `2/3`.
+    ///
+    /// # Errors
+    /// What was expected.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let expected = || format!("expected I/N (shard I of N, from 1), e.g. 2/3, got {text:?}");
+        let (index, count) = text.split_once('/').ok_or_else(expected)?;
+        let number = |s: &str| s.trim().parse::<usize>().map_err(|_| expected());
+        Self::new(number(index)?, number(count)?)
+    }
+
+    /// The shard of a Slurm job array task, from the variables Slurm sets
+    /// (`SLURM_ARRAY_TASK_ID`, `SLURM_ARRAY_TASK_MIN`, `SLURM_ARRAY_TASK_MAX`,
+    /// `SLURM_ARRAY_TASK_COUNT`, read through `var`): task `MIN` is shard 1. The array must be
+    /// contiguous (`--array=A-B`, any `A`).
+    ///
+    /// # Errors
+    /// Which variable is missing or not a number, or that the array is not contiguous.
+    pub fn from_slurm(var: impl Fn(&str) -> Option<String>) -> Result<Self, String> {
+        let read = |name: &str| -> Result<usize, String> {
+            let text = var(name).ok_or_else(|| {
+                format!("--shard slurm: {name} is not set (is this a Slurm job array task?)")
+            })?;
+            text.trim()
+                .parse()
+                .map_err(|_| format!("--shard slurm: {name}: expected a number, got {text:?}"))
+        };
+        let (id, min, max, count) = (
+            read("SLURM_ARRAY_TASK_ID")?,
+            read("SLURM_ARRAY_TASK_MIN")?,
+            read("SLURM_ARRAY_TASK_MAX")?,
+            read("SLURM_ARRAY_TASK_COUNT")?,
+        );
+        if max < min || max - min + 1 != count || id < min || id > max {
+            return Err(format!(
+                "--shard slurm: expected a contiguous job array (--array=A-B), got tasks                  {min}..{max} counting {count}, this one {id}"
+            ));
+        }
+        Self::new(id - min + 1, count)
+    }
+
+    /// Whether the run at `position` (from 0, over the whole batch) belongs to this shard.
+    pub fn takes(self, position: usize) -> bool {
+        position % self.count == self.index - 1
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
 }
 
 /// Errors that stop a whole batch (a single case's failure does not).
@@ -160,7 +252,21 @@ impl Input {
 /// A file after loading: its input, or the entry recording why it cannot run.
 type Loaded = Result<Input, BatchEntry>;
 
-fn error_entry(file: &Path, name: String, error: String, started: Instant) -> BatchEntry {
+/// One run of a batch: the file it runs, its input (or why it cannot run), and the sweep run
+/// it is, if any.
+struct Job {
+    file: PathBuf,
+    loaded: Loaded,
+    sweep: Option<SweepRun>,
+}
+
+fn error_entry(
+    file: &Path,
+    name: String,
+    error: String,
+    sweep: Option<SweepRun>,
+    started: Instant,
+) -> BatchEntry {
     BatchEntry {
         case_file: file.to_path_buf(),
         name,
@@ -168,72 +274,124 @@ fn error_entry(file: &Path, name: String, error: String, started: Instant) -> Ba
         summary: None,
         notes: Vec::new(),
         error: Some(error),
+        sweep,
         wall_time_s: started.elapsed().as_secs_f64(),
     }
 }
 
-/// Reads a deck, a model file (JSON declaring `skid_model`) or a case file.
-fn load(file: &Path) -> Result<Input, String> {
+/// Reads a deck, a model file (JSON declaring `skid_model`) or a case file, with `overrides`.
+fn load(file: &Path, overrides: &[String]) -> Result<Input, String> {
     if is_deck(file) {
-        return read_deck_model(file, &[])
+        return read_deck_model(file, overrides)
             .map(|(spec, notes)| Input::Model(spec, notes))
             .map_err(|e| e.to_string());
     }
     if let Ok(text) = std::fs::read_to_string(file)
         && declares_model(&text)
     {
-        return parse_model(&text, file, &[])
+        return parse_model(&text, file, overrides)
             .map(|spec| Input::Model(spec, Vec::new()))
             .map_err(|e| e.to_string());
     }
-    load_case(file, &[])
+    load_case(file, overrides)
         .map(Input::Case)
         .map_err(|e| e.to_string())
 }
 
-/// Loads every file; one whose name an earlier file already uses cannot run (both would write
-/// the same output directory).
-fn load_all(files: &[PathBuf]) -> Vec<(PathBuf, Loaded)> {
-    let mut owners: HashMap<String, PathBuf> = HashMap::new();
-    files
-        .iter()
-        .map(|file| {
-            let started = Instant::now();
-            let stem = file.file_stem().map_or_else(
-                || file.display().to_string(),
-                |s| s.to_string_lossy().into(),
-            );
-            let loaded = match load(file) {
-                Err(e) => Err(error_entry(file, stem, e, started)),
-                Ok(input) => match owners.get(input.name()) {
-                    Some(owner) => {
-                        let message = format!(
-                            "name '{}' is already used by {}",
-                            input.name(),
-                            owner.display()
-                        );
-                        Err(error_entry(
-                            file,
-                            input.name().to_string(),
-                            message,
-                            started,
-                        ))
-                    }
-                    None => {
-                        owners.insert(input.name().to_string(), file.clone());
-                        Ok(input)
-                    }
-                },
-            };
-            (file.clone(), loaded)
-        })
-        .collect()
+/// The name of a file that could not be read: its stem.
+fn stem(file: &Path) -> String {
+    file.file_stem().map_or_else(
+        || file.display().to_string(),
+        |s| s.to_string_lossy().into(),
+    )
 }
 
-fn run_one(file: &Path, input: &Input, out: &Path) -> BatchEntry {
+/// Loads every file, a sweep file as its runs (its base with each run's overrides); a run
+/// whose name an earlier one already uses cannot run (both would write the same output
+/// directory).
+fn load_all(files: &[PathBuf]) -> Vec<Job> {
+    let mut jobs = Vec::new();
+    for file in files {
+        let started = Instant::now();
+        let is_sweep =
+            !is_deck(file) && std::fs::read_to_string(file).is_ok_and(|text| declares_sweep(&text));
+        if !is_sweep {
+            let loaded =
+                load(file, &[]).map_err(|e| error_entry(file, stem(file), e, None, started));
+            jobs.push(Job {
+                file: file.clone(),
+                loaded,
+                sweep: None,
+            });
+            continue;
+        }
+        match load_sweep(file) {
+            Err(e) => jobs.push(Job {
+                file: file.clone(),
+                loaded: Err(error_entry(file, stem(file), e.to_string(), None, started)),
+                sweep: None,
+            }),
+            Ok(sweep) => {
+                for run in sweep.runs {
+                    let started = Instant::now();
+                    let overrides: Vec<String> = sweep
+                        .spec
+                        .set
+                        .iter()
+                        .cloned()
+                        .chain(run.overrides())
+                        .collect();
+                    let loaded = load(&sweep.base, &overrides).map_err(|e| {
+                        error_entry(&sweep.base, run.name.clone(), e, Some(run.clone()), started)
+                    });
+                    jobs.push(Job {
+                        file: sweep.base.clone(),
+                        loaded,
+                        sweep: Some(run),
+                    });
+                }
+            }
+        }
+    }
+    let mut owners: HashMap<String, PathBuf> = HashMap::new();
+    for job in &mut jobs {
+        let Ok(input) = &job.loaded else { continue };
+        let name = input.name().to_string();
+        let source = job
+            .sweep
+            .as_ref()
+            .map_or_else(|| job.file.clone(), |run| run.file.clone());
+        if let Some(owner) = owners.get(&name) {
+            let message = format!("name '{name}' is already used by {}", owner.display());
+            job.loaded = Err(error_entry(
+                &job.file,
+                name,
+                message,
+                job.sweep.clone(),
+                Instant::now(),
+            ));
+        } else {
+            owners.insert(name, source);
+        }
+    }
+    jobs
+}
+
+/// Runs one loaded input into `<out>/<name>/`, a sweep run with its `parameters.json`.
+fn run_one(file: &Path, input: &Input, sweep: Option<&SweepRun>, out: &Path) -> BatchEntry {
     let started = Instant::now();
     let name = input.name().to_string();
     let dir = out.join(&name);
+    if let Some(run) = sweep {
+        let path = dir.join(PARAMETERS_JSON);
+        let written = std::fs::create_dir_all(&dir).and_then(|()| {
+            write_atomic(&path, serde_json::to_string_pretty(run).unwrap_or_default())
+        });
+        if let Err(e) = written {
+            let message = format!("{}: cannot write: {e}", path.display());
+            return error_entry(file, name, message, Some(run.clone()), started);
+        }
+    }
     let (result, expected, notes) = match input {
         Input::Case(case) => (
             run_case(case, file, &dir).map(RunSummary::Case),
@@ -265,16 +423,19 @@ fn run_one(file: &Path, input: &Input, out: &Path) -> BatchEntry {
                 error: summary.error().map(str::to_string),
                 summary: Some(summary),
                 notes,
+                sweep: sweep.cloned(),
                 wall_time_s: started.elapsed().as_secs_f64(),
             }
         }
-        Err(e) => error_entry(file, name, e.to_string(), started),
+        Err(e) => error_entry(file, name, e.to_string(), sweep.cloned(), started),
     }
 }
 
-/// Runs every file on a pool of `jobs` threads (0: one per core), each into `<out>/<name>/`, calls `progress` as each case ends, and writes `<out>/batch.json`.
+/// Runs the runs of `files` that belong to `shard` on a pool of `jobs` threads (0: one per
+/// core), each into `<out>/<name>/`, calls `progress` with the entry and the number of runs of
+/// the shard as each run ends, and writes `<out>/batch.json` listing them.
 ///
-/// Returns the entries in the order of `files`.
+/// Returns the entries in the order of `files` (a sweep's runs in its order).
 ///
 /// # Errors
 /// [`BatchError`] if the thread pool cannot start or `out`/`batch.json` cannot be written; a
@@ -283,7 +444,8 @@ pub fn run_batch(
     files: &[PathBuf],
     out: &Path,
     jobs: usize,
-    progress: impl Fn(&BatchEntry) + Sync,
+    shard: Shard,
+    progress: impl Fn(&BatchEntry, usize) + Sync,
 ) -> Result<Vec<BatchEntry>, BatchError> {
     std::fs::create_dir_all(out).map_err(|source| BatchError::Output {
         path: out.to_path_buf(),
@@ -293,16 +455,22 @@ pub fn run_batch(
         .num_threads(jobs)
         .build()
         .map_err(|source| BatchError::Pool { jobs, source })?;
-    let loaded = load_all(files);
+    let loaded: Vec<Job> = load_all(files)
+        .into_iter()
+        .enumerate()
+        .filter(|(position, _)| shard.takes(*position))
+        .map(|(_, job)| job)
+        .collect();
+    let total = loaded.len();
     let entries: Vec<BatchEntry> = pool.install(|| {
         loaded
             .par_iter()
-            .map(|(file, loaded)| {
-                let entry = match loaded {
-                    Ok(input) => run_one(file, input, out),
+            .map(|job| {
+                let entry = match &job.loaded {
+                    Ok(input) => run_one(&job.file, input, job.sweep.as_ref(), out),
                     Err(entry) => entry.clone(),
                 };
-                progress(&entry);
+                progress(&entry, total);
                 entry
             })
             .collect()
@@ -355,8 +523,8 @@ mod tests {
         std::fs::write(&b, good).expect("write");
         std::fs::write(&bad, "{ not json").expect("write");
         let loaded = load_all(&[a.clone(), b.clone(), bad.clone()]);
-        assert!(loaded[0].1.is_ok());
-        let duplicate = loaded[1].1.as_ref().expect_err("same name as a.json");
+        assert!(loaded[0].loaded.is_ok());
+        let duplicate = loaded[1].loaded.as_ref().expect_err("same name as a.json");
         assert_eq!(duplicate.status, BatchStatus::Error);
         assert!(
             duplicate
@@ -364,7 +532,7 @@ mod tests {
                 .as_deref()
                 .is_some_and(|e| e.contains("a.json"))
         );
-        let malformed = loaded[2].1.as_ref().expect_err("malformed");
+        let malformed = loaded[2].loaded.as_ref().expect_err("malformed");
         assert_eq!(malformed.name, "bad");
         assert!(
             malformed
@@ -380,13 +548,111 @@ mod tests {
         let text = include_str!("../../../cases/hard/2d-pressure-x10.json");
         let file = Path::new("2d-pressure-x10.json");
         let case = crate::validate::parse_case(text, file, &[]).expect("valid case");
-        let entry = run_one(file, &Input::Case(case), dir.path());
+        let entry = run_one(file, &Input::Case(case), None, dir.path());
         assert_eq!(entry.status, BatchStatus::FailedAsExpected, "{entry:?}");
         assert!(entry.status.as_expected());
         let other = r#"expect.failure="newton_not_converged""#.to_string();
         let case = crate::validate::parse_case(text, file, &[other]).expect("valid case");
-        let entry = run_one(file, &Input::Case(case), dir.path());
+        let entry = run_one(file, &Input::Case(case), None, dir.path());
         assert_eq!(entry.status, BatchStatus::Failed, "{entry:?}");
         assert!(!entry.status.as_expected());
+    }
+
+    #[test]
+    fn shards_deal_every_run_to_exactly_one_of_them() {
+        let shards: Vec<Shard> = (1..=3).map(|i| Shard::new(i, 3).expect("shard")).collect();
+        for position in 0..14 {
+            let owners = shards.iter().filter(|s| s.takes(position)).count();
+            assert_eq!(owners, 1, "position {position}");
+        }
+        assert!(shards[1].takes(1) && shards[1].takes(4));
+        assert!(Shard::ALL.takes(0) && Shard::ALL.takes(7));
+    }
+
+    #[test]
+    fn shards_are_read_as_i_of_n_from_1() {
+        assert_eq!(Shard::parse("2/3"), Ok(Shard { index: 2, count: 3 }));
+        assert_eq!(Shard::parse("2/3").map(|s| s.to_string()), Ok("2/3".into()));
+        for bad in ["0/3", "4/3", "1/0", "3", "a/3", "1/b", ""] {
+            let e = Shard::parse(bad).expect_err(bad);
+            assert!(e.contains("expected"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn a_slurm_array_task_is_its_shard_counted_from_the_first_task() {
+        let env = |vars: &'static [(&'static str, &'static str)]| {
+            move |name: &str| {
+                vars.iter()
+                    .find(|(n, _)| *n == name)
+                    .map(|(_, v)| (*v).to_string())
+            }
+        };
+        let zero_based = env(&[
+            ("SLURM_ARRAY_TASK_ID", "0"),
+            ("SLURM_ARRAY_TASK_MIN", "0"),
+            ("SLURM_ARRAY_TASK_MAX", "2"),
+            ("SLURM_ARRAY_TASK_COUNT", "3"),
+        ]);
+        assert_eq!(
+            Shard::from_slurm(zero_based),
+            Ok(Shard { index: 1, count: 3 })
+        );
+        let one_based = env(&[
+            ("SLURM_ARRAY_TASK_ID", "3"),
+            ("SLURM_ARRAY_TASK_MIN", "1"),
+            ("SLURM_ARRAY_TASK_MAX", "3"),
+            ("SLURM_ARRAY_TASK_COUNT", "3"),
+        ]);
+        assert_eq!(
+            Shard::from_slurm(one_based),
+            Ok(Shard { index: 3, count: 3 })
+        );
+        let stepped = env(&[
+            ("SLURM_ARRAY_TASK_ID", "2"),
+            ("SLURM_ARRAY_TASK_MIN", "0"),
+            ("SLURM_ARRAY_TASK_MAX", "4"),
+            ("SLURM_ARRAY_TASK_COUNT", "3"),
+        ]);
+        assert!(Shard::from_slurm(stepped).is_err_and(|e| e.contains("contiguous")));
+        let outside = env(&[]);
+        assert!(
+            Shard::from_slurm(outside).is_err_and(|e| e.contains("SLURM_ARRAY_TASK_ID is not set"))
+        );
+    }
+
+    #[test]
+    fn a_sweep_file_contributes_its_runs_each_with_its_overrides() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let base = dir.path().join("base.json");
+        std::fs::write(&base, include_str!("../../../cases/drum/2d-analytic.json")).expect("write");
+        let sweep = dir.path().join("mu.json");
+        std::fs::write(
+            &sweep,
+            r#"{"skid_sweep": 1, "name": "mu", "base": "base.json",
+                "set": ["drum.omega0=3"],
+                "parameters": [{"field": "contact.mu", "values": [0.1, -1, 0.3]}]}"#,
+        )
+        .expect("write");
+        let jobs = load_all(&[sweep.clone(), base.clone()]);
+        assert_eq!(jobs.len(), 4);
+        let Ok(Input::Case(first)) = &jobs[0].loaded else {
+            panic!("the first run loads")
+        };
+        assert_eq!(
+            (first.name.as_str(), first.contact.mu, first.drum.omega0),
+            ("mu-1", 0.1, 3.0)
+        );
+        let negative = jobs[1].loaded.as_ref().expect_err("mu = -1 is refused");
+        assert_eq!(negative.name, "mu-2");
+        assert!(
+            negative
+                .error
+                .as_deref()
+                .is_some_and(|e| e.contains("contact.mu"))
+        );
+        assert_eq!(negative.sweep.as_ref().map(|r| r.index), Some(2));
+        assert!(jobs[2].loaded.is_ok());
+        assert!(jobs[3].sweep.is_none() && jobs[3].loaded.is_ok());
     }
 }

@@ -14,14 +14,19 @@
 //! - [`fields`]: ParaView field output (VTU frames and a PVD collection);
 //! - [`runner`]: running one case into an output directory, or resuming an interrupted run;
 //! - [`restart`]: the restart files an interrupted run is resumed from;
-//! - [`batch`]: running many cases in parallel;
+//! - [`sweep`]: parameter sweeps over the fields of a case, model file or deck;
+//! - [`batch`]: running many cases in parallel, sweeps expanded, one shard of them or all;
+//! - [`check`]: reading and building an input without running it;
 //! - [`mod@bench`]: the cost of a case beside its error over a ladder of time steps;
+//! - [`reference`]: the JSON Schemas of case and model files and their markdown reference,
+//!   generated from the types;
 //! - [`report`]: the validation report: the benchmark runs, the hard cases, the convergence
 //!   study.
 
 pub mod atomic;
 pub mod batch;
 pub mod bench;
+pub mod check;
 pub mod csv_out;
 pub mod deck;
 pub mod drum;
@@ -29,14 +34,17 @@ pub mod fields;
 pub mod history;
 pub mod model_file;
 pub mod newton;
+pub mod reference;
 pub mod report;
 pub mod restart;
 pub mod runner;
 pub mod schema;
 pub mod summary;
+pub mod sweep;
 pub mod validate;
 
-pub use batch::{BatchEntry, BatchError, BatchStatus, collect_case_files, run_batch};
+pub use batch::{BatchEntry, BatchError, BatchStatus, Shard, collect_case_files, run_batch};
+pub use report::sweep::{SweepOutcome, write_sweep_report};
 pub use report::{ReportError, ReportOutcome, ReportSources, write_report};
 pub use runner::{
     Resumed, RunSummary, default_output_dir, read_deck_model, resume_run, run_case, run_case_file,

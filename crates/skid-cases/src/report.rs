@@ -8,6 +8,9 @@
 //! - the convergence study ([`convergence`]): t_stop and e_slide against mesh and time-step
 //!   refinement with observed orders, and Newton residual histories.
 //!
+//! The sweep report ([`sweep`]) is a report of its own: the runs of parameter sweeps, merged
+//! from the batch directories of their shards.
+//!
 //! This module: reading runs, and the comparison math (interpolation, `e_slide`); [`mod@format`]:
 //! number formatting and check lists shared by the sections.
 
@@ -16,6 +19,7 @@ pub mod format;
 pub mod hard;
 pub mod markdown;
 pub mod plot;
+pub mod sweep;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

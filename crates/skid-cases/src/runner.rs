@@ -21,9 +21,9 @@ use skid_integrator::{Model, RunError, State};
 use serde::Serialize;
 
 use crate::atomic::write_atomic;
+use crate::check::{case_scene, model_scene};
 use crate::csv_out::CsvMark;
 use crate::deck::{is_deck, read_model};
-use crate::drum::build;
 use crate::fields::{self, DrumOutline, FieldWriter};
 use crate::history::DrumRecorder;
 use crate::model_file::history::ModelRecorder;
@@ -336,10 +336,7 @@ fn run_in<const D: usize>(
     restart_every: usize,
     start: Start,
 ) -> Result<Summary, CaseError> {
-    let scene = build::<D>(case).map_err(|message| CaseError::Model {
-        path: source.to_path_buf(),
-        message,
-    })?;
+    let scene = case_scene::<D>(case, source)?;
     let fields_dir = dir.join(fields::FIELDS_DIR);
     let drum = DrumOutline {
         radius: case.drum.radius,
@@ -486,12 +483,6 @@ pub fn run_model_with(
         field: field.into(),
         message,
     };
-    if spec.output.field_interval.is_some() {
-        return Err(invalid(
-            "output.field_interval",
-            "ParaView field output is written for drum case files only so far; remove it".into(),
-        ));
-    }
     match spec.dimension {
         2 => run_model_in::<2>(spec, source, dir, restart_every, Start::Fresh),
         3 => run_model_in::<3>(spec, source, dir, restart_every, Start::Fresh),
@@ -506,11 +497,7 @@ fn run_model_in<const D: usize>(
     restart_every: usize,
     start: Start,
 ) -> Result<ModelSummary, CaseError> {
-    let scene = model_file::build::<D>(spec).map_err(|e| CaseError::Invalid {
-        path: source.to_path_buf(),
-        field: e.field,
-        message: e.message,
-    })?;
+    let scene = model_scene::<D>(spec, source)?;
     let history_path = dir.join(model_file::history::HISTORY_CSV);
     let (mut history, mut newton, input, checkpoint) = match start {
         Start::Fresh => {

@@ -8,10 +8,11 @@
 //! front face in the plane `y = R + standoff` and its back face `thickness` above, spanning
 //! `x in [-length/2, length/2]` (and `z in [-width/2, width/2]` in 3D). The drum spins about +z.
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// A complete case.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Case {
     /// Case name (output directory and report label).
@@ -44,7 +45,7 @@ pub struct Case {
 }
 
 /// The rigid drum: its inertia sits at the reference node on the axis.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct DrumSpec {
     /// Radius, m.
@@ -63,7 +64,7 @@ pub struct DrumSpec {
 
 /// Drum surface idealization. Whatever the idealization, the drum's inertia sits at its
 /// reference node and its surface carries no mass and no degrees of freedom.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum DrumSurfaceSpec {
     /// Analytical circle (2D) or cylinder (3D).
@@ -94,7 +95,7 @@ pub enum DrumSurfaceSpec {
 }
 
 /// Element types of a faceted drum.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum FacetElement {
     /// Two-node rigid line (2D).
@@ -108,7 +109,7 @@ pub enum FacetElement {
 }
 
 /// The pad block and its mesh.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct PadSpec {
     /// Circumferential length (along x), m.
@@ -141,7 +142,7 @@ fn one() -> f64 {
 }
 
 /// Element counts of the structured pad mesh.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ElementCounts {
     /// Along the circumference (x).
@@ -158,7 +159,7 @@ fn one_usize() -> usize {
 }
 
 /// Material laws.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum MaterialSpec {
     /// Polynomial hyperelasticity of order 1:
@@ -174,7 +175,7 @@ pub enum MaterialSpec {
 }
 
 /// The rigid plate tied to the pad's back face; it may only translate radially (along y).
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct BackPlateSpec {
     /// Pressure on the back face, Pa (pushes the pad onto the drum).
@@ -185,10 +186,10 @@ pub struct BackPlateSpec {
 }
 
 /// Coulomb friction between the pad and the drum.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
-    /// Friction coefficient.
+    /// Coulomb friction coefficient (dimensionless, >= 0).
     pub mu: f64,
     /// How contact candidates are chosen.
     #[serde(default)]
@@ -196,7 +197,7 @@ pub struct ContactSpec {
 }
 
 /// How contact candidates are chosen.
-#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ContactFormulation {
     /// A contact pair: the pad's front face (slave) against the drum surface (master).
@@ -212,7 +213,7 @@ pub enum ContactFormulation {
 }
 
 /// One analysis step.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum StepSpec {
     /// Static equilibrium with loads ramped to full value.
@@ -252,7 +253,7 @@ pub enum StepSpec {
 /// Error-controlled increments of a dynamic step (see `skid_integrator::stepper::Adaptive`):
 /// an increment whose estimated local error exceeds `tolerance` is taken again shorter, the
 /// next size follows from the error, and an increment ends where the drum would stop.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AdaptiveSpec {
     /// Local error tolerance, relative to the model size (translations) or 1 rad (rotations).
@@ -274,7 +275,7 @@ pub(crate) fn default_alpha() -> f64 {
 }
 
 /// Solver settings; every field is optional.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(default, deny_unknown_fields)]
 pub struct SolverSpec {
     /// Newton iteration limit per increment.
@@ -318,7 +319,7 @@ impl Default for SolverSpec {
 
 /// Which algorithm leads the exact Coulomb solve of every Newton iteration (see
 /// `skid_contact::coulomb::CoulombMethod`).
-#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum CoulombMethodSpec {
     /// Semismooth Newton from the last forces, the conic (clarabel) fixed point where it fails.
@@ -339,7 +340,7 @@ impl From<CoulombMethodSpec> for skid_contact::coulomb::CoulombMethod {
 
 /// How each Newton iteration obtains its contact forces (see
 /// `skid_integrator::increment::ContactSolve`).
-#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum ContactSolveSpec {
     /// `global` for a quasi-static pad, `reduced` otherwise. A quasi-static pad is held only by
@@ -357,34 +358,34 @@ pub enum ContactSolveSpec {
 }
 
 /// Output settings; every field is optional.
-#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(default, deny_unknown_fields)]
 pub struct OutputSpec {
-    /// Physical time between ParaView field frames in dynamic steps, s (`<out>/fields/`, see
-    /// [`crate::fields`]); frames are also written for the initial state, at the end of every
-    /// static step and at the end of the run. `None`: no field output.
+    /// Physical time between ParaView field frames in dynamic steps, s (written to
+    /// `<out>/fields/`); frames are also written for the initial state, at the end of every
+    /// static step and at the end of the run. Absent or null: no field output.
     pub field_interval: Option<f64>,
 }
 
 /// Expectations on a run, for the checks of `skid report --hard`; every field is optional.
 /// The checks themselves are derived from the case (see `skid_cases::report::hard`); this only
 /// adjusts them where a case's physics departs from the assumptions of the defaults.
-#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(default, deny_unknown_fields)]
 pub struct ExpectSpec {
     /// Relative tolerance of the stop time against the estimate `I omega0 / (mu p A R)`;
-    /// `None`: the report's default.
+    /// absent or null: the report's default.
     pub t_stop_estimate_tolerance: Option<f64>,
     /// Why the case departs from the defaults (shown in the report).
     pub note: String,
     /// The run is expected to stop early with this kind of failure: the case lies beyond what
     /// the model can represent, and shows that skid stops with a clear message and keeps its
-    /// results (issue 4). `None`: the run is expected to complete.
+    /// results. Absent or null: the run is expected to complete.
     pub failure: Option<ExpectedFailure>,
 }
 
-/// A kind of failure a case may be built to show (see [`ExpectSpec::failure`]).
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+/// A kind of failure a case may be built to show (see `expect.failure`).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum ExpectedFailure {
     /// An element turned inside out or folded.

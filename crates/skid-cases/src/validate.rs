@@ -267,12 +267,12 @@ fn non_negative(field: &str, v: f64) -> Result<(), Problem> {
 }
 
 /// Longest case or step name, in characters.
-const MAX_NAME: usize = 100;
+pub(crate) const MAX_NAME: usize = 100;
 
 /// A case name is the name of its output directory: 1 to [`MAX_NAME`] ASCII letters, digits and
 /// `.`, `_`, `+`, `-`, not starting with `.` (hidden, or the directory itself or its parent)
 /// or `-` (read as an option on a command line).
-fn check_case_name(name: &str) -> Result<(), Problem> {
+pub(crate) fn check_case_name(name: &str) -> Result<(), Problem> {
     let allowed = |c: char| c.is_ascii_alphanumeric() || "._+-".contains(c);
     if name.is_empty()
         || name.chars().count() > MAX_NAME

@@ -1,18 +1,21 @@
 //! `skid batch`: runs case files, model files and decks in parallel with a progress bar and lists the outcomes.
 //!
 //! Exit codes: 0 every case completed; 1 some case could not be run or stopped early; 2 no case
-//! files were found; 3 `batch.json` could not be written.
+//! files were found, or `--shard` is invalid; 3 `batch.json` could not be written.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use skid_cases::{BatchEntry, BatchError, BatchStatus, RunSummary, collect_case_files, run_batch};
+use skid_cases::{
+    BatchEntry, BatchError, BatchStatus, RunSummary, Shard, collect_case_files, run_batch,
+};
 
-/// The progress bar on stderr; indicatif hides it when stderr is not a terminal.
-fn progress_bar(cases: usize) -> ProgressBar {
-    let bar = ProgressBar::with_draw_target(Some(cases as u64), ProgressDrawTarget::stderr());
+/// The progress bar on stderr, its length set as the runs end; indicatif hides it when stderr
+/// is not a terminal.
+fn progress_bar() -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
     if let Ok(style) =
         ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} cases {msg}")
     {
@@ -38,8 +41,25 @@ fn line(entry: &BatchEntry, width: usize) -> String {
     )
 }
 
-/// Runs `paths` into `out` on `jobs` threads (0: one per core).
-pub fn run(paths: &[PathBuf], out: &Path, jobs: usize) -> ExitCode {
+/// The shard `--shard` names: `I/N`, or `slurm` for the Slurm array task's; all runs without it.
+fn shard(option: Option<&str>) -> Result<Shard, String> {
+    match option {
+        None => Ok(Shard::ALL),
+        Some("slurm") => Shard::from_slurm(|name| std::env::var(name).ok()),
+        Some(text) => Shard::parse(text).map_err(|e| format!("--shard: {e}")),
+    }
+}
+
+/// Runs `paths` (the runs of shard `shard_option`, all without it) into `out` on `jobs`
+/// threads (0: one per core).
+pub fn run(paths: &[PathBuf], out: &Path, jobs: usize, shard_option: Option<&str>) -> ExitCode {
+    let shard = match shard(shard_option) {
+        Ok(shard) => shard,
+        Err(e) => {
+            eprintln!("skid: {e}");
+            return ExitCode::from(2);
+        }
+    };
     let files = match collect_case_files(paths) {
         Ok(files) => files,
         Err(e) => {
@@ -47,8 +67,9 @@ pub fn run(paths: &[PathBuf], out: &Path, jobs: usize) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let bar = progress_bar(files.len());
-    let entries = run_batch(&files, out, jobs, |entry| {
+    let bar = progress_bar();
+    let entries = run_batch(&files, out, jobs, shard, |entry, total| {
+        bar.set_length(total as u64);
         if let Some(error) = &entry.error {
             bar.suspend(|| {
                 eprintln!(
@@ -85,8 +106,13 @@ pub fn run(paths: &[PathBuf], out: &Path, jobs: usize) -> ExitCode {
     } else {
         String::new()
     };
+    let of_shard = if shard == Shard::ALL {
+        String::new()
+    } else {
+        format!(" (shard {shard})")
+    };
     println!(
-        "{} of {} cases completed{expected}; see {}",
+        "{} of {} cases{of_shard} completed{expected}; see {}",
         count(BatchStatus::Completed),
         entries.len(),
         out.join("batch.json").display()

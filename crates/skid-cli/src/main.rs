@@ -1,13 +1,15 @@
 //! `skid`: run braking-drum cases from the command line.
 //!
 //! One module per command, each documenting its exit codes: [`run`], [`batch`], [`report`],
-//! [`bench`], [`convert`].
+//! [`bench`], [`convert`], [`check`], [`schema`].
 
 mod batch;
 mod bench;
+mod check;
 mod convert;
 mod report;
 mod run;
+mod schema;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -15,6 +17,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use skid_cases::ReportSources;
 use skid_cases::bench::{BenchMethod, BenchSettings};
+use skid_cases::reference::Format;
 
 #[derive(Parser)]
 #[command(
@@ -81,8 +84,9 @@ enum Command {
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         overrides: Vec<String>,
     },
-    /// Run case files, model files and decks in parallel, each into <out>/<name>/; writes
-    /// <out>/batch.json.
+    /// Run case files, model files, decks and sweep files in parallel, each run into
+    /// <out>/<name>/; writes <out>/batch.json. A sweep file runs one run per combination of its
+    /// parameters, each with its parameters.json.
     Batch {
         /// Files, or directories whose *.json and *.inp files are run (sorted by name).
         #[arg(required = true)]
@@ -93,10 +97,17 @@ enum Command {
         /// Cases run at once [default: one per core].
         #[arg(long)]
         jobs: Option<usize>,
+        /// Run shard I of N only (I from 1): the runs whose position in the batch, counted
+        /// from 0, is I-1 modulo N. `slurm` takes I and N from the Slurm job array task
+        /// (SLURM_ARRAY_TASK_ID and the array's bounds). Give each shard its own --out and
+        /// merge them with `skid report --sweep`.
+        #[arg(long, value_name = "I/N|slurm")]
+        shard: Option<String>,
     },
     /// The validation report (markdown with SVG plots): the benchmark runs against a reference
     /// run, the hard-case checks, the convergence study; each section from its own directory.
-    /// With none of --runs, --hard, --convergence: the benchmark section of `out`.
+    /// With none of --runs, --hard, --convergence, --sweep: the benchmark section of `out`.
+    /// With --sweep: the sweep report instead, merged from batch directories.
     Report {
         /// Benchmark runs: one subdirectory per run (summary.json, history.csv).
         #[arg(long)]
@@ -112,9 +123,15 @@ enum Command {
         /// one run per level.
         #[arg(long)]
         convergence: Option<PathBuf>,
-        /// The markdown report; the plots are written beside it.
-        #[arg(long, default_value = "validation/report.md")]
-        out: PathBuf,
+        /// Sweep report: the sweep runs listed by the batch.json of each directory (one
+        /// `skid batch` of sweep files, or its shards), one table per sweep in run order.
+        #[arg(long, num_args = 1.., value_name = "DIR",
+              conflicts_with_all = ["runs", "reference", "hard", "convergence"])]
+        sweep: Vec<PathBuf>,
+        /// The markdown report; the plots are written beside it [default: validation/report.md,
+        /// with --sweep out/sweep.md].
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Cost against error: each case at a ladder of time steps (coarser than the case, the
     /// case, then finer) with each contact solve, errors against the finest level; writes
@@ -144,6 +161,30 @@ enum Command {
         #[arg(long, value_delimiter = ',', default_value = "reduced,global")]
         methods: Vec<String>,
     },
+    /// Check case files, model files, decks and sweep files without running them: each (each
+    /// run of a sweep) is read, validated and built into its model (mesh, bodies, contact
+    /// candidates); prints `FILE: ok (...)` or the message `skid run` would give.
+    Check {
+        /// The case files, model files, sweep files (JSON) or decks (.inp).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Override a field of every file (repeatable), as in `skid run`.
+        #[arg(long = "set", value_name = "FIELD=VALUE")]
+        overrides: Vec<String>,
+    },
+    /// Print the JSON Schema of case files or model files, generated from the types that read
+    /// them, or with --markdown their reference (one table per type).
+    Schema {
+        /// Which format: `case`, `model` or `sweep`.
+        #[arg(default_value = "case", value_parser = Format::parse)]
+        format: Format,
+        /// The markdown reference instead of the JSON Schema.
+        #[arg(long)]
+        markdown: bool,
+        /// Write to this file instead of standard output.
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -152,14 +193,25 @@ fn main() -> ExitCode {
     // the command line, before any run starts.
     faer::set_global_parallelism(factorization_parallelism(cli.threads));
     match cli.command {
-        Command::Batch { paths, out, jobs } => batch::run(&paths, &out, jobs.unwrap_or(0)),
+        Command::Batch {
+            paths,
+            out,
+            jobs,
+            shard,
+        } => batch::run(&paths, &out, jobs.unwrap_or(0), shard.as_deref()),
         Command::Report {
             runs,
             reference,
             hard,
             convergence,
+            sweep,
             out,
         } => {
+            if !sweep.is_empty() {
+                let out = out.unwrap_or_else(|| PathBuf::from("out/sweep.md"));
+                return report::run_sweep(&sweep, &out);
+            }
+            let out = out.unwrap_or_else(|| PathBuf::from("validation/report.md"));
             let runs = match (&runs, &hard, &convergence) {
                 (None, None, None) => Some(PathBuf::from("out")),
                 _ => runs,
@@ -201,6 +253,12 @@ fn main() -> ExitCode {
             out,
             overrides,
         } => convert::run(&case, &overrides, &out),
+        Command::Check { files, overrides } => check::run(&files, &overrides),
+        Command::Schema {
+            format,
+            markdown,
+            out,
+        } => schema::run(format, markdown, out.as_deref()),
         Command::Bench {
             cases,
             out,

@@ -1,14 +1,40 @@
 //! `skid report`: the validation report of the benchmark runs, the hard cases and the
-//! convergence study.
+//! convergence study; or the sweep report of batch directories.
 //!
-//! Exit codes: 0 the report was written and every acceptance check passed (or was skipped);
-//! 1 the report was written but a check failed; 2 the runs, the reference or the study could
-//! not be read; 3 the report or its plots could not be written.
+//! Exit codes: 0 the report was written and every acceptance check passed (or was skipped),
+//! or for a sweep every run is listed and ended as expected; 1 the report was written but a
+//! check failed, or runs are missing or did not end as expected; 2 the runs, the reference,
+//! the study or a batch could not be read; 3 the report or its plots could not be written.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use skid_cases::{ReportError, ReportSources, write_report};
+use skid_cases::{ReportError, ReportSources, write_report, write_sweep_report};
+
+/// The exit code of a report that could not be written.
+fn failure(e: &ReportError) -> ExitCode {
+    eprintln!("skid: {e}");
+    ExitCode::from(match e {
+        ReportError::Plot { .. } | ReportError::Write { .. } => 3,
+        _ => 2,
+    })
+}
+
+/// Writes the sweep report of the batch directories `dirs` to `out`.
+pub fn run_sweep(dirs: &[PathBuf], out: &Path) -> ExitCode {
+    match write_sweep_report(dirs, out) {
+        Ok(outcome) => {
+            println!("wrote {}", out.display());
+            println!("{}", outcome.line());
+            if outcome.missing > 0 || outcome.unexpected > 0 {
+                ExitCode::from(1)
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+        Err(e) => failure(&e),
+    }
+}
 
 /// Writes the report of `sources` to `out`.
 pub fn run(sources: &ReportSources<'_>, out: &Path) -> ExitCode {
@@ -28,12 +54,6 @@ pub fn run(sources: &ReportSources<'_>, out: &Path) -> ExitCode {
                 ExitCode::SUCCESS
             }
         }
-        Err(e) => {
-            eprintln!("skid: {e}");
-            ExitCode::from(match e {
-                ReportError::Plot { .. } | ReportError::Write { .. } => 3,
-                _ => 2,
-            })
-        }
+        Err(e) => failure(&e),
     }
 }

@@ -2,55 +2,12 @@
 //! message naming the case file and every fragment the entry's `.expect` lists, never panics,
 //! and leaves no output behind.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 use std::process::Command;
 
-/// One entry of the corpus, read from its `.expect` file.
-struct Entry {
-    expect: PathBuf,
-    case: PathBuf,
-    overrides: Vec<String>,
-    messages: Vec<String>,
-}
-
-fn corpus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../cases/bad")
-}
-
-fn read_entry(expect: &Path) -> Entry {
-    let text = std::fs::read_to_string(expect).expect("expect file");
-    let dir = expect.parent().expect("directory");
-    let mut case = expect.with_extension("json");
-    let (mut overrides, mut messages) = (Vec::new(), Vec::new());
-    for line in text
-        .lines()
-        .filter(|l| !l.is_empty() && !l.starts_with('#'))
-    {
-        match line.split_once(": ") {
-            Some(("case", file)) => case = dir.join(file),
-            Some(("set", spec)) => overrides.push(spec.to_string()),
-            Some(("message", fragment)) => messages.push(fragment.to_string()),
-            _ => panic!("{}: unreadable line {line:?}", expect.display()),
-        }
-    }
-    assert!(!messages.is_empty(), "{}: no message", expect.display());
-    Entry {
-        expect: expect.to_path_buf(),
-        case,
-        overrides,
-        messages,
-    }
-}
-
-fn files_with(extension: &str) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(corpus())
-        .expect("cases/bad")
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == extension))
-        .collect();
-    files.sort();
-    files
-}
+use common::{Entry, corpus, files_with};
 
 fn any_file_named(dir: &Path, name: &str) -> bool {
     std::fs::read_dir(dir)
@@ -76,7 +33,7 @@ fn every_case_file_of_the_corpus_has_its_expected_message() {
 
 #[test]
 fn every_bad_input_exits_2_naming_the_file_and_field_and_writes_nothing() {
-    let entries: Vec<Entry> = files_with("expect").iter().map(|p| read_entry(p)).collect();
+    let entries: Vec<Entry> = common::entries();
     assert!(entries.len() >= 45, "{} entries", entries.len());
     for entry in &entries {
         // Run where a default output directory (out/<name>) would land in a fresh directory.

@@ -8,6 +8,7 @@
 
 use std::collections::BTreeMap;
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::schema::{
@@ -18,10 +19,10 @@ use crate::schema::{
 pub const MODEL_FORMAT_VERSION: u32 = 1;
 
 /// A whole scene: one deformable part, rigid bodies, constraints, loads, contact, steps.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
-    /// Format version, [`MODEL_FORMAT_VERSION`]; its presence marks the file as a model file.
+    /// Format version (1, the only one so far); its presence marks the file as a model file.
     pub skid_model: u32,
     /// Name of the model (default output directory `out/<name>`).
     pub name: String,
@@ -59,7 +60,7 @@ pub struct ModelSpec {
 }
 
 /// The deformable part: a mesh of one-point elements with one section.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct PartSpec {
     /// Name used in messages.
@@ -81,7 +82,7 @@ pub struct PartSpec {
 }
 
 /// Element types of a deformable part.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, JsonSchema, PartialEq, Eq)]
 pub enum ElementType {
     /// 4-node plane-strain quadrilateral, one-point integration with hourglass control (2D).
     #[serde(rename = "CPE4R")]
@@ -107,7 +108,7 @@ impl ElementType {
 }
 
 /// Elements of one type.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ElementBlockSpec {
     /// Element type.
@@ -118,7 +119,7 @@ pub struct ElementBlockSpec {
 }
 
 /// The section of a part: its material and what the element formulation needs.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SectionSpec {
     /// Hyperelastic material.
@@ -143,7 +144,7 @@ fn one() -> f64 {
 
 /// A rigid body: a reference node with a point mass and a rotary inertia, and optionally a
 /// contact surface described in its body frame (origin at the reference node).
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct RigidBodySpec {
     /// Name (boundary conditions, ties and contact pairs refer to it).
@@ -169,7 +170,7 @@ pub struct RigidBodySpec {
 }
 
 /// Rigid surfaces, in the body frame.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum RigidSurfaceSpec {
     /// The cylinder `|y - (e.y) e| = radius` about the axis `e` through the origin (in 2D the
@@ -216,7 +217,9 @@ pub enum RigidSurfaceSpec {
 }
 
 /// A degree of freedom: translations `x`, `y`, `z`, rotations `rx`, `ry`, `rz`.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(
+    Clone, Copy, Debug, Deserialize, Serialize, JsonSchema, PartialEq, Eq, PartialOrd, Ord,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Dof {
     /// Translation along x.
@@ -266,7 +269,7 @@ impl Dof {
 
 /// Degrees of freedom held at zero displacement: of a rigid body's reference node, or of the
 /// nodes of a node set (translations only).
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct BoundarySpec {
     /// Rigid body whose reference node is held (exactly one of `body` and `node_set`).
@@ -280,7 +283,7 @@ pub struct BoundarySpec {
 }
 
 /// Nodes that translate with a rigid body's reference node.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct TieSpec {
     /// Node set of the part.
@@ -290,7 +293,7 @@ pub struct TieSpec {
 }
 
 /// Loads.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum LoadSpec {
     /// A uniform follower pressure on a surface of the part (positive pushes into it), Pa.
@@ -303,7 +306,7 @@ pub enum LoadSpec {
 }
 
 /// Frictional contact between nodes of the part and a rigid body's surface.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ContactPairSpec {
     /// Name used in outputs and messages.
@@ -317,7 +320,7 @@ pub struct ContactPairSpec {
 }
 
 /// Contact candidates of a pair.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum SlaveSpec {
     /// The nodes of a node set.
@@ -334,7 +337,7 @@ pub enum SlaveSpec {
 }
 
 /// One analysis step; `boundary` adds rigid-body conditions held during this step only.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ModelStepSpec {
     /// Static equilibrium with loads ramped to full value.
@@ -371,7 +374,7 @@ pub enum ModelStepSpec {
 }
 
 /// Degrees of freedom of a rigid body held at their value at the start of a step.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct StepBoundarySpec {
     /// Rigid body.

@@ -1,0 +1,64 @@
+//! What several test files share: the bad-input corpus (`cases/bad/`, see its README).
+
+#![allow(dead_code)] // Each test file uses its part.
+
+use std::path::{Path, PathBuf};
+
+/// One entry of the corpus, read from its `.expect` file.
+pub struct Entry {
+    /// The `.expect` file.
+    pub expect: PathBuf,
+    /// The file to run.
+    pub case: PathBuf,
+    /// The `--set` overrides to pass.
+    pub overrides: Vec<String>,
+    /// Fragments the message must contain.
+    pub messages: Vec<String>,
+}
+
+/// The corpus directory.
+pub fn corpus() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../cases/bad")
+}
+
+/// Reads one `.expect` file.
+pub fn read_entry(expect: &Path) -> Entry {
+    let text = std::fs::read_to_string(expect).expect("expect file");
+    let dir = expect.parent().expect("directory");
+    let mut case = expect.with_extension("json");
+    let (mut overrides, mut messages) = (Vec::new(), Vec::new());
+    for line in text
+        .lines()
+        .filter(|l| !l.is_empty() && !l.starts_with('#'))
+    {
+        match line.split_once(": ") {
+            Some(("case", file)) => case = dir.join(file),
+            Some(("set", spec)) => overrides.push(spec.to_string()),
+            Some(("message", fragment)) => messages.push(fragment.to_string()),
+            _ => panic!("{}: unreadable line {line:?}", expect.display()),
+        }
+    }
+    assert!(!messages.is_empty(), "{}: no message", expect.display());
+    Entry {
+        expect: expect.to_path_buf(),
+        case,
+        overrides,
+        messages,
+    }
+}
+
+/// The corpus files with `extension`, sorted.
+pub fn files_with(extension: &str) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(corpus())
+        .expect("cases/bad")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == extension))
+        .collect();
+    files.sort();
+    files
+}
+
+/// Every entry of the corpus.
+pub fn entries() -> Vec<Entry> {
+    files_with("expect").iter().map(|p| read_entry(p)).collect()
+}
