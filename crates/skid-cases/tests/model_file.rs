@@ -232,7 +232,8 @@ fn a_frictionless_block_held_only_by_its_contacts_stays_at_rest_on_the_reduced_p
     .map(ToString::to_string)
     .collect();
     let dir = tempfile::tempdir().expect("tempdir");
-    let RunSummary::Model(summary) = run_file(&path, &overrides, Some(dir.path())).expect("runs")
+    let RunSummary::Model(summary) =
+        run_file(&path, &overrides, Some(dir.path()), DEFAULT_RESTART_EVERY).expect("runs")
     else {
         panic!("a model file gives a model summary");
     };

@@ -6,19 +6,11 @@
 //! removed. The runs are shortened (a short spin-down) to keep the file fast in a debug build.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use serde_json::Value;
 
-fn skid() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_skid"))
-}
-
-fn shipped(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../cases")
-        .join(relative)
-}
+mod common;
+use common::{shipped, skid};
 
 /// Keys of `summary.json` (at any depth) and `batch.json` that hold wall times.
 const TIMING_KEYS: [&str; 4] = [

@@ -12,15 +12,8 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
-fn skid() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_skid"))
-}
-
-fn shipped(relative: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../cases")
-        .join(relative)
-}
+mod common;
+use common::{shipped, skid};
 
 /// The overrides that shorten the shipped 2D drum and give it field output.
 const SHORT: [&str; 2] = ["steps[1].duration=0.004", "output.field_interval=0.001"];

@@ -1,8 +1,22 @@
-//! What several test files share: the bad-input corpus (`cases/bad/`, see its README).
+//! What several test files share: the `skid` binary, the shipped cases and the bad-input
+//! corpus (`cases/bad/`, see its README).
 
 #![allow(dead_code)] // Each test file uses its part.
 
 use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The `skid` binary of this build.
+pub fn skid() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_skid"))
+}
+
+/// A file under the repository's `cases/`.
+pub fn shipped(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../cases")
+        .join(relative)
+}
 
 /// One entry of the corpus, read from its `.expect` file.
 pub struct Entry {
