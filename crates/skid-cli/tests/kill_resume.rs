@@ -6,7 +6,7 @@
 //! output every millisecond, a restart file every 2 increments), killed at seeded random
 //! moments over the run; a resumed run is itself killed again at random until one finishes.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
