@@ -350,17 +350,13 @@ fn solve_to_length(
             ..settings.clone()
         };
         let refined = solve_contact_forces(problem, &solution.r, &tighter)?;
-        let counts = (
-            solution.conic_solves + refined.conic_solves,
-            solution.fixed_point_iterations + refined.fixed_point_iterations,
-            solution.newton_steps + refined.newton_steps,
-        );
-        solution = refined;
-        (
-            solution.conic_solves,
-            solution.fixed_point_iterations,
-            solution.newton_steps,
-        ) = counts;
+        solution = CoulombSolution {
+            conic_solves: solution.conic_solves + refined.conic_solves,
+            fixed_point_iterations: solution.fixed_point_iterations
+                + refined.fixed_point_iterations,
+            newton_steps: solution.newton_steps + refined.newton_steps,
+            ..refined
+        };
     }
     Ok(solution)
 }
