@@ -96,15 +96,24 @@ fn results(dir: &Path) -> Vec<(String, String)> {
     files
 }
 
-/// Checks what a killed run left in `dir`: no summary, no file under a final name that is not
-/// whole, a restart file (if any) that reads; returns whether it was killed in its output
-/// phase (its history already under its final name).
-fn check_killed(dir: &Path) -> bool {
-    assert!(
-        !dir.join("summary.json").exists(),
-        "{}: a killed run left a summary",
-        dir.display()
-    );
+/// Where a killed run was when the kill landed, as told by what it left.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Killed {
+    /// Before its outputs: no history under its final name yet.
+    Running,
+    /// While writing its outputs: the history under its final name, no summary yet.
+    InOutput,
+    /// After its last output (`summary.json` is written last), while the process was exiting.
+    Ended,
+}
+
+/// Checks what a killed run left in `dir`: a `summary.json` only if everything else is there
+/// (the caller compares the files), otherwise no file under a final name that is not whole and
+/// a restart file (if any) that reads; returns where the run was when it was killed.
+fn check_killed(dir: &Path) -> Killed {
+    if dir.join("summary.json").exists() {
+        return Killed::Ended;
+    }
     if let Ok(text) = std::fs::read_to_string(dir.join("restart.json")) {
         serde_json::from_str::<Value>(&text).expect("restart.json is whole");
     }
@@ -119,8 +128,10 @@ fn check_killed(dir: &Path) -> bool {
             47,
             "a history.csv under its name is complete"
         );
+        Killed::InOutput
+    } else {
+        Killed::Running
     }
-    history.exists()
 }
 
 /// A tiny seeded generator (xorshift64*), for kill moments that are random but repeatable.
@@ -214,7 +225,7 @@ fn runs_killed_at_random_moments_resume_to_the_uninterrupted_outputs() {
         };
         if killed {
             kills += 1;
-            in_output += usize::from(check_killed(&dir));
+            in_output += usize::from(check_killed(&dir) == Killed::InOutput);
             if !dir.join("restart.json").exists() {
                 // killed before its first restart point: nothing to resume, and saying so
                 let output = skid()
