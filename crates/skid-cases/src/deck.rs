@@ -74,7 +74,7 @@ pub fn read_model(path: &Path) -> Result<DeckModel, DeckError> {
         .file_stem()
         .map_or_else(|| "deck".to_string(), |s| s.to_string_lossy().into_owned());
     let deck = Location {
-        file: path.to_path_buf(),
+        file: path.into(),
         line: 0,
     };
     let model = assemble::assemble(&defs, &name, &deck)?;

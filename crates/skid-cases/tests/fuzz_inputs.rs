@@ -28,7 +28,8 @@ use skid_cases::{CaseError, drum, parse_case};
 /// Longest time one input may take to be read, validated and (if small) built.
 const TIME_LIMIT: Duration = Duration::from_secs(30);
 
-/// Largest peak resident memory of the test process (`VmHWM`) allowed after any input.
+/// Largest peak resident memory of the test process (`VmHWM`, reset before each input) allowed
+/// while it reads one input.
 const MEMORY_LIMIT: u64 = 2_000_000_000;
 
 /// Accepted cases whose memory estimate is below this are also built into their model.
@@ -62,6 +63,13 @@ fn seeds(dirs: &[&str]) -> Vec<(PathBuf, String)> {
     files
 }
 
+/// Resets the peak resident memory of this process to its current resident memory (Linux
+/// `clear_refs` code 5), so that [`peak_memory`] afterwards measures one input, not the
+/// largest of all inputs so far; where it cannot, the peak stays cumulative (stricter).
+fn reset_peak_memory() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
 /// Peak resident memory of this process, bytes (`VmHWM` of `/proc/self/status`), where known.
 fn peak_memory() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -92,6 +100,7 @@ fn fuzz<S: Strategy>(
     let mut runner = TestRunner::new(config);
     let result = runner.run(&strategy, |input| {
         tried.fetch_add(1, Ordering::Relaxed);
+        reset_peak_memory();
         let start = Instant::now();
         property(input)?;
         let elapsed = start.elapsed();
@@ -854,7 +863,7 @@ fn check_deck_error(
     prop_assert!(!error.message.trim().is_empty(), "empty message: {error:?}");
     let lines = files
         .iter()
-        .find(|(file, _)| *file == error.location.file)
+        .find(|(file, _)| *file == &*error.location.file)
         .map(|&(_, lines)| lines);
     match lines {
         Some(lines) => prop_assert!(

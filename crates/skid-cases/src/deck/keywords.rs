@@ -15,15 +15,20 @@
 //!
 //! Every block and data line remembers its file and line, so that the semantic layer names them
 //! in its messages.
+//!
+//! A deck, its includes followed (a file included twice counts twice), may hold at most
+//! [`MAX_DECK_LINES`] lines and [`MAX_DECK_BYTES`] bytes; both are checked before the text that
+//! would pass them is read, so an oversized deck is refused before it is held in memory.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Where a line of a deck is: file and 1-based line number.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Location {
-    /// File.
-    pub file: PathBuf,
+    /// File (shared by every line of it).
+    pub file: Arc<Path>,
     /// Line number, from 1 (0: the file as a whole).
     pub line: usize,
 }
@@ -92,24 +97,90 @@ impl Block {
 /// Largest depth of nested `*INCLUDE`s.
 const MAX_INCLUDE_DEPTH: usize = 32;
 
+/// Most lines a deck may hold with its includes: about two million nodes and their elements,
+/// some 200 bytes each once read.
+pub const MAX_DECK_LINES: usize = 5_000_000;
+
+/// Most bytes of text a deck may hold with its includes.
+pub const MAX_DECK_BYTES: u64 = 500_000_000;
+
+/// What has been read of a deck so far, with its includes, and the most it may hold.
+struct Read {
+    lines: usize,
+    bytes: u64,
+    max_lines: usize,
+    max_bytes: u64,
+}
+
+impl Read {
+    fn new(max_lines: usize, max_bytes: u64) -> Self {
+        Self {
+            lines: 0,
+            bytes: 0,
+            max_lines,
+            max_bytes,
+        }
+    }
+
+    /// Adds `bytes` about to be read; an error if the deck passes its most bytes.
+    fn add_bytes(&mut self, bytes: u64) -> Result<(), String> {
+        self.bytes = self.bytes.saturating_add(bytes);
+        if self.bytes > self.max_bytes {
+            return Err(format!(
+                "the deck with its *INCLUDEs passes {} bytes of text, the most skid reads",
+                self.max_bytes
+            ));
+        }
+        Ok(())
+    }
+
+    /// Adds the lines of `text`; an error if the deck passes its most lines.
+    fn add_lines(&mut self, text: &str) -> Result<(), String> {
+        self.lines = self.lines.saturating_add(text.lines().count());
+        if self.lines > self.max_lines {
+            return Err(format!(
+                "the deck with its *INCLUDEs passes {} lines, the most skid reads (a file \
+                 included again counts again)",
+                self.max_lines
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Reads the deck `path` into blocks, following `*INCLUDE`s.
 ///
 /// # Errors
 /// [`DeckError`] for an unreadable file, data before the first keyword, an empty keyword name,
-/// a malformed parameter, an include without `INPUT`, or an include cycle.
+/// a malformed parameter, an include without `INPUT`, an include cycle, or a deck larger than
+/// [`MAX_DECK_LINES`] or [`MAX_DECK_BYTES`].
 pub fn read_deck(path: &Path) -> Result<Vec<Block>, DeckError> {
+    read_deck_within(path, MAX_DECK_LINES, MAX_DECK_BYTES)
+}
+
+/// [`read_deck`] with other limits on the lines and bytes of the deck and its includes.
+///
+/// # Errors
+/// See [`read_deck`].
+pub fn read_deck_within(
+    path: &Path,
+    max_lines: usize,
+    max_bytes: u64,
+) -> Result<Vec<Block>, DeckError> {
     let mut blocks = Vec::new();
-    read_into(path, &mut Vec::new(), &mut blocks)?;
+    let mut read = Read::new(max_lines, max_bytes);
+    read_into(path, &mut Vec::new(), &mut read, &mut blocks)?;
     Ok(blocks)
 }
 
 fn read_into(
     path: &Path,
     stack: &mut Vec<PathBuf>,
+    read: &mut Read,
     blocks: &mut Vec<Block>,
 ) -> Result<(), DeckError> {
     let at = |line| Location {
-        file: path.to_path_buf(),
+        file: Arc::from(path),
         line,
     };
     let canonical = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
@@ -119,9 +190,18 @@ fn read_into(
             message: "included again from itself (an *INCLUDE cycle)".into(),
         });
     }
+    let size = std::fs::metadata(path).map_or(0, |m| m.len());
+    read.add_bytes(size).map_err(|message| DeckError {
+        location: at(0),
+        message,
+    })?;
     let text = std::fs::read_to_string(path).map_err(|e| DeckError {
         location: at(0),
         message: format!("cannot read: {e}"),
+    })?;
+    read.add_lines(&text).map_err(|message| DeckError {
+        location: at(0),
+        message,
     })?;
     stack.push(canonical);
     let parsed = parse_text(&text, path)?;
@@ -137,8 +217,8 @@ fn read_into(
             return Err(block.error("takes no data lines"));
         }
         let included = path.parent().unwrap_or(Path::new("")).join(input);
-        read_into(&included, stack, blocks).map_err(|e| {
-            if e.location.line == 0 && e.location.file == included {
+        read_into(&included, stack, read, blocks).map_err(|e| {
+            if e.location.line == 0 && *e.location.file == *included {
                 block.error(format!("{}: {}", included.display(), e.message))
             } else {
                 e
@@ -154,8 +234,9 @@ fn read_into(
 /// # Errors
 /// See [`read_deck`].
 pub fn parse_text(text: &str, file: &Path) -> Result<Vec<Block>, DeckError> {
+    let file: Arc<Path> = Arc::from(file);
     let at = |line| Location {
-        file: file.to_path_buf(),
+        file: Arc::clone(&file),
         line,
     };
     let mut blocks: Vec<Block> = Vec::new();
@@ -301,6 +382,35 @@ mod tests {
         assert!(e.message.contains("NAME=VALUE"), "{e}");
         let e = err("*STEP,\n*STATIC\n");
         assert!(e.message.contains("continuation"), "{e}");
+    }
+
+    #[test]
+    fn a_deck_that_passes_its_lines_or_bytes_with_its_includes_is_refused_at_the_include() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let main = dir.path().join("main.inp");
+        // 3 lines of main and the 4 of a part included three times: 15 lines
+        let part = "*NODE\n1, 0.0\n2, 1.0\n3, 2.0\n";
+        std::fs::write(dir.path().join("part.inp"), part).expect("write");
+        let include = "*INCLUDE, INPUT=part.inp\n";
+        std::fs::write(&main, include.repeat(3)).expect("write");
+        let text_bytes = 3 * (include.len() + part.len()) as u64;
+        assert_eq!(
+            read_deck_within(&main, 15, text_bytes).expect("fits").len(),
+            3
+        );
+        let e = read_deck_within(&main, 14, text_bytes).expect_err("one line too many");
+        assert_eq!(
+            (e.location.line, &*e.location.file),
+            (3, main.as_path()),
+            "{e}"
+        );
+        assert!(e.message.contains("passes 14 lines"), "{e}");
+        let e = read_deck_within(&main, 15, text_bytes - 1).expect_err("one byte too many");
+        assert_eq!(e.location.line, 3, "{e}");
+        assert!(e.message.contains("bytes of text"), "{e}");
+        // a deck too large by itself is refused as a whole, before it is read
+        let e = read_deck_within(&main, 15, 10).expect_err("main too large");
+        assert_eq!(e.location.line, 0, "{e}");
     }
 
     #[test]
