@@ -19,7 +19,7 @@ use crate::drum::{BACK_PLATE, DRUM};
 use crate::model_file::history::pair_totals;
 
 /// Column names of `history.csv`.
-pub const COLUMNS: [&str; 22] = [
+pub const COLUMNS: [&str; 23] = [
     "time",
     "step",
     "increment",
@@ -41,6 +41,7 @@ pub const COLUMNS: [&str; 22] = [
     "external_work",
     "friction_dissipation",
     "normal_work",
+    "algorithmic_dissipation",
     "dt",
 ];
 
@@ -69,6 +70,9 @@ pub struct Sample {
     pub friction_dissipation: f64,
     /// Accumulated normal contact work, J.
     pub normal_work: f64,
+    /// Accumulated algorithmic dissipation of the time integration, J.
+    #[serde(default)]
+    pub algorithmic_dissipation: f64,
     /// Deepest penetration among the contacts, m (0 if none).
     pub max_penetration: f64,
     /// Largest gap at a contact that carries force while sliding, m.
@@ -171,6 +175,7 @@ impl<const D: usize> Observer<D> for DrumRecorder {
             format!("{:.9e}", e.external_work),
             format!("{:.9e}", e.friction_dissipation),
             format!("{:.9e}", e.normal_work),
+            format!("{:.9e}", e.algorithmic_dissipation),
             format!("{:.6e}", report.size),
         ])?;
         self.samples.push(Sample {
@@ -185,6 +190,7 @@ impl<const D: usize> Observer<D> for DrumRecorder {
             external_work: e.external_work,
             friction_dissipation: e.friction_dissipation,
             normal_work: e.normal_work,
+            algorithmic_dissipation: e.algorithmic_dissipation,
             max_penetration: penetration.max(0.0),
             sliding_separation: separation,
         });

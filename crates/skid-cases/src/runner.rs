@@ -60,6 +60,14 @@ impl RunSummary {
             Self::Model(s) => s.error.as_deref(),
         }
     }
+
+    /// What a user should know before trusting the run.
+    pub fn warnings(&self) -> &[String] {
+        match self {
+            Self::Case(s) => &s.warnings,
+            Self::Model(s) => &s.warnings,
+        }
+    }
 }
 
 /// An input read for a run: a drum case, or a model (from a model file or a deck, with the

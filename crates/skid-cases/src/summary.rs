@@ -5,7 +5,7 @@ use serde::Serialize;
 use skid_integrator::{RunError, RunStatistics};
 
 use crate::history::Sample;
-use crate::model_file::summary::RunCost;
+use crate::model_file::summary::{RunCost, dissipation_warning};
 use crate::schema::Case;
 
 /// `summary.json`.
@@ -49,14 +49,20 @@ pub struct Summary {
     pub friction_work_j: Option<f64>,
     /// `|drum energy lost - friction work - other work| / drum energy lost`, where the other
     /// work is the change of the pad's kinetic, strain and hourglass energy minus the work of
-    /// the pressure and of the normal contact forces. `None` when the drum loses less than a
+    /// the pressure and of the normal contact forces, plus the time integration's own
+    /// dissipation. `None` when the drum loses less than a
     /// millionth of its initial kinetic energy (frictionless runs, or a drum starting at rest,
     /// `omega0 = 0`): the ratio has no meaning
     /// there, and `energy_balance_residual_j` says how well energy is conserved.
     pub energy_balance_error: Option<f64>,
-    /// The numerator of `energy_balance_error`, J (signed: positive when energy is lost to
-    /// the time integration's numerical dissipation).
+    /// The numerator of `energy_balance_error`, J: energy lost unaccounted for once the time
+    /// integration's own dissipation (`algorithmic_dissipation_j`) is counted.
     pub energy_balance_residual_j: Option<f64>,
+    /// Energy removed by the time integration itself over the dynamic steps, J (HHT's
+    /// numerical damping).
+    pub algorithmic_dissipation_j: Option<f64>,
+    /// What a user should know before trusting a completed run.
+    pub warnings: Vec<String>,
     /// Largest hourglass energy / strain energy over the dynamic steps.
     pub max_hourglass_ratio: Option<f64>,
     /// Deepest penetration over the run, m.
@@ -155,16 +161,32 @@ pub fn summarize(
         .then(|| sliding.iter().map(|s| s.normal_force).sum::<f64>() / sliding.len() as f64);
 
     let (mut lost, mut friction, mut balance, mut residual_j) = (None, None, None, None);
+    let (mut algorithmic, mut warnings) = (None, Vec::new());
     if let (Some(b), Some(e)) = (dynamic.first(), dynamic.last()) {
         let inertia = case.drum.rotary_inertia;
         let drum_lost = 0.5 * inertia * (b.omega * b.omega - e.omega * e.omega);
         let d_friction = e.friction_dissipation - b.friction_dissipation;
         // Energy the system lost beyond friction: -(change of mechanical energy - work done
         // on it - work of the normal contact forces + frictional dissipation).
+        let d_algorithmic = e.algorithmic_dissipation - b.algorithmic_dissipation;
         let residual = -((e.mechanical_energy - b.mechanical_energy)
             - (e.external_work - b.external_work)
             - (e.normal_work - b.normal_work)
-            + d_friction);
+            + d_friction
+            + d_algorithmic);
+        // The energy in play: the largest mechanical energy, load work or dissipation.
+        let in_play = dynamic
+            .iter()
+            .flat_map(|s| {
+                [
+                    s.mechanical_energy,
+                    (s.external_work - b.external_work).abs(),
+                    s.friction_dissipation - b.friction_dissipation,
+                ]
+            })
+            .fold(0.0, f64::max);
+        algorithmic = Some(d_algorithmic);
+        warnings.extend(dissipation_warning(d_algorithmic, in_play));
         let initial_drum_energy = 0.5 * inertia * b.omega * b.omega;
         lost = Some(drum_lost);
         friction = Some(d_friction);
@@ -206,6 +228,8 @@ pub fn summarize(
         friction_work_j: friction,
         energy_balance_error: balance,
         energy_balance_residual_j: residual_j,
+        algorithmic_dissipation_j: algorithmic,
+        warnings,
         max_hourglass_ratio,
         max_gap_violation_m: samples
             .iter()

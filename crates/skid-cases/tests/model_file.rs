@@ -254,6 +254,49 @@ fn a_frictionless_block_held_only_by_its_contacts_stays_at_rest_on_the_reduced_p
     );
 }
 
+/// The quasi-static block sticking to the ground it swings back, at coarse steps (seed 1 run 188
+/// of the stress sweep, shortened): the end-point equilibrium of the block damps the swing like
+/// backward Euler (its swing, of period about 8.5 ms, loses a share `pi omega dt` of its
+/// amplitude per period), so most of the energy goes to the time integration. The ledger counts
+/// it and balances; the summary warns that the answer depends on the time step.
+#[test]
+fn a_coarsely_stepped_quasi_static_block_balances_its_energy_and_warns() {
+    let path = repo("cases/verification/2d-block-on-sliding-ground.json");
+    let overrides: Vec<String> = [
+        "contact[0].mu=1.801",
+        "loads[0].pressure=1478000.0",
+        "rigid_bodies[0].initial_velocity=[-3.705, 0.0]",
+        "steps[1].dt=0.002505",
+        "steps[1].duration=0.02505",
+        "steps[1].alpha=0.0",
+    ]
+    .iter()
+    .map(ToString::to_string)
+    .collect();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let RunSummary::Model(summary) =
+        run_file(&path, &overrides, Some(dir.path()), DEFAULT_RESTART_EVERY).expect("runs")
+    else {
+        panic!("a model file gives a model summary");
+    };
+    assert_eq!(summary.error, None);
+    let error = summary.energy_balance_error.expect("energy in play");
+    let residual = summary.energy_balance_residual_j.expect("residual");
+    let algorithmic = summary.algorithmic_dissipation_j.expect("dissipation");
+    let scale = residual.abs() / error;
+    assert!(error < 0.01, "energy balance error {error}");
+    assert!(
+        algorithmic > 0.2 * scale,
+        "the time integration removed {algorithmic} J of {scale} J"
+    );
+    assert_eq!(summary.warnings.len(), 1, "{:?}", summary.warnings);
+    assert!(
+        summary.warnings[0].contains("time step"),
+        "{:?}",
+        summary.warnings
+    );
+}
+
 /// A 2D block on rollers (bottom nodes fixed in y, one of them in x) under a small pressure on
 /// its top: homogeneous uniaxial stress in plane strain, `eps_yy = -p (1 - nu^2) / E` and
 /// `eps_xx = p nu (1 + nu) / E`, with E and nu of the initial shear and bulk moduli.

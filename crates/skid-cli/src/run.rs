@@ -23,11 +23,11 @@ pub fn run(
 ) -> ExitCode {
     let every = restart_every.unwrap_or(DEFAULT_RESTART_EVERY);
     match run_file(case, overrides, out, every) {
-        Ok(summary) => finished(
-            &case.display().to_string(),
-            serde_json::to_string(&summary),
-            summary.error(),
-        ),
+        Ok(summary) => {
+            let name = case.display().to_string();
+            warn(&name, summary.warnings());
+            finished(&name, serde_json::to_string(&summary), summary.error())
+        }
         Err(e) => failed(&e),
     }
 }
@@ -44,6 +44,7 @@ pub fn resume(
     let name = dir.display().to_string();
     match resume_run(dir, case.map(|c| (c, overrides)), restart_every) {
         Ok(Resumed::Continued(summary)) => {
+            warn(&name, summary.warnings());
             finished(&name, serde_json::to_string(&summary), summary.error())
         }
         Ok(Resumed::AlreadyEnded(summary)) => {
@@ -52,6 +53,13 @@ pub fn resume(
             finished(&name, serde_json::to_string(&summary), error)
         }
         Err(e) => failed(&e),
+    }
+}
+
+/// Prints the summary's warnings on standard error.
+fn warn(name: &str, warnings: &[String]) {
+    for warning in warnings {
+        eprintln!("skid: {name}: warning: {warning}");
     }
 }
 

@@ -42,7 +42,7 @@ use crate::coupling::{ContactRows, contact_rows, contact_step};
 use crate::dof::EquationKind;
 use crate::error::IncrementFailure;
 use crate::global_contact::{GlobalContactSolver, contact_weights, law_residual};
-use crate::hht::Hht;
+use crate::hht::{Hht, IncrementEnds};
 use crate::model::Model;
 use crate::state::{ContactPointState, EnergyLedger, State};
 use crate::stepper::Settings;
@@ -631,6 +631,23 @@ fn finish<const D: usize>(
         IncrementKind::Dynamic { h, .. } => (start.time + h, 1.0),
     };
     let dx = &x - &start.x;
+    let contact_reaction = rows.transpose_times(r, x.len());
+    let algorithmic = match kind {
+        IncrementKind::Static { .. } => 0.0,
+        IncrementKind::Dynamic { hht, h } => hht.algorithmic_dissipation(
+            h,
+            &IncrementEnds {
+                mass: model.mass(),
+                quasi_static: model.quasi_static(),
+                dx: &dx,
+                f0: &start.net_force,
+                f1: &net,
+                a0: &start.a,
+                a1: &a,
+                contact: &contact_reaction,
+            },
+        ),
+    };
     let energy = EnergyLedger {
         kinetic: 0.5 * v.component_mul(&v).dot(model.mass()),
         strain: internal.strain_energy,
@@ -638,11 +655,12 @@ fn finish<const D: usize>(
         external_work: start.energy.external_work + 0.5 * (&start.external_force + &f_ext).dot(&dx),
         friction_dissipation: start.energy.friction_dissipation + friction,
         normal_work: start.energy.normal_work + normal_work,
+        algorithmic_dissipation: start.energy.algorithmic_dissipation + algorithmic,
     };
     State {
         time,
         load_factor,
-        contact_reaction: rows.transpose_times(r, x.len()),
+        contact_reaction,
         x,
         v,
         a,

@@ -47,6 +47,10 @@ pub struct EnergyLedger {
     /// Work of the normal contact forces `sum r_N Delta g`, `r_N` taken as for the friction
     /// (zero for a persistent contact).
     pub normal_work: f64,
+    /// Energy removed by the time integration itself (HHT's numerical damping and the end-point
+    /// equilibrium of quasi-static solids, see [`crate::hht::Hht::algorithmic_dissipation`]).
+    #[serde(default)]
+    pub algorithmic_dissipation: f64,
 }
 
 /// Solution at the end of an increment.

@@ -9,7 +9,7 @@
 //! of the friction force components along the master surface's coordinate directions, N),
 //! `P.active`, `P.sliding` (closed contacts, and those at the cone's boundary), `P.max_penetration`
 //! (m); then `kinetic_energy`, `strain_energy`, `hourglass_energy`, `external_work`,
-//! `friction_dissipation`, `normal_work` (J). Numbers carry 10 significant digits. The file is
+//! `friction_dissipation`, `normal_work`, `algorithmic_dissipation` (J). Numbers carry 10 significant digits. The file is
 //! complete or absent ([`PartialCsv`]).
 
 use std::path::Path;
@@ -111,6 +111,7 @@ pub fn columns<const D: usize>(model: &Model<D>) -> Vec<String> {
             "external_work",
             "friction_dissipation",
             "normal_work",
+            "algorithmic_dissipation",
         ]
         .map(String::from),
     );
@@ -283,6 +284,7 @@ impl<const D: usize> Observer<D> for ModelRecorder {
                 e.external_work,
                 e.friction_dissipation,
                 e.normal_work,
+                e.algorithmic_dissipation,
             ]
             .map(number),
         );
@@ -292,6 +294,7 @@ impl<const D: usize> Observer<D> for ModelRecorder {
             e.external_work.abs(),
             e.normal_work.abs(),
             e.friction_dissipation,
+            e.algorithmic_dissipation.abs(),
         ]
         .into_iter()
         .fold(record.energy_scale, f64::max);

@@ -99,10 +99,14 @@ pub struct ModelSummary {
     pub bodies: Vec<BodyState>,
     /// Contact resultants in the last converged state.
     pub pairs: Vec<PairSummary>,
-    /// Energy the run lost beyond friction, J: `-(dE - dW_ext - dW_N + D_friction)` between the
-    /// initial and the last state (`E` kinetic + strain + hourglass, `W_ext` the loads' work,
-    /// `W_N` the normal contact forces' work); positive for numerical dissipation.
+    /// Energy the run lost unaccounted for, J:
+    /// `-(dE - dW_ext - dW_N + D_friction + D_algorithmic)` between the initial and the last
+    /// state (`E` kinetic + strain + hourglass, `W_ext` the loads' work, `W_N` the normal
+    /// contact forces' work, `D_algorithmic` what the time integration removed).
     pub energy_balance_residual_j: Option<f64>,
+    /// Energy removed by the time integration itself over the run, J (HHT's numerical damping,
+    /// the end-point equilibrium of quasi-static solids).
+    pub algorithmic_dissipation_j: Option<f64>,
     /// `|residual| / scale` with the scale the largest energy, work or dissipation of the run;
     /// `None` if nothing in the run carries energy.
     pub energy_balance_error: Option<f64>,
@@ -110,9 +114,29 @@ pub struct ModelSummary {
     pub max_gap_violation_m: f64,
     /// Largest gap at a contact carrying force while sliding, m.
     pub max_sliding_separation_m: f64,
+    /// What a user should know before trusting a completed run (see [`dissipation_warning`]).
+    pub warnings: Vec<String>,
     /// Cost of the run.
     #[serde(flatten)]
     pub cost: RunCost,
+}
+
+/// Share of the energy in play above which a summary warns that the time integration itself
+/// removed it.
+pub const DISSIPATION_WARNING_SHARE: f64 = 0.05;
+
+/// The warning for a run whose time integration removed `dissipated` J, more than
+/// [`DISSIPATION_WARNING_SHARE`] of the energy in play `scale`: the answer then depends on the
+/// time step (the ledger still balances, so the solution is the scheme's, not a wrong one).
+pub fn dissipation_warning(dissipated: f64, scale: f64) -> Option<String> {
+    (scale > 0.0 && dissipated > DISSIPATION_WARNING_SHARE * scale).then(|| {
+        format!(
+            "the time integration removed {:.1} % of the energy in play ({dissipated:.4e} J of \
+             {scale:.4e} J: HHT damping, or the end-point equilibrium of quasi-static solids); \
+             the answer depends on the time step, take smaller increments",
+            100.0 * dissipated / scale
+        )
+    })
 }
 
 /// Summarizes a run of `model` (named `name`) from its history record and statistics; `error` is why it
@@ -124,15 +148,18 @@ pub fn summarize<const D: usize>(
     stats: &RunStatistics,
     error: Option<&RunError>,
 ) -> ModelSummary {
-    let residual = match (&record.first_energy, &record.last_energy) {
-        (Some(a), Some(b)) => Some(
-            -((b.kinetic + b.strain + b.hourglass - (a.kinetic + a.strain + a.hourglass))
-                - (b.external_work - a.external_work)
-                - (b.normal_work - a.normal_work)
-                + (b.friction_dissipation - a.friction_dissipation)),
-        ),
-        _ => None,
-    };
+    let ends = record
+        .first_energy
+        .as_ref()
+        .zip(record.last_energy.as_ref());
+    let residual = ends.map(|(a, b)| {
+        -((b.kinetic + b.strain + b.hourglass - (a.kinetic + a.strain + a.hourglass))
+            - (b.external_work - a.external_work)
+            - (b.normal_work - a.normal_work)
+            + (b.friction_dissipation - a.friction_dissipation)
+            + (b.algorithmic_dissipation - a.algorithmic_dissipation))
+    });
+    let algorithmic = ends.map(|(a, b)| b.algorithmic_dissipation - a.algorithmic_dissipation);
     let scale = record.energy_scale;
     ModelSummary {
         model: name.to_string(),
@@ -160,7 +187,12 @@ pub fn summarize<const D: usize>(
             })
             .collect(),
         energy_balance_residual_j: residual,
+        algorithmic_dissipation_j: algorithmic,
         energy_balance_error: residual.filter(|_| scale > 0.0).map(|r| r.abs() / scale),
+        warnings: algorithmic
+            .and_then(|d| dissipation_warning(d, scale))
+            .into_iter()
+            .collect(),
         max_gap_violation_m: record.max_penetration.max(0.0),
         max_sliding_separation_m: record.max_sliding_separation,
         cost: RunCost::from(stats),
