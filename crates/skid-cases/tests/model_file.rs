@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use serde_json::{Value, json};
 use skid_cases::csv_out::CsvTable;
 use skid_cases::drum::model_spec;
+use skid_cases::model_file::summary::ModelSummary;
 use skid_cases::model_file::{self, ModelSpec, SpecError, parse_model, to_json};
 use skid_cases::restart::DEFAULT_RESTART_EVERY;
 use skid_cases::{RunSummary, load_case, run_case_file, run_file};
@@ -218,26 +219,18 @@ fn a_block_on_a_sliding_ground_brakes_it_at_exactly_mu_n_over_m() {
 /// contacts closed to the contact tolerance.
 #[test]
 fn a_frictionless_block_held_only_by_its_contacts_stays_at_rest_on_the_reduced_path() {
-    let path = repo("cases/verification/3d-block-on-sliding-ground.json");
-    let overrides: Vec<String> = [
-        "contact[0].mu=0.0",
-        "loads[0].pressure=304200.0",
-        "rigid_bodies[0].initial_velocity=[-0.02921, 0.0, 0.0]",
-        "steps[1].dt=0.0008356",
-        "steps[1].duration=0.0100272",
-        "steps[1].alpha=-0.177",
-        "solver.contact_solve=\"reduced\"",
-    ]
-    .iter()
-    .map(ToString::to_string)
-    .collect();
-    let dir = tempfile::tempdir().expect("tempdir");
-    let RunSummary::Model(summary) =
-        run_file(&path, &overrides, Some(dir.path()), DEFAULT_RESTART_EVERY).expect("runs")
-    else {
-        panic!("a model file gives a model summary");
-    };
-    assert_eq!(summary.error, None);
+    let (dir, summary) = run_scene(
+        "3d-block-on-sliding-ground",
+        &[
+            "contact[0].mu=0.0",
+            "loads[0].pressure=304200.0",
+            "rigid_bodies[0].initial_velocity=[-0.02921, 0.0, 0.0]",
+            "steps[1].dt=0.0008356",
+            "steps[1].duration=0.0100272",
+            "steps[1].alpha=-0.177",
+            "solver.contact_solve=\"reduced\"",
+        ],
+    );
     let table = Columns::read(&dir.path().join("history.csv"));
     let step = table.text("step");
     let v = table.numbers("plate.v_y");
@@ -254,25 +247,11 @@ fn a_frictionless_block_held_only_by_its_contacts_stays_at_rest_on_the_reduced_p
     );
 }
 
-/// The quasi-static block sticking to the ground it swings back, at coarse steps (seed 1 run 188
-/// of the stress sweep, shortened): the end-point equilibrium of the block damps the swing like
-/// backward Euler (its swing, of period about 8.5 ms, loses a share `pi omega dt` of its
-/// amplitude per period), so most of the energy goes to the time integration. The ledger counts
-/// it and balances; the summary warns that the answer depends on the time step.
-#[test]
-fn a_coarsely_stepped_quasi_static_block_balances_its_energy_and_warns() {
-    let path = repo("cases/verification/2d-block-on-sliding-ground.json");
-    let overrides: Vec<String> = [
-        "contact[0].mu=1.801",
-        "loads[0].pressure=1478000.0",
-        "rigid_bodies[0].initial_velocity=[-3.705, 0.0]",
-        "steps[1].dt=0.002505",
-        "steps[1].duration=0.02505",
-        "steps[1].alpha=0.0",
-    ]
-    .iter()
-    .map(ToString::to_string)
-    .collect();
+/// Runs the shipped verification scene `name` with `overrides` into a temporary directory
+/// (returned with the summary), and checks that it completed.
+fn run_scene(name: &str, overrides: &[&str]) -> (tempfile::TempDir, ModelSummary) {
+    let path = repo(&format!("cases/verification/{name}.json"));
+    let overrides: Vec<String> = overrides.iter().map(ToString::to_string).collect();
     let dir = tempfile::tempdir().expect("tempdir");
     let RunSummary::Model(summary) =
         run_file(&path, &overrides, Some(dir.path()), DEFAULT_RESTART_EVERY).expect("runs")
@@ -280,6 +259,27 @@ fn a_coarsely_stepped_quasi_static_block_balances_its_energy_and_warns() {
         panic!("a model file gives a model summary");
     };
     assert_eq!(summary.error, None);
+    (dir, summary)
+}
+
+/// The quasi-static block sticking to the ground it swings back, at coarse steps (seed 1 run 188
+/// of the stress sweep, shortened): the end-point equilibrium of the block damps the swing like
+/// backward Euler (its swing, of period about 8.5 ms, loses a share `pi omega dt` of its
+/// amplitude per period), so most of the energy goes to the time integration. The ledger counts
+/// it and balances; the summary warns that the answer depends on the time step.
+#[test]
+fn a_coarsely_stepped_quasi_static_block_balances_its_energy_and_warns() {
+    let (_dir, summary) = run_scene(
+        "2d-block-on-sliding-ground",
+        &[
+            "contact[0].mu=1.801",
+            "loads[0].pressure=1478000.0",
+            "rigid_bodies[0].initial_velocity=[-3.705, 0.0]",
+            "steps[1].dt=0.002505",
+            "steps[1].duration=0.02505",
+            "steps[1].alpha=0.0",
+        ],
+    );
     let error = summary.energy_balance_error.expect("energy in play");
     let residual = summary.energy_balance_residual_j.expect("residual");
     let algorithmic = summary.algorithmic_dissipation_j.expect("dissipation");
