@@ -777,7 +777,7 @@ def write_report(records, args, total_wall, results):
                                                 or 0.0))[:10]
         md += [f"### {len(warned)} runs completed with a warning", "",
                "Each passes every check and its summary warns (the time integration removed "
-               "more than 5 % of the energy in play); the ten that lost the most:", ""]
+               "more than 5 % of the energy in play); the ten that lost the most joules:", ""]
         md += table(["run", "scene", "warning", "parameters"],
                     [[r["index"], r["scene"], "; ".join(r.get("warnings", [])),
                       describe(r)] for r in share])
