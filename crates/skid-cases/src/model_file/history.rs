@@ -169,6 +169,13 @@ pub struct RunRecord {
     pub final_pairs: Vec<PairTotals>,
     /// Energy ledger of the first recorded state (the initial one).
     pub first_energy: Option<EnergyLedger>,
+    /// Energy ledger of the state the first dynamic step started from (updated with every
+    /// state until the first dynamic increment).
+    #[serde(default)]
+    pub dynamic_start_energy: Option<EnergyLedger>,
+    /// Whether a dynamic increment has been recorded.
+    #[serde(default)]
+    pub dynamic: bool,
     /// Energy ledger of the last converged state.
     pub last_energy: Option<EnergyLedger>,
     /// Largest of the kinetic + strain + hourglass energy, |external work|, |normal work| and
@@ -299,6 +306,10 @@ impl<const D: usize> Observer<D> for ModelRecorder {
         .into_iter()
         .fold(record.energy_scale, f64::max);
         record.first_energy.get_or_insert_with(|| e.clone());
+        record.dynamic |= report.dynamic;
+        if !record.dynamic {
+            record.dynamic_start_energy = Some(e.clone());
+        }
         record.last_energy = Some(e.clone());
         record.final_pairs = totals;
         record.final_bodies = body_states(model, s);
