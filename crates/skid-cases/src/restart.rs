@@ -85,7 +85,7 @@ pub enum RecorderMemory {
     /// A drum case: its samples so far.
     Drum(Vec<Sample>),
     /// A model file: its record so far.
-    Model(RunRecord),
+    Model(Box<RunRecord>),
 }
 
 /// The contents of `restart.json` (see the module documentation).

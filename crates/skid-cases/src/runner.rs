@@ -535,7 +535,7 @@ fn run_model_in<const D: usize>(
                     "it holds field output, which model files do not write",
                 ));
             }
-            let history = ModelRecorder::reopen(dir, &history, record)
+            let history = ModelRecorder::reopen(dir, &history, *record)
                 .map_err(output(history_path.clone()))?;
             let newton =
                 NewtonRecorder::reopen(dir, &newton).map_err(output(dir.join(NEWTON_CSV)))?;
@@ -596,7 +596,7 @@ impl<const D: usize> History<D> for ModelRecorder {
     }
 
     fn memory(&self) -> RecorderMemory {
-        RecorderMemory::Model(self.record().clone())
+        RecorderMemory::Model(Box::new(self.record().clone()))
     }
 }
 
