@@ -329,6 +329,23 @@ fn output(path: PathBuf) -> impl FnOnce(std::io::Error) -> CaseError {
     move |source| CaseError::Output { path, source }
 }
 
+/// An output that a resumed run continues could not be reopened: missing or changed since the
+/// restart point, so the run cannot be resumed ([`CaseError::Resume`]), or unreadable
+/// ([`CaseError::Output`]).
+fn reopen_error(dir: &Path, path: PathBuf) -> impl FnOnce(std::io::Error) -> CaseError + '_ {
+    move |source| match source.kind() {
+        std::io::ErrorKind::NotFound | std::io::ErrorKind::InvalidData => CaseError::Resume {
+            dir: dir.to_path_buf(),
+            message: format!(
+                "{}: the output written so far is missing or has changed since the restart \
+                 point ({source})",
+                path.display()
+            ),
+        },
+        _ => CaseError::Output { path, source },
+    }
+}
+
 /// A restart file that does not fit the run it is resumed into.
 fn misfit(dir: &Path, message: &str) -> CaseError {
     CaseError::Resume {
@@ -378,13 +395,13 @@ fn run_in<const D: usize>(
                 return Err(misfit(dir, "it holds a model file's history, not a drum's"));
             };
             let recorder = DrumRecorder::reopen(dir, &history, samples)
-                .map_err(output(dir.join("history.csv")))?;
-            let newton =
-                NewtonRecorder::reopen(dir, &newton).map_err(output(dir.join(NEWTON_CSV)))?;
+                .map_err(reopen_error(dir, dir.join("history.csv")))?;
+            let newton = NewtonRecorder::reopen(dir, &newton)
+                .map_err(reopen_error(dir, dir.join(NEWTON_CSV)))?;
             let fields = match (case.output.field_interval, fields) {
                 (Some(interval), Some(memory)) => Some(
                     FieldWriter::reopen(dir, interval, drum, memory, checkpoint.state.clone())
-                        .map_err(output(fields_dir.clone()))?,
+                        .map_err(reopen_error(dir, fields_dir.clone()))?,
                 ),
                 (None, None) => None,
                 _ => return Err(misfit(dir, "its field output does not fit the case's")),
@@ -536,9 +553,9 @@ fn run_model_in<const D: usize>(
                 ));
             }
             let history = ModelRecorder::reopen(dir, &history, *record)
-                .map_err(output(history_path.clone()))?;
-            let newton =
-                NewtonRecorder::reopen(dir, &newton).map_err(output(dir.join(NEWTON_CSV)))?;
+                .map_err(reopen_error(dir, history_path.clone()))?;
+            let newton = NewtonRecorder::reopen(dir, &newton)
+                .map_err(reopen_error(dir, dir.join(NEWTON_CSV)))?;
             (history, newton, input, Some(checkpoint))
         }
     };

@@ -3,8 +3,8 @@
 //!
 //! Exit codes: 0 the run completed (or, resuming, had completed already); 1 the run stopped
 //! early (its summary says where and why); 2 the case file or the command line is invalid, or
-//! the run cannot be resumed (no restart file, or another input); 3 results could not be
-//! written.
+//! the run cannot be resumed (no restart file, another input, or outputs written so far that
+//! are missing or changed); 3 results could not be written.
 
 use std::path::Path;
 use std::process::ExitCode;

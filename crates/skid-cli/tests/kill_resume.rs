@@ -283,6 +283,15 @@ fn resume_refuses_another_input_and_says_when_the_run_has_ended() {
     let (code, message) = run(&["run", "--resume", dir_arg]);
     assert_eq!(code, Some(2), "{message}");
     assert!(message.contains("has changed since"), "{message}");
+    // the input restored, but the history written so far deleted
+    std::fs::write(&case_json, text).expect("restore");
+    std::fs::remove_file(dir.join("history.csv")).expect("remove");
+    let (code, message) = run(&["run", "--resume", dir_arg]);
+    assert_eq!(code, Some(2), "{message}");
+    assert!(
+        message.contains("history.csv") && message.contains("missing or has changed"),
+        "{message}"
+    );
     // a directory that holds no run
     let (code, message) = run(&["run", "--resume", tmp.path().to_str().expect("utf-8")]);
     assert_eq!(code, Some(2), "{message}");
