@@ -227,16 +227,24 @@ fn runs_killed_at_random_moments_resume_to_the_uninterrupted_outputs() {
             kills += 1;
             in_output += usize::from(check_killed(&dir) == Killed::InOutput);
             if !dir.join("restart.json").exists() {
-                // killed before its first restart point: nothing to resume, and saying so
+                // killed before its first restart point (or before it wrote its input or made
+                // its directory): nothing to resume, and saying so
+                let expected_message = if !dir.is_dir() {
+                    "no such directory"
+                } else if !dir.join("case.json").is_file() {
+                    "expected the input as run"
+                } else {
+                    "no restart.json"
+                };
                 let output = skid()
                     .arg("run")
                     .arg("--resume")
                     .arg(&dir)
                     .output()
                     .expect("skid runs");
-                assert_eq!(output.status.code(), Some(2));
                 let message = String::from_utf8_lossy(&output.stderr);
-                assert!(message.contains("no restart.json"), "{message}");
+                assert_eq!(output.status.code(), Some(2), "{message}");
+                assert!(message.contains(expected_message), "{message}");
                 continue;
             }
             kills += resume_to_the_end(&dir, span, &mut random);
