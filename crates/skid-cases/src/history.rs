@@ -12,6 +12,7 @@
 use std::path::Path;
 
 use skid_integrator::Model;
+use skid_integrator::state::EnergyLedger;
 use skid_integrator::stepper::{IncrementReport, Observer};
 
 use crate::csv_out::{CsvMark, PartialCsv};
@@ -58,21 +59,8 @@ pub struct Sample {
     pub omega: f64,
     /// Total normal contact force, N.
     pub normal_force: f64,
-    /// Kinetic + strain + hourglass energy, J.
-    pub mechanical_energy: f64,
-    /// Hourglass energy, J.
-    pub hourglass_energy: f64,
-    /// Strain energy, J.
-    pub strain_energy: f64,
-    /// Accumulated external work, J.
-    pub external_work: f64,
-    /// Accumulated frictional dissipation, J.
-    pub friction_dissipation: f64,
-    /// Accumulated normal contact work, J.
-    pub normal_work: f64,
-    /// Accumulated algorithmic dissipation of the time integration, J.
-    #[serde(default)]
-    pub algorithmic_dissipation: f64,
+    /// The energy ledger.
+    pub energy: EnergyLedger,
     /// Deepest penetration among the contacts, m (0 if none).
     pub max_penetration: f64,
     /// Largest gap at a contact that carries force while sliding, m.
@@ -184,13 +172,7 @@ impl<const D: usize> Observer<D> for DrumRecorder {
             angle,
             omega,
             normal_force: normal,
-            mechanical_energy: e.kinetic + e.strain + e.hourglass,
-            hourglass_energy: e.hourglass,
-            strain_energy: e.strain,
-            external_work: e.external_work,
-            friction_dissipation: e.friction_dissipation,
-            normal_work: e.normal_work,
-            algorithmic_dissipation: e.algorithmic_dissipation,
+            energy: e.clone(),
             max_penetration: penetration.max(0.0),
             sliding_separation: separation,
         });

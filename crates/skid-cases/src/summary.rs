@@ -165,23 +165,18 @@ pub fn summarize(
     if let (Some(b), Some(e)) = (dynamic.first(), dynamic.last()) {
         let inertia = case.drum.rotary_inertia;
         let drum_lost = 0.5 * inertia * (b.omega * b.omega - e.omega * e.omega);
-        let d_friction = e.friction_dissipation - b.friction_dissipation;
-        // Energy the system lost beyond friction: -(change of mechanical energy - work done
-        // on it - work of the normal contact forces + frictional dissipation).
-        let d_algorithmic = e.algorithmic_dissipation - b.algorithmic_dissipation;
-        let residual = -((e.mechanical_energy - b.mechanical_energy)
-            - (e.external_work - b.external_work)
-            - (e.normal_work - b.normal_work)
-            + d_friction
-            + d_algorithmic);
+        let (b_energy, e_energy) = (&b.energy, &e.energy);
+        let d_friction = e_energy.friction_dissipation - b_energy.friction_dissipation;
+        let d_algorithmic = e_energy.algorithmic_dissipation - b_energy.algorithmic_dissipation;
+        let residual = e_energy.unaccounted_since(b_energy);
         // The energy in play: the largest mechanical energy, load work or dissipation.
         let in_play = dynamic
             .iter()
             .flat_map(|s| {
                 [
-                    s.mechanical_energy,
-                    (s.external_work - b.external_work).abs(),
-                    s.friction_dissipation - b.friction_dissipation,
+                    s.energy.mechanical(),
+                    (s.energy.external_work - b_energy.external_work).abs(),
+                    s.energy.friction_dissipation - b_energy.friction_dissipation,
                 ]
             })
             .fold(0.0, f64::max);
@@ -198,8 +193,8 @@ pub fn summarize(
     let max_hourglass_ratio = (!dynamic.is_empty()).then(|| {
         dynamic
             .iter()
-            .filter(|s| s.strain_energy > 0.0)
-            .map(|s| s.hourglass_energy / s.strain_energy)
+            .filter(|s| s.energy.strain > 0.0)
+            .map(|s| s.energy.hourglass / s.energy.strain)
             .fold(0.0, f64::max)
     });
 
@@ -322,7 +317,7 @@ mod tests {
             s.time = k as f64 * 1e-5;
             s.dynamic = k > 0;
             s.omega = [0.0, -2.5e-16, 8e-13][k];
-            s.mechanical_energy = 0.1 + 1e-14 * k as f64;
+            s.energy.kinetic = 0.1 + 1e-14 * k as f64;
         }
         let s = summarize(&case, &samples, &RunStatistics::default(), None);
         assert_eq!(s.energy_balance_error, None);

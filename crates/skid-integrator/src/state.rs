@@ -53,6 +53,23 @@ pub struct EnergyLedger {
     pub algorithmic_dissipation: f64,
 }
 
+impl EnergyLedger {
+    /// Kinetic + strain + hourglass energy, J.
+    pub fn mechanical(&self) -> f64 {
+        self.kinetic + self.strain + self.hourglass
+    }
+
+    /// Energy lost unaccounted for since the ledger `start`, J (positive when lost):
+    /// `-(dE - dW_ext - dW_N + dD_friction + dD_algorithmic)`, `E` the mechanical energy.
+    pub fn unaccounted_since(&self, start: &Self) -> f64 {
+        -((self.mechanical() - start.mechanical())
+            - (self.external_work - start.external_work)
+            - (self.normal_work - start.normal_work)
+            + (self.friction_dissipation - start.friction_dissipation)
+            + (self.algorithmic_dissipation - start.algorithmic_dissipation))
+    }
+}
+
 /// Solution at the end of an increment.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct State {

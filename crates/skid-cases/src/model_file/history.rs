@@ -9,8 +9,8 @@
 //! of the friction force components along the master surface's coordinate directions, N),
 //! `P.active`, `P.sliding` (closed contacts, and those at the cone's boundary), `P.max_penetration`
 //! (m); then `kinetic_energy`, `strain_energy`, `hourglass_energy`, `external_work`,
-//! `friction_dissipation`, `normal_work`, `algorithmic_dissipation` (J). Numbers carry 10 significant digits. The file is
-//! complete or absent ([`PartialCsv`]).
+//! `friction_dissipation`, `normal_work`, `algorithmic_dissipation` (J). Numbers carry 10
+//! significant digits. The file is complete or absent ([`PartialCsv`]).
 
 use std::path::Path;
 
@@ -169,13 +169,8 @@ pub struct RunRecord {
     pub final_pairs: Vec<PairTotals>,
     /// Energy ledger of the first recorded state (the initial one).
     pub first_energy: Option<EnergyLedger>,
-    /// Energy ledger of the state the first dynamic step started from (updated with every
-    /// state until the first dynamic increment).
-    #[serde(default)]
+    /// Energy ledger of the state the first dynamic step started from, once it has started.
     pub dynamic_start_energy: Option<EnergyLedger>,
-    /// Whether a dynamic increment has been recorded.
-    #[serde(default)]
-    pub dynamic: bool,
     /// Energy ledger of the last converged state.
     pub last_energy: Option<EnergyLedger>,
     /// Largest of the kinetic + strain + hourglass energy, |external work|, |normal work| and
@@ -306,9 +301,8 @@ impl<const D: usize> Observer<D> for ModelRecorder {
         .into_iter()
         .fold(record.energy_scale, f64::max);
         record.first_energy.get_or_insert_with(|| e.clone());
-        record.dynamic |= report.dynamic;
-        if !record.dynamic {
-            record.dynamic_start_energy = Some(e.clone());
+        if report.dynamic && record.dynamic_start_energy.is_none() {
+            record.dynamic_start_energy = record.last_energy.clone();
         }
         record.last_energy = Some(e.clone());
         record.final_pairs = totals;

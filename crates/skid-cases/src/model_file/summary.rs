@@ -153,19 +153,12 @@ pub fn summarize<const D: usize>(
     // Newton checks), and its ledger integrates the work of loads ramped over its increments
     // by the trapezoidal rule, exact only as the increments shrink (seed 1 run 229 of the stress
     // sweep: one increment to 8.5 MPa left 33 % of the energy in play as quadrature error).
-    let start = if record.dynamic {
-        record.dynamic_start_energy.as_ref()
-    } else {
-        record.first_energy.as_ref()
-    };
+    let start = record
+        .dynamic_start_energy
+        .as_ref()
+        .or(record.first_energy.as_ref());
     let ends = start.zip(record.last_energy.as_ref());
-    let residual = ends.map(|(a, b)| {
-        -((b.kinetic + b.strain + b.hourglass - (a.kinetic + a.strain + a.hourglass))
-            - (b.external_work - a.external_work)
-            - (b.normal_work - a.normal_work)
-            + (b.friction_dissipation - a.friction_dissipation)
-            + (b.algorithmic_dissipation - a.algorithmic_dissipation))
-    });
+    let residual = ends.map(|(a, b)| b.unaccounted_since(a));
     let algorithmic = ends.map(|(a, b)| b.algorithmic_dissipation - a.algorithmic_dissipation);
     let scale = record.energy_scale;
     ModelSummary {
