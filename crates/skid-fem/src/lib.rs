@@ -8,6 +8,7 @@
 //!   code path for 2D plane strain (D = 2) and 3D (D = 3).
 //! * [`pressure`]: follower pressure on element faces.
 //! * [`mesh`]: solid meshes with node sets and surfaces ([`SolidMesh`]).
+//! * [`ordering`]: a fill-reducing order of a mesh's nodes (nested dissection).
 //! * [`tetra`]: tetrahedral meshes (the C3D4 drum) and their exterior faces.
 //! * [`rigid`]: rigid bodies (reference node with point mass and rotary inertia).
 //!
@@ -17,6 +18,7 @@ pub mod cell;
 pub mod error;
 pub mod material;
 pub mod mesh;
+pub mod ordering;
 pub mod pressure;
 pub mod rigid;
 pub mod solid;
