@@ -326,11 +326,13 @@ const MAX_TIGHTENINGS: usize = 3;
 /// small mass shift regularises), a relative `1e-8` leaves penetrations of micrometres. The
 /// solve is then repeated from its own forces with the relative tolerance scaled by
 /// `length_tolerance / error` (halved, at least [`TIGHTEST_COULOMB_TOLERANCE`]), at most
-/// [`MAX_TIGHTENINGS`] times. Whatever it reaches is returned: the Newton iteration judges the
-/// contact law at the new kinematics in lengths and rejects what is not good enough.
+/// [`MAX_TIGHTENINGS`] times. Whatever it reaches is returned, also where a tightened solve
+/// does not converge to its tighter tolerance (the forces it started from stand): the Newton
+/// iteration judges the contact law at the new kinematics in lengths and rejects what is not
+/// good enough.
 ///
 /// # Errors
-/// The Coulomb solver's failure.
+/// The Coulomb solver's failure on the first solve.
 fn solve_to_length(
     problem: &FrictionProblem,
     warm: &DVector<f64>,
@@ -349,7 +351,11 @@ fn solve_to_length(
             tolerance,
             ..settings.clone()
         };
-        let refined = solve_contact_forces(problem, &solution.r, &tighter)?;
+        let refined = match solve_contact_forces(problem, &solution.r, &tighter) {
+            Ok(refined) => refined,
+            Err(ContactError::FixedPointNotConverged { .. }) => break,
+            Err(other) => return Err(other),
+        };
         solution = CoulombSolution {
             conic_solves: solution.conic_solves + refined.conic_solves,
             fixed_point_iterations: solution.fixed_point_iterations
