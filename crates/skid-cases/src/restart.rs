@@ -36,7 +36,7 @@ pub const RESTART_JSON: &str = "restart.json";
 /// Converged increments between restart files when the command line does not say.
 pub const DEFAULT_RESTART_EVERY: usize = 100;
 /// Version of the restart file's layout.
-pub const RESTART_FORMAT: u32 = 2;
+pub const RESTART_FORMAT: u32 = 3;
 
 /// The 64-bit FNV-1a hash, for telling whether a file is the one a restart file was made with.
 #[derive(Clone, Copy, Debug)]

@@ -55,6 +55,8 @@ pub struct Assembler {
     values: Vec<f64>,
     /// Element pressures of the mixed tangent between Newton iterates.
     mixed: MixedPressures,
+    /// Numeric factorizations of the tangent so far.
+    pub factorizations: usize,
 }
 
 impl Assembler {
@@ -109,6 +111,7 @@ impl Assembler {
             slot_position,
             values,
             mixed: MixedPressures::new(model.elements().len()),
+            factorizations: 0,
         })
     }
 
@@ -274,7 +277,8 @@ impl Assembler {
     ///
     /// # Errors
     /// [`IncrementFailure::LinearSolve`] if it is not positive definite.
-    pub fn factorize(&self) -> Result<Factorization, IncrementFailure> {
+    pub fn factorize(&mut self) -> Result<Factorization, IncrementFailure> {
+        self.factorizations += 1;
         self.pattern.factorize(&self.values)
     }
 

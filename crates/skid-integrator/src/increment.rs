@@ -99,6 +99,31 @@ pub struct Timings {
     pub contact_solve: Duration,
 }
 
+/// Factorizations and iterative solves of the linear systems.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct SolveCounts {
+    /// Cholesky factorizations of the effective tangent (contact-free steps, the reduced
+    /// contact path).
+    pub tangent_factorizations: usize,
+    /// Sparse LU factorizations of the global contact system.
+    pub lu_factorizations: usize,
+    /// `L D L^T` factorizations of its quasi-definite approximation.
+    pub preconditioner_factorizations: usize,
+    /// GMRES iterations (each one solve with a factorization and one product with the matrix).
+    pub krylov_iterations: usize,
+}
+
+impl SolveCounts {
+    /// Adds the work done between the snapshots `before` and `after` of a workspace's counts.
+    pub fn add_between(&mut self, before: &Self, after: &Self) {
+        self.tangent_factorizations += after.tangent_factorizations - before.tangent_factorizations;
+        self.lu_factorizations += after.lu_factorizations - before.lu_factorizations;
+        self.preconditioner_factorizations +=
+            after.preconditioner_factorizations - before.preconditioner_factorizations;
+        self.krylov_iterations += after.krylov_iterations - before.krylov_iterations;
+    }
+}
+
 /// Counters of one converged increment.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct IncrementCounters {
@@ -139,8 +164,18 @@ pub enum ContactSolve {
 pub struct Workspace {
     /// Assembly of the effective tangent and its Cholesky factorizations.
     pub assembler: Assembler,
-    /// The global contact system's LU factorizations.
+    /// The global contact system's factorizations.
     pub global: GlobalContactSolver,
+}
+
+impl Workspace {
+    /// The factorizations and GMRES iterations of this workspace so far.
+    pub fn counts(&self) -> SolveCounts {
+        SolveCounts {
+            tangent_factorizations: self.assembler.factorizations,
+            ..self.global.counts
+        }
+    }
 }
 
 /// Solves one increment from `start`. `held[eq]` marks equations kept at their start value.
@@ -253,6 +288,8 @@ fn solve_increment_with<const D: usize>(
         IncrementKind::Dynamic { .. } => Some(&x - &start.x),
     };
     let mut halvings = 0;
+    // The forces before the last global step, to go back half way with the step.
+    let mut forces_before: Option<DVector<f64>> = None;
     // The factorization of the last contact step (see the contact step below).
     let mut reusable = None;
     // The candidates' weights of the contact law residual, fixed for the increment so that the
@@ -363,6 +400,25 @@ fn solve_increment_with<const D: usize>(
                     contact_residual,
                 });
             }
+            // Semismooth Newton can cycle between two sets of contact branches, each step
+            // undoing the last: then the iterate goes back half way (forces too), which
+            // leaves the cycle.
+            if method == ContactSolve::Global
+                && halvings < MAX_STEP_HALVINGS
+                && is_cycling(&counters.residuals)
+                && let (Some(step), Some(before)) = (last_step.as_mut(), forces_before.as_ref())
+            {
+                *step *= 0.5;
+                x -= &*step;
+                assembler.advance_mixed_pressures(model, &(-&*step));
+                warm = (&warm + before) * 0.5;
+                last = Some(LastForces::Law {
+                    r: warm.clone(),
+                    rho: weights.clone().unwrap_or_default(),
+                });
+                halvings += 1;
+                continue;
+            }
         }
 
         // The mass term of the matrix is raised until `K + c M` can be factorized (see
@@ -391,7 +447,7 @@ fn solve_increment_with<const D: usize>(
             let step = global.step(model, k.as_ref(), &rows, &residual, &warm, rho, held);
             timings.linear_solve += clock.elapsed();
             let step = step?;
-            warm.clone_from(&step.r);
+            forces_before = Some(std::mem::replace(&mut warm, step.r.clone()));
             last = Some(LastForces::Law {
                 r: step.r,
                 rho: rho.clone(),
@@ -485,6 +541,16 @@ impl LastForces {
             Self::Linearised { r, .. } | Self::Law { r, .. } => r,
         }
     }
+}
+
+/// True if the last convergence check repeats the one two before it (both residuals within
+/// 5 %): Newton alternating between two iterates.
+fn is_cycling(residuals: &[(f64, f64)]) -> bool {
+    let [.., (f0, c0), _, (f2, c2)] = residuals else {
+        return false;
+    };
+    let repeats = |a: f64, b: f64| (a - b).abs() <= 0.05 * a.max(b);
+    repeats(*f0, *f2) && repeats(*c0, *c2)
 }
 
 /// Newton iterations the global contact solve gets before the increment is handed to the
@@ -669,5 +735,23 @@ fn finish<const D: usize>(
         contacts,
         warm_forces,
         energy,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A check that repeats the one two before (both residuals within 5 %) is a cycle; a
+    /// falling sequence or a single repeat of the one just before is not.
+    #[test]
+    fn a_residual_repeating_every_other_check_is_a_cycle() {
+        let cycle = [(9.59e-3, 1.44e-3), (9.60e-3, 1.35e-3), (9.589e-3, 1.444e-3)];
+        assert!(is_cycling(&cycle));
+        let converging = [(1e-2, 1e-3), (1e-4, 1e-5), (1e-8, 1e-10)];
+        assert!(!is_cycling(&converging));
+        assert!(!is_cycling(&cycle[1..]));
+        let force_only = [(9.59e-3, 1.44e-3), (9.60e-3, 1.35e-3), (9.589e-3, 1.0e-5)];
+        assert!(!is_cycling(&force_only));
     }
 }

@@ -13,7 +13,9 @@
 //!   reduction of one Newton step to the exact-Coulomb problem in the contact forces (the dense
 //!   reference path);
 //! - [`global_contact`]: one Newton step of unknowns and contact forces together, on a sparse
-//!   unsymmetric system (the default path);
+//!   unsymmetric system, solved by GMRES ([`krylov`]) preconditioned with the factors of a
+//!   symmetric quasi-definite approximation ([`quasi_definite`]) in a nested-dissection
+//!   order ([`ordering`]);
 //! - [`increment`]: Newton-Raphson for one increment (static or dynamic);
 //! - [`stepper`]: steps, automatic cutback, and reporting of converged increments.
 //!
@@ -30,6 +32,7 @@ pub mod increment;
 pub mod krylov;
 pub mod mixed;
 pub mod model;
+pub mod ordering;
 pub mod quasi_definite;
 pub mod sparse;
 pub mod state;

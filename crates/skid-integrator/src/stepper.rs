@@ -33,8 +33,8 @@ use crate::error::{IncrementFailure, RunError};
 use crate::global_contact::{GlobalContactSolver, GlobalSolverMemory};
 use crate::hht::Hht;
 use crate::increment::{
-    ContactSolve, IncrementCounters, IncrementKind, NewtonSettings, Timings, Workspace,
-    solve_increment,
+    ContactSolve, IncrementCounters, IncrementKind, NewtonSettings, SolveCounts, Timings,
+    Workspace, solve_increment,
 };
 use crate::model::Model;
 use crate::state::{ContactPointState, EnergyLedger, State};
@@ -546,6 +546,9 @@ pub struct RunStatistics {
     pub cutback_causes: std::collections::BTreeMap<String, usize>,
     /// Time spent in the parts of Newton (all attempts).
     pub timings: Timings,
+    /// Factorizations and GMRES iterations (all attempts).
+    #[serde(default)]
+    pub solves: SolveCounts,
     /// Wall time of the whole run.
     pub wall_time: Duration,
 }
@@ -760,16 +763,21 @@ struct Run<'a, const D: usize> {
 }
 
 impl<const D: usize> Run<'_, D> {
-    /// Hands the observer a checkpoint if it wants one after the increment just reported.
+    /// Hands the observer a checkpoint if it wants one after the increment just reported,
+    /// made by `make` from the workspace; a checkpoint ends the reuse of the global solver's
+    /// quasi-definite factors (see [`GlobalContactSolver::forget_preconditioner`]), so that the
+    /// run goes on as one resumed from it would.
     fn offer_checkpoint(
         &mut self,
         boundary: bool,
-        make: impl FnOnce() -> Checkpoint,
+        workspace: &mut Workspace,
+        make: impl FnOnce(&Workspace) -> Checkpoint,
     ) -> Result<(), RunError> {
         if self.observer.wants_checkpoint(boundary) {
-            let mut checkpoint = make();
+            let mut checkpoint = make(workspace);
             checkpoint.statistics.wall_time = self.earlier + self.clock.elapsed();
             self.observer.on_checkpoint(self.model, &checkpoint)?;
+            workspace.global.forget_preconditioner();
         }
         Ok(())
     }
@@ -833,12 +841,12 @@ impl<const D: usize> Run<'_, D> {
                     counters: &none,
                 },
             )?;
-            self.offer_checkpoint(true, || Checkpoint {
+            self.offer_checkpoint(true, &mut workspace, |workspace| Checkpoint {
                 state: state.clone(),
                 step: 0,
                 position: None,
                 statistics: stats.clone(),
-                solver: SolverMemory::of(&workspace),
+                solver: SolverMemory::of(workspace),
             })?;
         }
         for (index, step) in steps.iter().enumerate().skip(first_step) {
@@ -916,7 +924,8 @@ impl<const D: usize> Run<'_, D> {
                     h: dp * span,
                 },
             };
-            match solve_increment(
+            let before = workspace.counts();
+            let solved = solve_increment(
                 model,
                 workspace,
                 &state,
@@ -924,7 +933,9 @@ impl<const D: usize> Run<'_, D> {
                 &held,
                 settings,
                 &mut stats.timings,
-            ) {
+            );
+            stats.solves.add_between(&before, &workspace.counts());
+            match solved {
                 Ok((mut next, counters)) => {
                     let mut next_size = None;
                     if let (Some(run), IncrementKind::Dynamic { hht, h }) = (&mut adaptive, kind) {
@@ -969,20 +980,22 @@ impl<const D: usize> Run<'_, D> {
                         size = (size * settings.cutback.growth_factor).min(nominal);
                         successes = 0;
                     }
-                    self.offer_checkpoint(progress >= 1.0 - 1e-12, || Checkpoint {
-                        state: state.clone(),
-                        step: index,
-                        position: Some(StepPosition {
-                            start_load_factor: lambda0,
-                            start_time: t0,
-                            progress,
-                            size,
-                            successes,
-                            increment,
-                            adaptive: adaptive.as_ref().map(AdaptiveRun::memory),
-                        }),
-                        statistics: stats.clone(),
-                        solver: SolverMemory::of(workspace),
+                    self.offer_checkpoint(progress >= 1.0 - 1e-12, workspace, |workspace| {
+                        Checkpoint {
+                            state: state.clone(),
+                            step: index,
+                            position: Some(StepPosition {
+                                start_load_factor: lambda0,
+                                start_time: t0,
+                                progress,
+                                size,
+                                successes,
+                                increment,
+                                adaptive: adaptive.as_ref().map(AdaptiveRun::memory),
+                            }),
+                            statistics: stats.clone(),
+                            solver: SolverMemory::of(workspace),
+                        }
                     })?;
                 }
                 Err(cause) => {

@@ -27,6 +27,14 @@ pub struct RunCost {
     pub contact_newton_steps: usize,
     /// Increments the global contact solve did not converge and the reduced one solved.
     pub contact_fallbacks: usize,
+    /// Cholesky factorizations of the effective tangent.
+    pub tangent_factorizations: usize,
+    /// LU factorizations of the global contact system.
+    pub lu_factorizations: usize,
+    /// Factorizations of its quasi-definite approximation (the GMRES preconditioner).
+    pub preconditioner_factorizations: usize,
+    /// GMRES iterations on the global contact system.
+    pub krylov_iterations: usize,
     /// Failed attempts answered by a cutback.
     pub cutbacks: usize,
     /// Converged increments of adaptive steps taken again shorter for their local error.
@@ -54,6 +62,10 @@ impl From<&RunStatistics> for RunCost {
             fixed_point_iterations: stats.fixed_point_iterations,
             contact_newton_steps: stats.contact_newton_steps,
             contact_fallbacks: stats.contact_fallbacks,
+            tangent_factorizations: stats.solves.tangent_factorizations,
+            lu_factorizations: stats.solves.lu_factorizations,
+            preconditioner_factorizations: stats.solves.preconditioner_factorizations,
+            krylov_iterations: stats.solves.krylov_iterations,
             cutbacks: stats.cutbacks,
             error_rejections: stats.error_rejections,
             cutback_causes: stats.cutback_causes.clone(),
