@@ -98,7 +98,7 @@ const KRYLOV_MAX_ITERATIONS: usize = 8;
 /// equations (pad 20 x 4 x 4) the LU alone is faster (1.01 s against 1.10 s), at 3,077
 /// (40 x 4 x 4) the preconditioner is (2.31 s against 3.96 s); at 9,965 (40 x 8 x 8) a dynamic
 /// iteration takes 0.10-0.15 s with it against 0.55-0.75 s for the LU.
-const QUASI_DEFINITE_FROM: usize = 2000;
+pub const QUASI_DEFINITE_FROM: usize = 2000;
 /// GMRES iterations on the quasi-definite preconditioner of this system's `S` before the
 /// matrix is factorized.
 const QUASI_DEFINITE_MAX_ITERATIONS: usize = 30;

@@ -271,7 +271,6 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
     if steps.is_empty() {
         return fail("steps", "expected at least one step");
     }
-    let settings = solver_settings(&spec.solver, section.quasi_static)?;
     if let Some(interval) = spec.output.field_interval {
         positive("output.field_interval", interval)?;
     }
@@ -289,6 +288,7 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         field: "(model)".into(),
         message: e.to_string(),
     })?;
+    let settings = solver_settings(&spec.solver, ContactSolve::preferred_for(&model))?;
     Ok(Scene {
         model,
         steps,
@@ -729,10 +729,10 @@ fn held_motions<const D: usize>(
     Ok(held)
 }
 
-/// Solver settings; `auto` takes the global contact solve for a quasi-static part (the
-/// reduced one needs its stiffness inverse, singular without contact) and the reduced one
-/// otherwise; the conic Coulomb method works on the reduced operator only.
-fn solver_settings(s: &SolverSpec, quasi_static: bool) -> Result<Settings, SpecError> {
+/// Solver settings; `auto` takes the contact solve `preferred` for the model
+/// ([`ContactSolve::preferred_for`]); the conic Coulomb method works on the reduced operator
+/// only.
+fn solver_settings(s: &SolverSpec, preferred: ContactSolve) -> Result<Settings, SpecError> {
     if s.max_newton_iterations == 0 {
         return fail("solver.max_newton_iterations", "expected at least 1");
     }
@@ -762,8 +762,8 @@ fn solver_settings(s: &SolverSpec, quasi_static: bool) -> Result<Settings, SpecE
         },
         contact_solve: match (s.contact_solve, s.coulomb_method) {
             (_, CoulombMethodSpec::Conic) | (ContactSolveSpec::Reduced, _) => ContactSolve::Reduced,
-            (ContactSolveSpec::Auto, _) if !quasi_static => ContactSolve::Reduced,
-            _ => ContactSolve::Global,
+            (ContactSolveSpec::Auto, _) => preferred,
+            (ContactSolveSpec::Global, _) => ContactSolve::Global,
         },
         cutback: CutbackSettings {
             factor: s.cutback_factor,
