@@ -416,7 +416,8 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
             }
         }
     }
-    crate::report::plot::plot_work_precision(
+    crate::report::plot::plot_log_log(
+        "Work-precision",
         &series,
         (
             "median wall time [s]",

@@ -19,6 +19,7 @@ pub mod format;
 pub mod hard;
 pub mod markdown;
 pub mod plot;
+pub mod scaling;
 pub mod sweep;
 
 use std::fmt::Write as _;
@@ -357,6 +358,9 @@ pub struct ReportSources<'a> {
     pub hard: Option<&'a Path>,
     /// The convergence study: one subdirectory per series, holding one per level.
     pub convergence: Option<&'a Path>,
+    /// The measurements of cost against problem size (`scaling.json` of
+    /// `scripts/scaling.py`).
+    pub scaling: Option<&'a Path>,
 }
 
 /// What [`write_report`] wrote and found.
@@ -388,6 +392,11 @@ fn regenerate(sources: &ReportSources<'_>, out: &Path) -> String {
     if let Some(convergence) = sources.convergence {
         commands.push(format!("scripts/convergence.sh {}", convergence.display()));
         let _ = write!(report, " --convergence {}", convergence.display());
+    }
+    if let Some(scaling) = sources.scaling {
+        let dir = scaling.parent().unwrap_or(Path::new("."));
+        commands.push(format!("scripts/scaling.py --out {}", dir.display()));
+        let _ = write!(report, " --scaling {}", scaling.display());
     }
     let _ = write!(report, " --out {}", out.display());
     commands.push(report);
@@ -441,6 +450,13 @@ pub fn write_report(sources: &ReportSources<'_>, out: &Path) -> Result<ReportOut
     if let Some(study_dir) = sources.convergence {
         let study = convergence::load_study(study_dir)?;
         let (section, plots) = convergence::section(study_dir, &study, dir)?;
+        text.push('\n');
+        text.push_str(&section);
+        files.extend(plots);
+    }
+    if let Some(scaling_file) = sources.scaling {
+        let study = scaling::load(scaling_file)?;
+        let (section, plots) = scaling::section(scaling_file, &study, dir)?;
         text.push('\n');
         text.push_str(&section);
         files.extend(plots);

@@ -123,10 +123,13 @@ enum Command {
         /// one run per level.
         #[arg(long)]
         convergence: Option<PathBuf>,
+        /// Cost against problem size: the scaling.json of `scripts/scaling.py`.
+        #[arg(long)]
+        scaling: Option<PathBuf>,
         /// Sweep report: the sweep runs listed by the batch.json of each directory (one
         /// `skid batch` of sweep files, or its shards), one table per sweep in run order.
         #[arg(long, num_args = 1.., value_name = "DIR",
-              conflicts_with_all = ["runs", "reference", "hard", "convergence"])]
+              conflicts_with_all = ["runs", "reference", "hard", "convergence", "scaling"])]
         sweep: Vec<PathBuf>,
         /// The markdown report; the plots are written beside it [default: validation/report.md,
         /// with --sweep out/sweep.md].
@@ -204,6 +207,7 @@ fn main() -> ExitCode {
             reference,
             hard,
             convergence,
+            scaling,
             sweep,
             out,
         } => {
@@ -212,8 +216,8 @@ fn main() -> ExitCode {
                 return report::run_sweep(&sweep, &out);
             }
             let out = out.unwrap_or_else(|| PathBuf::from("validation/report.md"));
-            let runs = match (&runs, &hard, &convergence) {
-                (None, None, None) => Some(PathBuf::from("out")),
+            let runs = match (&runs, &hard, &convergence, &scaling) {
+                (None, None, None, None) => Some(PathBuf::from("out")),
                 _ => runs,
             };
             let sources = ReportSources {
@@ -221,6 +225,7 @@ fn main() -> ExitCode {
                 reference: reference.as_deref(),
                 hard: hard.as_deref(),
                 convergence: convergence.as_deref(),
+                scaling: scaling.as_deref(),
             };
             report::run(&sources, &out)
         }

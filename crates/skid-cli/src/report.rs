@@ -1,5 +1,6 @@
-//! `skid report`: the validation report of the benchmark runs, the hard cases and the
-//! convergence study; or the sweep report of batch directories.
+//! `skid report`: the validation report of the benchmark runs, the hard cases, the
+//! convergence study and the cost against problem size; or the sweep report of batch
+//! directories.
 //!
 //! Exit codes: 0 the report was written and every acceptance check passed (or was skipped),
 //! or for a sweep every run is listed and ended as expected; 1 the report was written but a

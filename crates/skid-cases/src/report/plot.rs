@@ -16,6 +16,8 @@ pub const DIFFERENCE_SVG: &str = "omega-difference.svg";
 pub const HARD_OMEGA_SVG: &str = "hard-omega.svg";
 /// File name of the Newton residual plot of the convergence study.
 pub const NEWTON_SVG: &str = "newton.svg";
+/// File name of the plot of cost against problem size.
+pub const SCALING_SVG: &str = "scaling.svg";
 
 /// The time axis of the benchmark plots.
 const TIME_AXIS: &str = "t [s] (from the start of the dynamic step)";
@@ -305,12 +307,14 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     }
 }
 
-/// `work-precision.svg`: error against wall time, both on log scales, one curve of points per
-/// `(label, [(wall time, error)])` (points with a non-positive value are left out).
+/// A plot titled `title` on log scales in both axes, one curve of points per `(label,
+/// [(x, y)])` (points with a non-positive value are left out): `work-precision.svg` (error
+/// against wall time), `scaling.svg` (cost against equations).
 ///
 /// # Errors
 /// [`ReportError`] if the plot cannot be drawn or written.
-pub fn plot_work_precision(
+pub fn plot_log_log(
+    title: &str,
     series: &[(String, Vec<(f64, f64)>)],
     (x_label, y_label): (&str, &str),
     path: &Path,
@@ -321,7 +325,7 @@ pub fn plot_work_precision(
     let y = log_range(all().map(|p| p.1));
     write_svg(path, |root| {
         let mut chart = ChartBuilder::on(root)
-            .caption("Work-precision", ("sans-serif", 22))
+            .caption(title, ("sans-serif", 22))
             .margin(16)
             .x_label_area_size(48)
             .y_label_area_size(72)
