@@ -69,6 +69,8 @@ enum Command {
         resume: Option<PathBuf>,
         /// Write the restart file every N converged increments, and at the start and the end
         /// of each step (0: no restart file) [default: 100; with --resume, the run's own].
+        /// Each restart file ends the reuse of the global contact solve's preconditioner, so
+        /// on large models N changes results at the level of the solver's tolerances.
         #[arg(long, value_name = "N")]
         restart_every: Option<usize>,
     },
