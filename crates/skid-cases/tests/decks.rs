@@ -146,8 +146,9 @@ fn a_deck_written_by_hand_reads_to_the_drum_model() {
             .iter()
             .map(|l| {
                 let mut l = l.clone();
-                let skid_cases::model_file::spec::LoadSpec::Pressure { surface, .. } = &mut l;
-                *surface = "pad_back".into();
+                if let skid_cases::model_file::spec::LoadSpec::Pressure { surface, .. } = &mut l {
+                    *surface = "pad_back".into();
+                }
                 l
             })
             .collect::<Vec<_>>()

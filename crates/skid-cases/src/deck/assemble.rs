@@ -227,6 +227,7 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
         boundary: spec_boundary,
         ties,
         loads,
+        amplitudes: Vec::new(),
         contact,
         steps,
         solver: SolverSpec::default(),

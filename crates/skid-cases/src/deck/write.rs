@@ -315,7 +315,12 @@ pub fn write_deck(
         if i == 0 && !spec.loads.is_empty() {
             let _ = writeln!(out, "*DSLOAD");
             for load in &spec.loads {
-                let LoadSpec::Pressure { surface, pressure } = load;
+                let LoadSpec::Pressure {
+                    surface, pressure, ..
+                } = load
+                else {
+                    continue;
+                };
                 let _ = writeln!(out, "{surface}, P, {}", num(*pressure));
             }
         }

@@ -177,7 +177,11 @@ pub(super) fn steps(
     let loads = first_loads
         .unwrap_or_default()
         .into_iter()
-        .map(|(surface, pressure)| LoadSpec::Pressure { surface, pressure })
+        .map(|(surface, pressure)| LoadSpec::Pressure {
+            surface,
+            pressure,
+            amplitude: None,
+        })
         .collect();
     Ok((out, loads))
 }
