@@ -10,6 +10,7 @@
 
 use std::path::{Path, PathBuf};
 
+use skid_cases::model_file::spec::LoadSpec;
 use skid_cases::model_file::{self, ModelSpec, parse_model};
 use skid_integrator::stepper::{IncrementReport, Observer, run};
 use skid_integrator::{Model, State};
@@ -186,25 +187,45 @@ fn block_pushed<const D: usize>() {
 ///   accelerates at `(F (cos a - mu sin a) - G (sin a + mu cos a)) / m
 ///   = 0.005 g (sin a + mu cos a) = 0.0230 m/s^2` (to 1 %).
 ///
-/// So the threshold lies within 0.5 % of the Coulomb value.
+/// So the threshold lies within 0.5 % of the Coulomb value. The 2D scene's deck
+/// (`2d-block-on-incline.inp`: `*AMPLITUDE`, `*DLOAD` with `GRAV`, `*CLOAD` on the plate's
+/// reference node) reads to the same loads and amplitudes, bit for bit, and passes the same
+/// checks.
 #[test]
 fn a_block_on_an_incline_slides_up_exactly_past_the_coulomb_threshold() {
-    block_on_incline::<2>();
-    block_on_incline::<3>();
+    block_on_incline::<2>(&scene_spec("2d-block-on-incline", &[]));
+    block_on_incline::<3>(&scene_spec("3d-block-on-incline", &[]));
+    let deck = skid_cases::deck::read_model(&repo("cases/verification/2d-block-on-incline.inp"))
+        .expect("deck reads")
+        .model;
+    let json = scene_spec("2d-block-on-incline", &[]);
+    assert_eq!(
+        (&deck.loads, &deck.amplitudes),
+        (&json.loads, &json.amplitudes)
+    );
+    block_on_incline::<2>(&deck);
 }
 
-fn block_on_incline<const D: usize>() {
-    let name = format!("{D}d-block-on-incline");
+/// `spec` with the force of its load `load` (a concentrated load) set to `force`.
+fn with_force(spec: &ModelSpec, load: usize, force: Vec<f64>) -> ModelSpec {
+    let mut spec = spec.clone();
+    match &mut spec.loads[load] {
+        LoadSpec::Concentrated { force: f, .. } => *f = Some(force),
+        other => panic!("load {load} is {other:?}"),
+    }
+    spec
+}
+
+fn block_on_incline<const D: usize>(scene: &ModelSpec) {
     let (a, g) = (10f64.to_radians(), 9.81);
     let weight = MASS * g;
     let threshold = (a.tan() + MU) / (1.0 - MU * a.tan());
     let hold_from = 0.02;
 
     let low = 0.995 * threshold * weight;
-    let spec = scene_spec(
-        &name,
-        &[push_override(1, [low * a.cos(), -low * a.sin()], D)],
-    );
+    let mut force = vec![low * a.cos(), -low * a.sin()];
+    force.resize(D, 0.0);
+    let spec = with_force(scene, 1, force);
     let (model, states) = simulate::<D>(&spec);
     let eq = plate_x(&model);
     let held: Vec<&State> = states.iter().filter(|s| s.time >= hold_from).collect();
@@ -227,8 +248,7 @@ fn block_on_incline<const D: usize>() {
         -t_static
     );
 
-    let spec = scene_spec(&name, &[]);
-    let (model, states) = simulate::<D>(&spec);
+    let (model, states) = simulate::<D>(scene);
     let eq = plate_x(&model);
     let held: Vec<&State> = states.iter().filter(|s| s.time >= hold_from).collect();
     for s in &held {
@@ -304,4 +324,83 @@ fn loads_whose_amplitudes_restart_with_a_step_jump_there_without_work() {
         "{unaccounted:e} J unaccounted of {:e} J stored",
         s0.energy.strain
     );
+}
+
+/// Each problem in a load or an amplitude is reported with its field path.
+#[test]
+fn every_load_error_names_its_field() {
+    let cases: [(&str, &str, &str); 14] = [
+        (
+            r#"loads[1].amplitude="ramp""#,
+            "loads[1].amplitude",
+            "no amplitude named 'ramp'",
+        ),
+        (
+            r#"amplitudes[1].points=[[0.0, 0.0], [0.0, 1.0]]"#,
+            "amplitudes[1].points[1]",
+            "the times must increase",
+        ),
+        (
+            r#"amplitudes[0].points=[[-1.0, 0.0]]"#,
+            "amplitudes[0].points[0]",
+            "expected a step time >= 0",
+        ),
+        (
+            r#"amplitudes[0].points=[]"#,
+            "amplitudes[0].points",
+            "at least one",
+        ),
+        (
+            r#"amplitudes[1].name="press""#,
+            "amplitudes[1].name",
+            "unique",
+        ),
+        (
+            r#"loads[0].body="nobody""#,
+            "loads[0].body",
+            "no rigid body named 'nobody'",
+        ),
+        (
+            r#"loads[0]={"type": "concentrated", "node_set": "top", "body": "plate", "force": [1.0, 0.0]}"#,
+            "loads[0]",
+            "exactly one of node_set and body",
+        ),
+        (
+            r#"loads[0]={"type": "concentrated", "body": "plate"}"#,
+            "loads[0]",
+            "a force, a moment or both",
+        ),
+        (r#"loads[0].force=[1.0]"#, "loads[0].force", "expected 2"),
+        (
+            r#"loads[0]={"type": "concentrated", "node_set": "top", "moment": [0.0, 0.0, 1.0]}"#,
+            "loads[0].moment",
+            "take no moment",
+        ),
+        (
+            r#"loads[0].moment=[1.0, 0.0, 0.0]"#,
+            "loads[0].moment",
+            "Rx is not a degree of freedom in 2D",
+        ),
+        (
+            r#"loads[0]={"type": "gravity", "acceleration": [0.0, -9.81, 0.0]}"#,
+            "loads[0].acceleration",
+            "expected 2",
+        ),
+        (
+            r#"part.element_sets={"upper": [0, 4]}"#,
+            "part.element_sets.upper",
+            "element 4 does not exist (4 elements)",
+        ),
+        (
+            r#"loads[0]={"type": "pressure", "surface": "top", "pressure": 1.0}"#,
+            "loads[0].surface",
+            "no surface named 'top'",
+        ),
+    ];
+    for (set, field, fragment) in cases {
+        let spec = scene_spec("2d-block-pushed-on-flat", &[set.to_string()]);
+        let error = model_file::build::<2>(&spec).expect_err(set);
+        assert_eq!(error.field, field, "{set}: {error:?}");
+        assert!(error.message.contains(fragment), "{set}: {}", error.message);
+    }
 }
