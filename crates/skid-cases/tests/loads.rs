@@ -90,14 +90,16 @@ fn plate_x<const D: usize>(model: &Model<D>) -> usize {
 /// Coulomb's law at every contact node `i`, `|T_i| <= mu N_i`, summed: the friction resultant
 /// can balance F only while `F <= mu N = 6 N`.
 /// - F = 3 N = 0.5 mu N: the block sticks. From the moment the push starts, no contact node
-///   slips more than 1e-9 of the block's width in all, and at rest the friction resultant is
-///   -F and the normal one N (both to 1e-6).
+///   slips more than 1e-9 of the block's width in all (measured: 2e-17 m), and at the end the
+///   friction resultant is -F to 1e-5 (measured 6.4e-7: the shear vibration the ramp left) and
+///   the normal one N to 1e-6.
 /// - F = 9 N = 1.5 mu N: once every contact slides along +x (its slip across it below 1e-3 of
 ///   its slip along it: in 3D the slip directions first settle), each carries exactly
 ///   `T_i = -mu N_i`, so the friction resultant is exactly -mu times the normal one (to 1e-6;
-///   the Coulomb tolerance is 1e-8), the normal one is N (to 1e-4: the plate bounces a little
-///   on the block), and the block accelerates at `(F - mu N) / m = 3000 m/s^2` (to 1e-4, from
-///   the plate's velocity over the last 10 ms).
+///   the Coulomb tolerance is 1e-8; measured 3e-16 in 2D, 8e-9 in 3D), the normal one is N (to
+///   1e-4: the plate bounces a little on the block), and the block accelerates at
+///   `(F - mu N) / m = 3000 m/s^2` (to 1e-4, measured 5e-6, from the plate's velocity over the
+///   last 10 ms).
 #[test]
 fn a_block_pushed_below_mu_n_sticks_and_above_slides_at_exactly_mu_n() {
     block_pushed::<2>();
@@ -125,7 +127,7 @@ fn block_pushed<const D: usize>() {
     );
     let (t, n) = static_resultants(&states);
     assert!(
-        (t + stick).abs() < 1e-6 * stick && (n - normal).abs() < 1e-6 * normal,
+        (t + stick).abs() < 1e-5 * stick && (n - normal).abs() < 1e-6 * normal,
         "{D}D stick: friction {t} N against the push {stick} N, normal {n} N"
     );
 
@@ -181,11 +183,11 @@ fn block_pushed<const D: usize>() {
 /// `F / G = (tan a + mu) / (1 - mu tan a) = 0.50293`.
 /// - At 0.995 times the threshold the block sticks: over the last 20 ms the plate moves less
 ///   than 1e-9 of the block's width, and the friction and normal resultants are T and N above
-///   (to 1e-6).
+///   (to 1e-6; measured 4e-10 and 1e-12).
 /// - At 1.005 times it slides up the slope: over the last 20 ms every contact slides, with a
 ///   friction resultant of exactly -mu times the normal one (to 1e-6), and the block
 ///   accelerates at `(F (cos a - mu sin a) - G (sin a + mu cos a)) / m
-///   = 0.005 g (sin a + mu cos a) = 0.0230 m/s^2` (to 1 %).
+///   = 0.005 g (sin a + mu cos a) = 0.0230 m/s^2` (to 1e-3; measured 1.4e-5).
 ///
 /// So the threshold lies within 0.5 % of the Coulomb value. The 2D scene's deck
 /// (`2d-block-on-incline.inp`: `*AMPLITUDE`, `*DLOAD` with `GRAV`, `*CLOAD` on the plate's
@@ -268,7 +270,7 @@ fn block_on_incline<const D: usize>(scene: &ModelSpec) {
     let acceleration = (last.v[eq] - first.v[eq]) / (last.time - first.time);
     let expected = 0.005 * g * (a.sin() + MU * a.cos());
     assert!(
-        (acceleration - expected).abs() < 0.01 * expected,
+        (acceleration - expected).abs() < 1e-3 * expected,
         "{D}D above: acceleration {acceleration} m/s^2, expected {expected}"
     );
 }
