@@ -4,7 +4,7 @@
 //!   continuation lines and `*INCLUDE`, each with its file and line.
 //! - [`read`]: the keyword subset read into definitions with the deck's labels and names
 //!   ([`fields`] reads typed parameters and fields, [`mesh`] nodes, elements and sets,
-//!   [`rigid`] analytical and faceted rigid surfaces).
+//!   [`rigid`] analytical and faceted rigid surfaces, [`loads`] amplitudes and loads).
 //! - [`assemble`]: the definitions turned into a model; [`write`]: a model written as a deck.
 //!
 //! The subset: `*HEADING`, `*NODE`, `*ELEMENT` (CPE4R, C3D8R; R2D2, R3D4, M3D4R, S4R, C3D4
@@ -15,16 +15,19 @@
 //! `*MASS`, `*ROTARY INERTIA`, `*SURFACE INTERACTION` with `*FRICTION`, `*CONTACT PAIR`,
 //! `*CONTACT` with `*CONTACT INCLUSIONS, ALL EXTERIOR` and `*CONTACT PROPERTY ASSIGNMENT`,
 //! `*BOUNDARY` (OP=MOD/NEW in steps), `*INITIAL CONDITIONS` (VELOCITY, ROTATING VELOCITY),
-//! `*AMPLITUDE` (defined, not yet usable), `*STEP` (NLGEOM), `*STATIC` and `*DYNAMIC` (DIRECT,
-//! ALPHA), `*DSLOAD` / `*DLOAD` pressures, `*OUTPUT`, `*NODE OUTPUT`, `*CONTACT OUTPUT`,
+//! `*AMPLITUDE` (TABULAR, step time), `*STEP` (NLGEOM), `*STATIC` and `*DYNAMIC` (DIRECT,
+//! ALPHA), `*CLOAD`, `*DSLOAD` / `*DLOAD` pressures and `*DLOAD` gravity (`GRAV`), each with
+//! `AMPLITUDE=`, `*OUTPUT`, `*NODE OUTPUT`, `*CONTACT OUTPUT`,
 //! `*END STEP`, `*INCLUDE`. Anything else is an error at its line.
 //!
 //! How skid reads what the keywords leave open, or what it models differently:
 //! - model-data boundary conditions hold throughout; in a step, zero-valued conditions on a
 //!   reference node hold that degree of freedom for the step (at its value at the step's start;
 //!   `OP=NEW` drops those of earlier steps);
-//! - the loads of the first step are ramped over it when it is static (applied at once when
-//!   dynamic) and held after; later steps must keep them;
+//! - the loads of the first step are those of the model: without amplitude, ramped over it
+//!   when it is static (applied at once when dynamic) and held after; with one, its value at
+//!   the step time (a static step's runs from 0 to 1); later steps must keep them (see
+//!   [`loads`] for gravity's direction and `OP=NEW`);
 //! - `*DYNAMIC` without `ALPHA` takes the keyword's default `-0.05`;
 //! - `*ELASTIC` is the compressible neo-Hookean solid with the same small-strain moduli;
 //! - rigid membranes and shells are contacted on their mid-surface (zero thickness), rigid
@@ -37,6 +40,7 @@
 pub mod assemble;
 pub mod fields;
 pub mod keywords;
+pub mod loads;
 pub mod mesh;
 pub mod read;
 pub mod rigid;

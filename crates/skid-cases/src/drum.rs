@@ -133,6 +133,7 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
             connectivity: mesh.elements,
         }],
         node_sets: mesh.node_sets,
+        element_sets: BTreeMap::new(),
         surfaces: mesh.surfaces,
         section: SectionSpec {
             material: pad.material.clone(),
@@ -233,7 +234,9 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
         loads: vec![LoadSpec::Pressure {
             surface: "ymax".into(),
             pressure: case.back_plate.pressure,
+            amplitude: None,
         }],
+        amplitudes: Vec::new(),
         contact: vec![ContactPairSpec {
             name: "pad-drum".into(),
             slave,

@@ -14,6 +14,7 @@ use skid_fem::solid::{ElementResponse, Tangent};
 
 use crate::coupling::{ContactRows, contact_coordinates};
 use crate::error::{IncrementFailure, LinearFailure, ModelError};
+use crate::loads::LoadInstant;
 use crate::mixed::MixedPressures;
 use crate::model::Model;
 use crate::sparse::{Factorization, PatternBuilder, SparsePattern};
@@ -331,23 +332,25 @@ impl Assembler {
 /// reports the tangent as indefinite.
 pub const MAX_SHIFT_DECADES: usize = 8;
 
-/// External nodal forces of the pressure loads at load factor `lambda`, on the current
-/// geometry (follower pressure), per equation.
+/// External nodal forces per equation at `instant`: `f = sum_l c_l f_l` with each load's
+/// factor `c_l` (its amplitude at the step time, or the ramp; see [`crate::loads`]), the
+/// pressures' `f_l` on the current geometry at `x` (follower pressure), the dead loads' fixed.
 pub fn external_forces<const D: usize>(
     model: &Model<D>,
     x: &DVector<f64>,
-    lambda: f64,
+    instant: LoadInstant,
 ) -> Result<DVector<f64>, IncrementFailure> {
     let mut f = DVector::zeros(model.dofs().len());
     let mesh = &model.part().mesh;
     for load in model.pressures() {
+        let pressure = instant.factor(load.amplitude.as_ref()) * load.pressure;
         for face in &load.faces {
             let xf: Vec<SVector<f64, D>> = face
                 .iter()
                 .map(|&n| mesh.nodes[n] + model.dofs().node_displacement(x, n))
                 .collect();
-            let forces = pressure_face_forces(&xf, lambda * load.pressure, model.part().thickness)
-                .map_err(|err| {
+            let forces =
+                pressure_face_forces(&xf, pressure, model.part().thickness).map_err(|err| {
                     IncrementFailure::Load(format!("pressure on face {face:?}: {err}"))
                 })?;
             for (&n, fn_) in face.iter().zip(&forces) {
@@ -359,12 +362,16 @@ pub fn external_forces<const D: usize>(
             }
         }
     }
+    for load in model.dead_loads() {
+        f.axpy(instant.factor(load.amplitude.as_ref()), &load.force, 1.0);
+    }
     Ok(f)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::loads::Loads;
     use crate::model::Tie;
     use crate::test_support::{body, pad_block};
     use nalgebra::DMatrix;
@@ -394,7 +401,7 @@ mod tests {
             body: 0,
             nodes: top,
         };
-        Model::new(part, vec![plate], vec![tie], vec![], vec![]).expect("model")
+        Model::new(part, vec![plate], vec![tie], Loads::default(), vec![]).expect("model")
     }
 
     /// The assembled tangent (through the DOF map, ties included) is the derivative of the

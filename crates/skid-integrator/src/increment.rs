@@ -45,6 +45,7 @@ use crate::global_contact::{
     GlobalContactSolver, QUASI_DEFINITE_FROM, contact_weights, law_residual,
 };
 use crate::hht::{Hht, IncrementEnds};
+use crate::loads::LoadInstant;
 use crate::model::Model;
 use crate::state::{ContactPointState, EnergyLedger, State};
 use crate::stepper::Settings;
@@ -80,6 +81,8 @@ pub enum IncrementKind {
         load_factor: f64,
         /// Factor on the mass matrix added to the Newton tangent.
         regularization: f64,
+        /// Step time at the end of the increment (the completed fraction of the step).
+        step_time: f64,
     },
     /// HHT increment of size `h`.
     Dynamic {
@@ -87,7 +90,30 @@ pub enum IncrementKind {
         hht: Hht,
         /// Time increment.
         h: f64,
+        /// Step time at the end of the increment, s.
+        step_time: f64,
     },
+}
+
+impl IncrementKind {
+    /// Where the loads stand at the end of the increment: the ramp of a static increment's load
+    /// factor (1 in a dynamic one) and the step time.
+    pub fn loads(&self) -> LoadInstant {
+        match *self {
+            Self::Static {
+                load_factor,
+                step_time,
+                ..
+            } => LoadInstant {
+                ramp: load_factor,
+                step_time,
+            },
+            Self::Dynamic { step_time, .. } => LoadInstant {
+                ramp: 1.0,
+                step_time,
+            },
+        }
+    }
 }
 
 /// Wall time spent in the parts of the Newton loop.
@@ -267,18 +293,15 @@ fn solve_increment_with<const D: usize>(
     };
     // The solid's rows of the tangent are `c_K K_T`, the mass term `c_M M` (regularising in a
     // static increment, inertial in a dynamic one).
-    let (lambda, k_factor, m_factor, m_term) = match kind {
-        IncrementKind::Static {
-            load_factor,
-            regularization,
-        } => (load_factor, 1.0, regularization, shift_mass),
-        IncrementKind::Dynamic { hht, h } => {
+    let (k_factor, m_factor, m_term) = match kind {
+        IncrementKind::Static { regularization, .. } => (1.0, regularization, shift_mass),
+        IncrementKind::Dynamic { hht, h, .. } => {
             let k_factor = if model.part().quasi_static {
                 hht.quasi_static_factor()
             } else {
                 1.0 + hht.alpha
             };
-            (1.0, k_factor, hht.mass_factor(h), mass)
+            (k_factor, hht.mass_factor(h), mass)
         }
     };
     // A quasi-static solid has no mass term in a dynamic tangent; if the tangent is indefinite
@@ -289,7 +312,7 @@ fn solve_increment_with<const D: usize>(
     };
     let mut x = match kind {
         IncrementKind::Static { .. } => start.x.clone(),
-        IncrementKind::Dynamic { hht, h } => hht.predict(h, &start.x, &start.v),
+        IncrementKind::Dynamic { hht, h, .. } => hht.predict(h, &start.x, &start.v),
     };
     for (eq, &h) in held.iter().enumerate() {
         if h {
@@ -323,7 +346,7 @@ fn solve_increment_with<const D: usize>(
         let clock = Instant::now();
         let (v, a) = match kind {
             IncrementKind::Static { .. } => (start.v.clone(), DVector::zeros(n)),
-            IncrementKind::Dynamic { hht, h } => {
+            IncrementKind::Dynamic { hht, h, .. } => {
                 let (mut v, mut a) =
                     hht.velocity_and_acceleration(h, &start.x, &start.v, &start.a, &x);
                 mean_rates(quasi_static, h, &start.x, &x, &mut v, &mut a);
@@ -354,7 +377,7 @@ fn solve_increment_with<const D: usize>(
             }
             Err(failure) => return Err(failure),
         };
-        let f_ext = external_forces(model, &x, lambda)?;
+        let f_ext = external_forces(model, &x, kind.loads())?;
         let net = &internal.force - &f_ext;
         let inertia = mass.component_mul(&a);
         let mut residual = match kind {
@@ -666,7 +689,7 @@ fn finish<const D: usize>(
     // smooth acceleration with the contact impulse (see `crate::hht`).
     let (r, v, a) = match kind {
         IncrementKind::Static { .. } => (r.clone(), v, a),
-        IncrementKind::Dynamic { hht, h } => {
+        IncrementKind::Dynamic { hht, h, .. } => {
             let contact = model.acceleration_of(&rows.transpose_times(r, x.len()));
             let (mut v, mut a) = hht.split_impulse(h, &start.v, &start.a, &a, &contact);
             mean_rates(model.quasi_static(), h, &start.x, &x, &mut v, &mut a);
@@ -720,7 +743,7 @@ fn finish<const D: usize>(
     let contact_reaction = rows.transpose_times(r, x.len());
     let algorithmic = match kind {
         IncrementKind::Static { .. } => 0.0,
-        IncrementKind::Dynamic { hht, h } => hht.algorithmic_dissipation(
+        IncrementKind::Dynamic { hht, h, .. } => hht.algorithmic_dissipation(
             h,
             &IncrementEnds {
                 mass: model.mass(),

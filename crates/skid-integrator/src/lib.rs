@@ -3,6 +3,7 @@
 //!
 //! The pieces, in the order a time increment uses them:
 //! - [`model`]: the assembled scene (mesh, material, rigid bodies, ties, loads, contact pairs);
+//! - [`loads`]: pressures, concentrated loads and gravity, and their amplitudes;
 //! - [`dof`]: which global equation each node component and rigid-body motion maps to;
 //! - [`sparse`]: the fixed sparsity pattern and the Cholesky factorization whose symbolic
 //!   analysis is computed once per run and reused for every Newton iteration;
@@ -30,6 +31,7 @@ pub mod global_contact;
 pub mod hht;
 pub mod increment;
 pub mod krylov;
+pub mod loads;
 pub mod mixed;
 pub mod model;
 pub mod ordering;
@@ -41,6 +43,7 @@ pub mod stepper;
 mod test_support;
 
 pub use error::{IncrementFailure, LinearFailure, ModelError, RunError};
+pub use loads::{Amplitude, ConcentratedLoad, GravityLoad, LoadInstant, LoadTarget, Loads};
 pub use model::{ContactPair, Model, PressureLoad, SolidPart, Tie};
 pub use state::State;
 pub use stepper::{

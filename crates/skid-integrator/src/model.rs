@@ -1,5 +1,5 @@
-//! The scene the integrator solves: one deformable solid, rigid bodies, ties, pressure loads and
-//! node-to-rigid-surface contact pairs. A [`Model`] is checked once when built and is immutable
+//! The scene the integrator solves: one deformable solid, rigid bodies, ties, loads (see
+//! [`crate::loads`]) and node-to-rigid-surface contact pairs. A [`Model`] is checked once when built and is immutable
 //! during a run.
 
 use nalgebra::{DVector, SVector, Vector3};
@@ -12,6 +12,7 @@ use skid_fem::solid::OnePointSolid;
 
 use crate::dof::DofMap;
 use crate::error::ModelError;
+use crate::loads::{Amplitude, DeadLoad, Loads, Scene};
 
 /// The deformable solid: mesh, material and section data.
 #[derive(Debug)]
@@ -55,6 +56,8 @@ pub struct PressureLoad {
     pub faces: Vec<Vec<usize>>,
     /// Pressure at load factor 1, Pa.
     pub pressure: f64,
+    /// Time variation (`None`: the ramp, see [`crate::loads`]).
+    pub amplitude: Option<Amplitude>,
 }
 
 /// Frictional contact between slave nodes of the solid and a surface carried by a rigid body.
@@ -79,6 +82,7 @@ pub struct Model<const D: usize> {
     bodies: Vec<RigidBody<D>>,
     ties: Vec<Tie>,
     pressures: Vec<PressureLoad>,
+    dead_loads: Vec<DeadLoad>,
     contacts: Vec<ContactPair>,
     elements: Vec<OnePointSolid<D>>,
     dofs: DofMap<D>,
@@ -98,14 +102,20 @@ impl<const D: usize> Model<D> {
     /// # Errors
     /// [`ModelError`] naming the entity at fault: a bad mesh or element geometry, non-physical
     /// density or thickness, an out-of-range node or body, a node tied twice, a tie to a body
-    /// that can rotate, a negative friction coefficient, or an equation without inertia.
+    /// that can rotate, a negative friction coefficient, an equation without inertia, or a
+    /// load that does not fit (see [`crate::loads::ConcentratedLoad`]).
     pub fn new(
         part: SolidPart<D>,
         bodies: Vec<RigidBody<D>>,
         ties: Vec<Tie>,
-        pressures: Vec<PressureLoad>,
+        loads: Loads<D>,
         contacts: Vec<ContactPair>,
     ) -> Result<Self, ModelError> {
+        let Loads {
+            pressures,
+            concentrated,
+            gravity,
+        } = loads;
         if D != 2 && D != 3 {
             return invalid(format!("dimension must be 2 or 3, got {D}"));
         }
@@ -287,11 +297,28 @@ impl<const D: usize> Model<D> {
         }
         let length_scale = (hi - lo).norm().max(f64::MIN_POSITIVE);
 
+        let scene = Scene {
+            dofs: &dofs,
+            bodies: &bodies,
+            elements: &elements,
+            connectivity: &part.mesh.elements,
+            density: part.density,
+            nodes: n_nodes,
+        };
+        let mut dead_loads = Vec::with_capacity(concentrated.len() + gravity.len());
+        for (i, load) in concentrated.iter().enumerate() {
+            dead_loads.push(load.dead(&scene, i)?);
+        }
+        for (i, load) in gravity.iter().enumerate() {
+            dead_loads.push(load.dead(&scene, i)?);
+        }
+
         Ok(Self {
             part,
             bodies,
             ties,
             pressures,
+            dead_loads,
             contacts,
             elements,
             dofs,
@@ -317,6 +344,10 @@ impl<const D: usize> Model<D> {
     /// Pressure loads.
     pub fn pressures(&self) -> &[PressureLoad] {
         &self.pressures
+    }
+    /// Concentrated and gravity loads, as nodal forces per equation at factor 1.
+    pub fn dead_loads(&self) -> &[DeadLoad] {
+        &self.dead_loads
     }
     /// Contact pairs.
     pub fn contacts(&self) -> &[ContactPair] {

@@ -2,7 +2,8 @@
 //!
 //! A run is a sequence of steps. A static step ramps the loads linearly from their current
 //! factor to 1 over its increments (pseudo-time, no physical time elapses); a dynamic step
-//! advances time with HHT-alpha at full load. A failed increment (Newton, conic solve, inverted
+//! advances time with HHT-alpha at full load. Loads with an amplitude follow it in the step
+//! time instead (see [`crate::loads`]), and are taken again at each step's start. A failed increment (Newton, conic solve, inverted
 //! element, ...) is retried with its size multiplied by the cutback factor; after a few
 //! successes the size grows back to nominal. When the cutbacks are exhausted the run stops with
 //! an error saying where and why; every increment converged before that has already been
@@ -36,6 +37,7 @@ use crate::increment::{
     ContactSolve, IncrementCounters, IncrementKind, NewtonSettings, SolveCounts, Timings,
     Workspace, solve_increment,
 };
+use crate::loads::LoadInstant;
 use crate::model::Model;
 use crate::state::{ContactPointState, EnergyLedger, State};
 
@@ -590,7 +592,14 @@ pub fn initial_state<const D: usize>(
             tangential_force: nalgebra::Vector2::zeros(),
         })
         .collect::<Vec<_>>();
-    let f_ext = external_forces(model, &x, load_factor)?;
+    let f_ext = external_forces(
+        model,
+        &x,
+        LoadInstant {
+            ramp: load_factor,
+            step_time: 0.0,
+        },
+    )?;
     let energy = EnergyLedger {
         kinetic: 0.5 * v.component_mul(&v).dot(model.mass()),
         ..EnergyLedger::default()
@@ -608,6 +617,32 @@ pub fn initial_state<const D: usize>(
         contacts,
         energy,
     })
+}
+
+/// The loads at the start of `step` (step time 0, the ramp where the last step left it, 1 in a
+/// dynamic step): an amplitude that restarts with the step may change them from the end of the
+/// last step. The state's external force and `f_int - f_ext` take the new loads, so that the
+/// step's first increment starts from them (its work by the trapezoidal rule, the HHT history
+/// term); a load that does not change leaves the state untouched.
+fn start_loads<const D: usize>(
+    model: &Model<D>,
+    step: &Step,
+    state: &mut State,
+) -> Result<(), IncrementFailure> {
+    let ramp = match step.kind {
+        StepKind::Static { .. } => state.load_factor,
+        StepKind::Dynamic { .. } => 1.0,
+    };
+    let instant = LoadInstant {
+        ramp,
+        step_time: 0.0,
+    };
+    let f_ext = external_forces(model, &state.x, instant)?;
+    if f_ext != state.external_force {
+        state.net_force += &state.external_force - &f_ext;
+        state.external_force = f_ext;
+    }
+    Ok(())
 }
 
 /// Smooth acceleration at the start of a dynamic step, `a = -M^{-1} (f_int - f_ext)`: the
@@ -883,8 +918,18 @@ impl<const D: usize> Run<'_, D> {
                 ..
             } => (dt / duration, duration, adaptive),
         };
-        if position.is_none() && matches!(step.kind, StepKind::Dynamic { .. }) {
-            state.a = consistent_acceleration(model, &state, &held);
+        if position.is_none() {
+            start_loads(model, step, &mut state).map_err(|cause| RunError::StepFailed {
+                step: step.name.clone(),
+                increment: 0,
+                time: state.time,
+                size: 0.0,
+                cutbacks: 0,
+                cause,
+            })?;
+            if matches!(step.kind, StepKind::Dynamic { .. }) {
+                state.a = consistent_acceleration(model, &state, &held);
+            }
         }
         // With adaptive increments the size may shrink to `min_dt`.
         let smallest =
@@ -918,10 +963,12 @@ impl<const D: usize> Run<'_, D> {
                 } => IncrementKind::Static {
                     load_factor: lambda0 + (1.0 - lambda0) * (progress + dp),
                     regularization: 1.0 / (regularization_time * regularization_time),
+                    step_time: progress + dp,
                 },
                 StepKind::Dynamic { alpha, .. } => IncrementKind::Dynamic {
                     hht: Hht::new(alpha).map_err(RunError::Invalid)?,
                     h: dp * span,
+                    step_time: (progress + dp) * span,
                 },
             };
             let before = workspace.counts();
@@ -938,7 +985,9 @@ impl<const D: usize> Run<'_, D> {
             match solved {
                 Ok((mut next, counters)) => {
                     let mut next_size = None;
-                    if let (Some(run), IncrementKind::Dynamic { hht, h }) = (&mut adaptive, kind) {
+                    if let (Some(run), IncrementKind::Dynamic { hht, h, .. }) =
+                        (&mut adaptive, kind)
+                    {
                         match run.judge(model, &hht, h, &state, &next, &held) {
                             Verdict::Retry(h) => {
                                 stats.error_rejections += 1;

@@ -7,6 +7,7 @@ use skid_fem::rigid::RigidBody;
 
 use skid_contact::surface::AnalyticCylinder;
 
+use crate::loads::Loads;
 use crate::model::{ContactPair, Model, SolidPart};
 
 /// A structured block of the benchmark pad material (first D entries of each array are used).
@@ -66,5 +67,5 @@ pub(crate) fn block_on_drum<const D: usize>() -> Model<D> {
         surface: Box::new(AnalyticCylinder::new(0.2, Vector3::z()).expect("surface")),
         mu: 0.15,
     };
-    Model::new(part, vec![drum], vec![], vec![], vec![pair]).expect("model")
+    Model::new(part, vec![drum], vec![], Loads::default(), vec![pair]).expect("model")
 }

@@ -58,12 +58,15 @@ fn block(side_force: f64) -> (Model<2>, f64) {
             PressureLoad {
                 faces: top_faces,
                 pressure: P_TOP,
+                amplitude: None,
             },
             PressureLoad {
                 faces: left_faces,
                 pressure: side_force / (HEIGHT * THICKNESS),
+                amplitude: None,
             },
-        ],
+        ]
+        .into(),
         vec![ContactPair {
             name: "block-ground".into(),
             nodes: bottom,

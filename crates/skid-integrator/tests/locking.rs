@@ -65,7 +65,9 @@ fn tip_deflection(k_over_mu: f64) -> f64 {
         vec![PressureLoad {
             faces: top,
             pressure: PRESSURE,
-        }],
+            amplitude: None,
+        }]
+        .into(),
         vec![],
     )
     .expect("model");

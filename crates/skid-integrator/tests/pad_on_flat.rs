@@ -58,7 +58,9 @@ fn pad(pressure: f64, d1: f64) -> Model<2> {
         vec![PressureLoad {
             faces: back_faces,
             pressure,
-        }],
+            amplitude: None,
+        }]
+        .into(),
         vec![ContactPair {
             name: "pad-ground".into(),
             nodes: front,

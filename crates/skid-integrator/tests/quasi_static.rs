@@ -70,7 +70,9 @@ fn scene(quasi_static: bool, plate_mass: f64) -> Result<Model<2>, skid_integrato
         vec![PressureLoad {
             faces: top_faces,
             pressure: P_TOP,
-        }],
+            amplitude: None,
+        }]
+        .into(),
         vec![ContactPair {
             name: "block-ground".into(),
             nodes: bottom,

@@ -13,8 +13,8 @@ use super::fields::key;
 use super::keywords::{DeckError, Location};
 use super::mesh::ElementKind;
 use super::read::{
-    BoundaryDef, Change, Definitions, FaceLabel, InitialDef, PressureDef, Procedure, RigidDef,
-    SectionKind, StepDef, SurfaceDef,
+    BoundaryDef, Change, Definitions, FaceLabel, InitialDef, Procedure, RigidDef, SectionKind,
+    StepDef, SurfaceDef,
 };
 use super::rigid::{prism, triangles};
 use crate::model_file::spec::{
@@ -26,6 +26,7 @@ use crate::schema::{OutputSpec, SolverSpec, default_regularization_time};
 
 mod bodies;
 mod conditions;
+mod loads;
 mod part;
 
 use bodies::*;
@@ -216,7 +217,11 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
         })
         .collect::<Result<Vec<_>, DeckError>>()?;
     check_held_ties(defs, &part, &bodies)?;
-    let (steps, loads) = steps(defs, &part, &bodies, &mut part_spec, deck)?;
+    let StepsAndLoads {
+        steps,
+        loads,
+        amplitudes,
+    } = steps(defs, &part, &bodies, &mut part_spec, deck)?;
     Ok(ModelSpec {
         skid_model: MODEL_FORMAT_VERSION,
         name: name.to_string(),
@@ -227,6 +232,7 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
         boundary: spec_boundary,
         ties,
         loads,
+        amplitudes,
         contact,
         steps,
         solver: SolverSpec::default(),

@@ -8,6 +8,7 @@ use super::fields::{
     allow_parameters, at_most, field, flag, key, label, line_error, real, real_or, required, valued,
 };
 use super::keywords::{Block, DeckError, Location};
+use super::loads::{AmplitudeDef, LoadChange, read_amplitude, read_load_block};
 use super::mesh::Mesh;
 use super::rigid::{AnalyticalKind, AnalyticalSurface, read_analytical};
 use crate::schema::MaterialSpec;
@@ -141,19 +142,6 @@ pub enum InitialDef {
     },
 }
 
-/// A distributed pressure: on a surface (`*DSLOAD`) or on face `k` of elements (`*DLOAD`).
-#[derive(Clone, Debug)]
-pub struct PressureDef {
-    /// Surface name (`*DSLOAD`) or element label or set (`*DLOAD`).
-    pub target: String,
-    /// Face of `*DLOAD, Pk` (`None` for a surface).
-    pub face: Option<usize>,
-    /// Pressure.
-    pub magnitude: f64,
-    /// Where.
-    pub location: Location,
-}
-
 /// Step procedures.
 #[derive(Clone, Debug)]
 pub enum Procedure {
@@ -196,7 +184,7 @@ pub struct StepDef {
     /// Boundary-condition changes in order.
     pub boundary: Vec<Change<BoundaryDef>>,
     /// Load changes in order.
-    pub loads: Vec<Change<PressureDef>>,
+    pub loads: Vec<LoadChange>,
     /// `NLGEOM` as given (`None`: absent).
     pub nlgeom: Option<bool>,
 }
@@ -242,7 +230,7 @@ pub struct Definitions {
     /// Initial conditions.
     pub initial: Vec<InitialDef>,
     /// Amplitudes by key.
-    pub amplitudes: HashMap<String, Location>,
+    pub amplitudes: HashMap<String, Named<AmplitudeDef>>,
     /// Steps in order.
     pub steps: Vec<StepDef>,
     /// What skid reads differently from the deck's request, one line each with its location.
@@ -422,13 +410,9 @@ fn read_model_block(
         }
         "INITIAL CONDITIONS" => read_initial(defs, block)?,
         "AMPLITUDE" => {
-            allow_parameters(block, &["NAME", "DEFINITION", "TIME"])?;
-            let name = required(block, "NAME")?;
-            if defs
-                .amplitudes
-                .insert(key(name), block.location.clone())
-                .is_some()
-            {
+            let amplitude = read_amplitude(block)?;
+            let name = amplitude.name.clone();
+            if defs.amplitudes.insert(key(&name), amplitude).is_some() {
                 return Err(block.error(format!("amplitude {name} is defined twice")));
             }
         }
@@ -930,8 +914,9 @@ fn start_step(defs: &Definitions, block: &Block) -> Result<StepDef, DeckError> {
     allow_parameters(block, &["NAME", "NLGEOM", "INC", "AMPLITUDE"])?;
     if let Some(amplitude) = valued(block, "AMPLITUDE")? {
         return Err(block.error(format!(
-            "AMPLITUDE={amplitude}: skid ramps loads over the first static step and holds them \
-             after; remove the parameter"
+            "AMPLITUDE={amplitude}: skid ramps the loads without amplitude over the first step if \
+             it is static and holds them after; remove the parameter, or give the loads an \
+             AMPLITUDE"
         )));
     }
     if let Some(inc) = valued(block, "INC")?
@@ -1015,51 +1000,9 @@ fn read_step_block(
                 items: read_boundary(block)?,
             });
         }
-        "DSLOAD" | "DLOAD" => {
-            allow_parameters(block, &["OP"])?;
-            let mut items = Vec::new();
-            for line in &block.data {
-                at_most(block, line, 3)?;
-                let target =
-                    field(line, 0).ok_or_else(|| line_error(block, line, "field 1 is missing"))?;
-                let load = field(line, 1).unwrap_or_default().to_ascii_uppercase();
-                let face = if block.name == "DSLOAD" {
-                    if load != "P" {
-                        return Err(line_error(
-                            block,
-                            line,
-                            format!("load type '{load}': only P (pressure) is read"),
-                        ));
-                    }
-                    None
-                } else {
-                    Some(
-                        load.strip_prefix('P')
-                            .and_then(|k| k.parse::<usize>().ok())
-                            .filter(|k| (1..=6).contains(k))
-                            .ok_or_else(|| {
-                                line_error(
-                                    block,
-                                    line,
-                                    format!("load type '{load}': expected P1..P6 (face pressure)"),
-                                )
-                            })?,
-                    )
-                };
-                items.push(PressureDef {
-                    target: target.to_string(),
-                    face,
-                    magnitude: real(block, line, 2, "magnitude")?,
-                    location: line.location.clone(),
-                });
-            }
-            step.loads.push(Change {
-                replace: op_new(block)?,
-                items,
-            });
-        }
-        "CLOAD" => {
-            return Err(block.error("concentrated loads are not supported yet"));
+        "CLOAD" | "DLOAD" | "DSLOAD" => {
+            let change = read_load_block(defs, block, op_new(block)?)?;
+            step.loads.push(change);
         }
         "OUTPUT" => {
             allow_parameters(

@@ -102,6 +102,10 @@ pub fn write_deck(
         let _ = writeln!(out, "*NSET, NSET={name}");
         label_lines(&mut out, nodes.iter().map(|n| n + 1));
     }
+    for (name, elements) in &part.element_sets {
+        let _ = writeln!(out, "*ELSET, ELSET={name}");
+        label_lines(&mut out, elements.iter().map(|e| e + 1));
+    }
     let solid = if dim == 2 {
         ElementKind::Cpe4r
     } else {
@@ -247,6 +251,17 @@ pub fn write_deck(
         initial_conditions(&mut out, body, dim);
     }
 
+    for amplitude in &spec.amplitudes {
+        let _ = writeln!(out, "**\n*AMPLITUDE, NAME={}", amplitude.name);
+        for chunk in amplitude.points.chunks(4) {
+            let _ = writeln!(
+                out,
+                "{}",
+                list(chunk.iter().flat_map(|[t, a]| [num(*t), num(*a)]))
+            );
+        }
+    }
+
     // steps
     for (i, step) in spec.steps.iter().enumerate() {
         let (name, boundary) = match step {
@@ -312,16 +327,77 @@ pub fn write_deck(
                 let _ = writeln!(out, "{}, {k}, {k}", hold.body);
             }
         }
-        if i == 0 && !spec.loads.is_empty() {
-            let _ = writeln!(out, "*DSLOAD");
-            for load in &spec.loads {
-                let LoadSpec::Pressure { surface, pressure } = load;
-                let _ = writeln!(out, "{surface}, P, {}", num(*pressure));
-            }
+        if i == 0 {
+            write_loads(&mut out, spec)?;
         }
         let _ = writeln!(out, "*END STEP");
     }
     Ok(out)
+}
+
+/// The loads, one keyword block each (its amplitude is a parameter of the keyword):
+/// `*DSLOAD` pressures, `*CLOAD` components on a node set or a body's reference node (its
+/// node set has the body's name), `*DLOAD, GRAV` with the acceleration as the direction and
+/// its norm as the magnitude, which reads back to the same bits.
+fn write_loads(out: &mut String, spec: &ModelSpec) -> Result<(), String> {
+    for (k, load) in spec.loads.iter().enumerate() {
+        let keyword = match load {
+            LoadSpec::Pressure { .. } => "DSLOAD",
+            LoadSpec::Concentrated { .. } => "CLOAD",
+            LoadSpec::Gravity { .. } => "DLOAD",
+        };
+        let amplitude = load
+            .amplitude()
+            .map_or_else(String::new, |a| format!(", AMPLITUDE={a}"));
+        let _ = writeln!(out, "*{keyword}{amplitude}");
+        match load {
+            LoadSpec::Pressure {
+                surface, pressure, ..
+            } => {
+                let _ = writeln!(out, "{surface}, P, {}", num(*pressure));
+            }
+            LoadSpec::Concentrated {
+                node_set,
+                body,
+                force,
+                moment,
+                ..
+            } => {
+                let target = node_set.as_deref().or(body.as_deref()).ok_or(format!(
+                    "loads[{k}]: a concentrated load needs a node set or a body"
+                ))?;
+                let components = force.iter().flatten().copied().enumerate().chain(
+                    moment
+                        .iter()
+                        .flatten()
+                        .copied()
+                        .enumerate()
+                        .filter(|&(axis, _)| spec.dimension == 3 || axis == 2)
+                        .map(|(axis, m)| (axis + 3, m)),
+                );
+                for (index, value) in components {
+                    let _ = writeln!(out, "{target}, {}, {}", index + 1, num(value));
+                }
+            }
+            LoadSpec::Gravity {
+                acceleration,
+                element_set,
+                ..
+            } => {
+                let mut g = acceleration.clone();
+                g.resize(3, 0.0);
+                let norm = g.iter().map(|c| c * c).sum::<f64>().sqrt();
+                let _ = writeln!(
+                    out,
+                    "{}, GRAV, {}, {}",
+                    element_set.as_deref().unwrap_or_default(),
+                    num(norm),
+                    list(g.iter().map(|c| num(*c)))
+                );
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A point of 2 or 3 coordinates in 3D (z = 0 in 2D).

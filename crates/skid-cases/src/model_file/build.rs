@@ -16,11 +16,13 @@ use skid_integrator::increment::{ContactSolve, NewtonSettings};
 use skid_integrator::stepper::{
     Adaptive, BodyMotion, CutbackSettings, HeldMotion, Settings, Step, StepKind,
 };
-use skid_integrator::{ContactPair, Model, PressureLoad, SolidPart, Tie};
+use skid_integrator::{ContactPair, Model, SolidPart, Tie};
+
+mod loads;
 
 use super::spec::{
-    BoundarySpec, Dof, LoadSpec, MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, RigidSurfaceSpec,
-    SlaveSpec, StepBoundarySpec,
+    BoundarySpec, Dof, MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, RigidSurfaceSpec, SlaveSpec,
+    StepBoundarySpec,
 };
 use crate::schema::{AdaptiveSpec, ContactSolveSpec, CoulombMethodSpec, MaterialSpec, SolverSpec};
 
@@ -108,6 +110,7 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         );
     }
     let mesh = part_mesh::<D>(spec)?;
+    loads::check_element_sets(spec, mesh.elements.len())?;
     let section = &spec.part.section;
     let material = match section.material {
         MaterialSpec::PolynomialN1 { c10, c01, d1 } => {
@@ -202,30 +205,6 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         })
         .collect::<Result<Vec<_>, SpecError>>()?;
 
-    let pressures = spec
-        .loads
-        .iter()
-        .enumerate()
-        .map(|(i, load)| match load {
-            LoadSpec::Pressure { surface, pressure } => {
-                if !pressure.is_finite() {
-                    return fail(
-                        format!("loads[{i}].pressure"),
-                        format!("expected a finite value, got {pressure}"),
-                    );
-                }
-                let faces = mesh.surfaces.get(surface).ok_or_else(|| SpecError {
-                    field: format!("loads[{i}].surface"),
-                    message: format!("no surface named '{surface}' in part '{}'", spec.part.name),
-                })?;
-                Ok(PressureLoad {
-                    faces: faces.clone(),
-                    pressure: *pressure,
-                })
-            }
-        })
-        .collect::<Result<Vec<_>, SpecError>>()?;
-
     let mut pair_names = BTreeSet::new();
     let mut contacts = Vec::with_capacity(spec.contact.len());
     for (i, pair) in spec.contact.iter().enumerate() {
@@ -262,6 +241,7 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         });
     }
 
+    let loads = loads::loads::<D>(spec, &mesh, &bodies, &body_of)?;
     let steps = spec
         .steps
         .iter()
@@ -284,7 +264,7 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         quasi_static: section.quasi_static,
         fixed: fixed_nodes,
     };
-    let model = Model::new(part, bodies, ties, pressures, contacts).map_err(|e| SpecError {
+    let model = Model::new(part, bodies, ties, loads, contacts).map_err(|e| SpecError {
         field: "(model)".into(),
         message: e.to_string(),
     })?;

@@ -1,8 +1,8 @@
 //! The history of any model: one CSV row per converged increment with every rigid body's free
 //! motions, every contact pair's resultants and the energy ledger.
 //!
-//! Columns, in order: `time`, `step`, `increment`, `load_factor`, `dt`, `newton_iterations`,
-//! `contact_solves`; for each rigid body `B` (model order) `B.u_x`, `B.v_x` (displacement and
+//! Columns, in order: `time`, `step`, `increment`, `load_factor` (the ramp of the loads without
+//! amplitude), `dt`, `newton_iterations`, `contact_solves`; for each rigid body `B` (model order) `B.u_x`, `B.v_x` (displacement and
 //! velocity of the reference node, likewise `y`, `z`) for each free translation and `B.angle`,
 //! `B.omega` if it rotates; for each contact pair `P`:
 //! `P.normal_force` (sum of the normal forces, N), `P.tangential_force_1` (and `_2` in 3D: sums

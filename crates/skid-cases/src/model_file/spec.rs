@@ -42,10 +42,17 @@ pub struct ModelSpec {
     /// Node sets tied to rigid bodies.
     #[serde(default)]
     pub ties: Vec<TieSpec>,
-    /// Loads, ramped from 0 to full value over the first static step (full value in dynamic
-    /// steps).
+    /// Loads; each acts in every step. A load with an `amplitude` is that amplitude's value
+    /// at the step time times its full value: the time since the step began in a dynamic step,
+    /// and in a static step (which takes no physical time) the completed fraction of the step,
+    /// 0 to 1 (a static step's time period is 1). A load without amplitude is ramped from 0 to
+    /// full value over the first step if it is static and held at full value after (from the
+    /// start if the first step is dynamic).
     #[serde(default)]
     pub loads: Vec<LoadSpec>,
+    /// Named amplitudes: piecewise-linear factors of the step time that loads may name.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub amplitudes: Vec<AmplitudeSpec>,
     /// Contact pairs: nodes of the part against the surface of a rigid body.
     #[serde(default)]
     pub contact: Vec<ContactPairSpec>,
@@ -77,6 +84,9 @@ pub struct PartSpec {
     /// clockwise; 3D: counter-clockwise seen from outside).
     #[serde(default)]
     pub surfaces: BTreeMap<String, Vec<Vec<usize>>>,
+    /// Named element sets (element numbers, counted across blocks), for gravity.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub element_sets: BTreeMap<String, Vec<usize>>,
     /// Material and section of every element.
     pub section: SectionSpec,
 }
@@ -292,7 +302,8 @@ pub struct TieSpec {
     pub body: String,
 }
 
-/// Loads.
+/// Loads; `amplitude` names an entry of `amplitudes` (absent: the default ramp, see
+/// `ModelSpec::loads`).
 #[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum LoadSpec {
@@ -302,7 +313,67 @@ pub enum LoadSpec {
         surface: String,
         /// Pressure, Pa.
         pressure: f64,
+        /// Amplitude name.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        amplitude: Option<String>,
     },
+    /// A force fixed in direction and size on every node of a node set (each node receives
+    /// the whole force), or a force and a moment on a rigid body's reference node.
+    Concentrated {
+        /// Node set of the part loaded (exactly one of `node_set` and `body`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        node_set: Option<String>,
+        /// Rigid body whose reference node is loaded.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        body: Option<String>,
+        /// Force, `dimension` components, N (absent: none).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        force: Option<Vec<f64>>,
+        /// Moment on a rigid body `[mx, my, mz]`, N m (absent: none); it must lie along the
+        /// body's free rotation axis.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        moment: Option<[f64; 3]>,
+        /// Amplitude name.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        amplitude: Option<String>,
+    },
+    /// A uniform body-force acceleration: the force `m g` on every lumped node mass of the
+    /// loaded elements (`rho V / 2^D` per element corner, `V` counting the thickness in 2D),
+    /// and on every rigid body's point mass when no element set is named.
+    Gravity {
+        /// Acceleration `g`, `dimension` components, m/s^2.
+        acceleration: Vec<f64>,
+        /// Element set of the part loaded (absent: the whole model, part and rigid bodies).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        element_set: Option<String>,
+        /// Amplitude name.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        amplitude: Option<String>,
+    },
+}
+
+impl LoadSpec {
+    /// The amplitude the load names, if any.
+    pub fn amplitude(&self) -> Option<&str> {
+        match self {
+            Self::Pressure { amplitude, .. }
+            | Self::Concentrated { amplitude, .. }
+            | Self::Gravity { amplitude, .. } => amplitude.as_deref(),
+        }
+    }
+}
+
+/// A named amplitude: the factor `a(t)` of the loads that name it, linear between the points
+/// `(t_k, a_k)` (times >= 0, strictly increasing, in the step time), `a_0` before the first
+/// point and the last value after the last.
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AmplitudeSpec {
+    /// Name (loads refer to it).
+    pub name: String,
+    /// Points `[time, factor]`: step time (s in a dynamic step, the completed fraction of a
+    /// static step) and factor.
+    pub points: Vec<[f64; 2]>,
 }
 
 /// Frictional contact between nodes of the part and a rigid body's surface.

@@ -1,7 +1,9 @@
-//! Boundary conditions of a deck (model data on bodies and part nodes, changes per step), its
-//! loads and its steps.
+//! Boundary conditions of a deck (model data on bodies and part nodes, changes per step) and
+//! its steps with their loads.
 
+use super::loads::{InForce, apply_loads, model_loads};
 use super::*;
+use crate::model_file::spec::AmplitudeSpec;
 
 pub(super) fn apply_model_boundary(
     defs: &Definitions,
@@ -105,22 +107,29 @@ pub(super) fn check_held_ties(
     Ok(())
 }
 
+/// A deck's steps and the model's loads with the amplitudes they name.
+pub(super) struct StepsAndLoads {
+    pub steps: Vec<ModelStepSpec>,
+    pub loads: Vec<LoadSpec>,
+    pub amplitudes: Vec<AmplitudeSpec>,
+}
+
 /// Steps and the loads they apply: boundary conditions with `OP=MOD` accumulate and `OP=NEW`
 /// replaces those of earlier steps (model-data conditions hold throughout); the loads of the
-/// first step are the model's, and later steps must keep them.
+/// first step are the model's (with the amplitudes they name), and later steps must keep them.
 pub(super) fn steps(
     defs: &Definitions,
     part: &Part,
     bodies: &[Body],
     part_spec: &mut PartSpec,
     deck: &Location,
-) -> Result<(Vec<ModelStepSpec>, Vec<LoadSpec>), DeckError> {
+) -> Result<StepsAndLoads, DeckError> {
     let dim = part.dimension;
     if defs.steps.is_empty() {
         return Err(error(deck, "the deck has no *STEP"));
     }
     let mut held: BTreeMap<usize, BTreeSet<usize>> = BTreeMap::new();
-    let mut loads_in_force: Vec<(String, f64)> = Vec::new();
+    let mut loads_in_force: Vec<InForce> = Vec::new();
     let mut first_loads = None;
     let mut out = Vec::new();
     for (i, step) in defs.steps.iter().enumerate() {
@@ -134,7 +143,7 @@ pub(super) fn steps(
             apply_step_boundary(defs, part, bodies, change, &mut held)?;
         }
         for change in &step.loads {
-            apply_loads(defs, part, part_spec, change, &mut loads_in_force)?;
+            apply_loads(defs, part, bodies, part_spec, change, &mut loads_in_force)?;
         }
         match &first_loads {
             None => first_loads = Some(loads_in_force.clone()),
@@ -174,12 +183,12 @@ pub(super) fn steps(
             .collect::<Result<Vec<_>, DeckError>>()?;
         out.push(step_spec(step, boundary)?);
     }
-    let loads = first_loads
-        .unwrap_or_default()
-        .into_iter()
-        .map(|(surface, pressure)| LoadSpec::Pressure { surface, pressure })
-        .collect();
-    Ok((out, loads))
+    let (loads, amplitudes) = model_loads(defs, part, bodies, &first_loads.unwrap_or_default());
+    Ok(StepsAndLoads {
+        steps: out,
+        loads,
+        amplitudes,
+    })
 }
 
 pub(super) fn apply_step_boundary(
@@ -208,73 +217,6 @@ pub(super) fn apply_step_boundary(
                 dof_of(part.dimension, k, &bc.location)?;
                 held.entry(b).or_default().insert(k);
             }
-        }
-    }
-    Ok(())
-}
-
-pub(super) fn apply_loads(
-    defs: &Definitions,
-    part: &Part,
-    part_spec: &mut PartSpec,
-    change: &Change<PressureDef>,
-    in_force: &mut Vec<(String, f64)>,
-) -> Result<(), DeckError> {
-    if change.replace {
-        in_force.clear();
-    }
-    for load in &change.items {
-        let surface = match load.face {
-            None => {
-                let surface = defs.surfaces.get(&key(&load.target)).ok_or_else(|| {
-                    error(
-                        &load.location,
-                        format!("*DSLOAD: no surface named {}", load.target),
-                    )
-                })?;
-                if !part_spec.surfaces.contains_key(&surface.name) {
-                    return Err(error(
-                        &load.location,
-                        format!(
-                            "*DSLOAD: {} is not a surface of element faces of the deformable part",
-                            surface.name
-                        ),
-                    ));
-                }
-                surface.name.clone()
-            }
-            Some(k) => {
-                let elements = defs.mesh.elements_named(&load.target).ok_or_else(|| {
-                    error(
-                        &load.location,
-                        format!(
-                            "*DLOAD: '{}' is neither an element nor an element set",
-                            load.target
-                        ),
-                    )
-                })?;
-                if elements
-                    .iter()
-                    .any(|e| !defs.mesh.elements[e].kind.is_solid())
-                {
-                    return Err(error(
-                        &load.location,
-                        "*DLOAD: pressures act on the deformable part's elements only",
-                    ));
-                }
-                let faces: Vec<(u64, FaceLabel)> = elements
-                    .into_iter()
-                    .map(|e| (e, FaceLabel::Numbered(k)))
-                    .collect();
-                let name = format!("{}-P{k}", load.target);
-                let corners = solid_faces(defs, part, &faces, &load.location)?;
-                part_spec.surfaces.insert(name.clone(), corners);
-                name
-            }
-        };
-        match in_force.iter_mut().find(|(s, _)| *s == surface) {
-            Some(existing) => existing.1 = load.magnitude,
-            None => in_force.push((surface, load.magnitude)),
         }
     }
     Ok(())

@@ -1,0 +1,216 @@
+//! The loads of a model file: amplitudes resolved by name, element sets, and every load's
+//! values checked against the part and the rigid bodies it acts on.
+
+use std::collections::BTreeMap;
+
+use nalgebra::{SVector, Vector3};
+use skid_fem::mesh::SolidMesh;
+use skid_fem::rigid::RigidBody;
+use skid_integrator::{Amplitude, ConcentratedLoad, GravityLoad, LoadTarget, Loads, PressureLoad};
+
+use super::{SpecError, fail, finite_point, vector3};
+use crate::model_file::spec::{AmplitudeSpec, Dof, LoadSpec, ModelSpec};
+
+/// The amplitudes by name, each checked: a unique non-empty name, at least one point, finite
+/// times >= 0 that increase strictly, finite factors.
+fn amplitudes(specs: &[AmplitudeSpec]) -> Result<BTreeMap<&str, Amplitude>, SpecError> {
+    let mut named = BTreeMap::new();
+    for (i, a) in specs.iter().enumerate() {
+        let f = |name: &str| format!("amplitudes[{i}].{name}");
+        if a.name.is_empty() || named.contains_key(a.name.as_str()) {
+            return fail(
+                f("name"),
+                format!("expected a unique non-empty name, got '{}'", a.name),
+            );
+        }
+        if let Some(k) = a.points.iter().position(|&[t, _]| t < 0.0) {
+            return fail(
+                format!("{}[{k}]", f("points")),
+                format!(
+                    "expected a step time >= 0, got {} (step time starts at 0)",
+                    a.points[k][0]
+                ),
+            );
+        }
+        let points = a.points.iter().map(|&[t, v]| (t, v)).collect();
+        let amplitude = Amplitude::new(points).map_err(|e| SpecError {
+            field: match e.point {
+                Some(k) => format!("{}[{k}]", f("points")),
+                None => f("points"),
+            },
+            message: e.message,
+        })?;
+        named.insert(a.name.as_str(), amplitude);
+    }
+    Ok(named)
+}
+
+/// Checks that every element of every element set exists (`elements` of them).
+pub(super) fn check_element_sets(spec: &ModelSpec, elements: usize) -> Result<(), SpecError> {
+    for (name, set) in &spec.part.element_sets {
+        if let Some(e) = set.iter().find(|&&e| e >= elements) {
+            return fail(
+                format!("part.element_sets.{name}"),
+                format!("element {e} does not exist ({elements} elements)"),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// A moment on `body`, which must lie along the body's free rotation axis (in 2D: z).
+fn body_moment<const D: usize>(
+    field: &str,
+    moment: [f64; 3],
+    body: &RigidBody<D>,
+) -> Result<Vector3<f64>, SpecError> {
+    let m = vector3(field, moment)?;
+    for (axis, dof) in [Dof::Rx, Dof::Ry, Dof::Rz].into_iter().enumerate() {
+        if m[axis] == 0.0 {
+            continue;
+        }
+        if !Dof::all(D).contains(&dof) {
+            return fail(
+                field,
+                format!("{dof:?} is not a degree of freedom in {D}D: expected 0 there"),
+            );
+        }
+        if body.rotation_axis.is_none_or(|e| e[axis] != 1.0) {
+            return fail(
+                field,
+                format!(
+                    "rigid body '{}' does not rotate about {dof:?} (a boundary condition fixes \
+                     it): expected 0 there",
+                    body.name
+                ),
+            );
+        }
+    }
+    Ok(m)
+}
+
+/// Every load of `spec`, resolved and checked, with the amplitudes they name.
+///
+/// # Errors
+/// The first problem, with its field path.
+pub(super) fn loads<const D: usize>(
+    spec: &ModelSpec,
+    mesh: &SolidMesh<D>,
+    bodies: &[RigidBody<D>],
+    body_of: &impl Fn(&str, &str) -> Result<usize, SpecError>,
+) -> Result<Loads<D>, SpecError> {
+    let named = amplitudes(&spec.amplitudes)?;
+    let mut loads = Loads::default();
+    for (i, load) in spec.loads.iter().enumerate() {
+        let f = |name: &str| format!("loads[{i}].{name}");
+        let amplitude = load
+            .amplitude()
+            .map(|name| {
+                named.get(name).cloned().ok_or_else(|| SpecError {
+                    field: f("amplitude"),
+                    message: format!("no amplitude named '{name}'"),
+                })
+            })
+            .transpose()?;
+        match load {
+            LoadSpec::Pressure {
+                surface, pressure, ..
+            } => {
+                if !pressure.is_finite() {
+                    return fail(
+                        f("pressure"),
+                        format!("expected a finite value, got {pressure}"),
+                    );
+                }
+                let faces = mesh.surfaces.get(surface).ok_or_else(|| SpecError {
+                    field: f("surface"),
+                    message: format!("no surface named '{surface}' in part '{}'", spec.part.name),
+                })?;
+                loads.pressures.push(PressureLoad {
+                    faces: faces.clone(),
+                    pressure: *pressure,
+                    amplitude,
+                });
+            }
+            LoadSpec::Concentrated {
+                node_set,
+                body,
+                force,
+                moment,
+                ..
+            } => {
+                if force.is_none() && moment.is_none() {
+                    return fail(format!("loads[{i}]"), "expected a force, a moment or both");
+                }
+                let force = match force {
+                    Some(v) => finite_point::<D>(&f("force"), v)?,
+                    None => SVector::zeros(),
+                };
+                let (target, moment) = match (node_set, body) {
+                    (Some(set), None) => {
+                        if moment.is_some() {
+                            return fail(f("moment"), "nodes of a solid part take no moment");
+                        }
+                        let nodes = mesh.node_sets.get(set).ok_or_else(|| SpecError {
+                            field: f("node_set"),
+                            message: format!(
+                                "no node set named '{set}' in part '{}'",
+                                spec.part.name
+                            ),
+                        })?;
+                        (LoadTarget::Nodes(nodes.clone()), Vector3::zeros())
+                    }
+                    (None, Some(name)) => {
+                        let b = body_of(&f("body"), name)?;
+                        let moment = match moment {
+                            Some(m) => body_moment(&f("moment"), *m, &bodies[b])?,
+                            None => Vector3::zeros(),
+                        };
+                        (LoadTarget::Body(b), moment)
+                    }
+                    _ => {
+                        return fail(
+                            format!("loads[{i}]"),
+                            "expected exactly one of node_set and body",
+                        );
+                    }
+                };
+                loads.concentrated.push(ConcentratedLoad {
+                    target,
+                    force,
+                    moment,
+                    amplitude,
+                });
+            }
+            LoadSpec::Gravity {
+                acceleration,
+                element_set,
+                ..
+            } => {
+                let acceleration = finite_point::<D>(&f("acceleration"), acceleration)?;
+                let elements = element_set
+                    .as_ref()
+                    .map(|name| {
+                        spec.part
+                            .element_sets
+                            .get(name)
+                            .cloned()
+                            .ok_or_else(|| SpecError {
+                                field: f("element_set"),
+                                message: format!(
+                                    "no element set named '{name}' in part '{}'",
+                                    spec.part.name
+                                ),
+                            })
+                    })
+                    .transpose()?;
+                loads.gravity.push(GravityLoad {
+                    acceleration,
+                    elements,
+                    amplitude,
+                });
+            }
+        }
+    }
+    Ok(loads)
+}
