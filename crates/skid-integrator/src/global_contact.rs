@@ -168,16 +168,21 @@ impl Factors {
 
 /// GMRES on `matrix z = rhs` with the preconditioner `m_inv` and at most `max_iterations`;
 /// `Some((z, iterations))` only if the true residual `||rhs - matrix z||` is below
-/// `tolerance ||rhs||` (GMRES's own estimate is not trusted alone).
+/// `tolerance ||rhs||` (GMRES's own estimate is not trusted alone). The iterations taken (all
+/// `max_iterations` if it fails) are added to `count`.
 fn checked_gmres(
     matrix: SparseColMatRef<'_, usize, f64>,
     rhs: &DVector<f64>,
     m_inv: impl FnMut(&DVector<f64>, &mut DVector<f64>),
-    tolerance: f64,
-    max_iterations: usize,
+    (tolerance, max_iterations): (f64, usize),
+    count: &mut usize,
 ) -> Option<(DVector<f64>, usize)> {
     let apply = |x: &DVector<f64>, out: &mut DVector<f64>| sparse_times(matrix, x, out);
-    let (z, iterations) = gmres(apply, m_inv, rhs, 0.1 * tolerance, max_iterations)?;
+    let Some((z, iterations)) = gmres(apply, m_inv, rhs, 0.1 * tolerance, max_iterations) else {
+        *count += max_iterations;
+        return None;
+    };
+    *count += iterations;
     let mut residual = DVector::zeros(rhs.len());
     sparse_times(matrix, &z, &mut residual);
     residual -= rhs;
@@ -563,15 +568,13 @@ impl GlobalContactSolver {
         if let Some(approximation) = symmetric {
             if let Some(budget) = self.reuse_budget(rhs.len(), &approximation.branches) {
                 let preconditioner = &self.quasi_definite;
-                let solution = checked_gmres(
+                if let Some((z, _)) = checked_gmres(
                     matrix,
                     rhs,
                     |x, out| preconditioner.precondition(x, out),
-                    INEXACT_TOLERANCE,
-                    budget,
-                );
-                self.counts.krylov_iterations += solution.as_ref().map_or(budget, |s| s.1);
-                if let Some((z, _)) = solution {
+                    (INEXACT_TOLERANCE, budget),
+                    &mut self.counts.krylov_iterations,
+                ) {
                     return Ok(z);
                 }
             }
@@ -606,10 +609,9 @@ impl GlobalContactSolver {
             matrix,
             rhs,
             |x, out| factors.solve(x, out),
-            KRYLOV_TOLERANCE,
-            KRYLOV_MAX_ITERATIONS,
+            (KRYLOV_TOLERANCE, KRYLOV_MAX_ITERATIONS),
+            &mut self.counts.krylov_iterations,
         );
-        self.counts.krylov_iterations += solution.as_ref().map_or(KRYLOV_MAX_ITERATIONS, |s| s.1);
         self.factors_stale = solution.is_none();
         solution.map(|(z, _)| z)
     }
@@ -637,17 +639,13 @@ impl GlobalContactSolver {
             .factorize(rhs.len(), unknowns, pairs, &values, self.order.as_deref())
             .ok()?;
         let preconditioner = &self.quasi_definite;
-        let solution = checked_gmres(
+        let (z, iterations) = checked_gmres(
             matrix,
             rhs,
             |x, out| preconditioner.precondition(x, out),
-            INEXACT_TOLERANCE,
-            QUASI_DEFINITE_MAX_ITERATIONS,
-        );
-        self.counts.krylov_iterations += solution
-            .as_ref()
-            .map_or(QUASI_DEFINITE_MAX_ITERATIONS, |s| s.1);
-        let (z, iterations) = solution?;
+            (INEXACT_TOLERANCE, QUASI_DEFINITE_MAX_ITERATIONS),
+            &mut self.counts.krylov_iterations,
+        )?;
         self.preconditioner_branches = Some(branches);
         self.fresh_iterations = iterations;
         Some(z)
