@@ -142,6 +142,76 @@ pub fn gap_discrete_gradient(
         })
 }
 
+/// Smallest body rotation over an increment, rad, for which [`rotation_column`] is formed: below
+/// it the difference quotients lose more to round-off (about `eps |f| / dtheta`) than the
+/// end-point derivative misses (about `|d^2f/dtheta^2| dtheta / 2`).
+pub const MIN_SECANT_TURN: f64 = 1e-8;
+
+/// Largest rotation column, over the node's lever arm `|r_0|`, that [`rotation_column`] gives
+/// with the translation's remainder: a rotation row is at most about `|r_0|` (`df/dtheta =
+/// -(df/dy) . (e x y)`), so a larger one is a remainder divided by a turn that is small against
+/// the node's motion.
+pub const MAX_COLUMN_LEVER: f64 = 2.0;
+
+/// The start of an increment for [`rotation_column`]: the body's angle `theta_0` and the node's
+/// offset `r_0 = x_0 - c_0` from the body's reference point.
+#[derive(Clone, Copy, Debug)]
+pub struct IncrementStart {
+    /// `theta_0`, rad.
+    pub angle: f64,
+    /// `r_0` (world frame).
+    pub offset: Vector3<f64>,
+}
+
+/// Rotation column of a node's rows `f = [g, xi_0, xi_1]` over an increment that makes them a
+/// discrete gradient. With the end-point `df/dx` (`end.d_dx`) in the node and translation
+/// columns, the body now at `theta_1 = frame.angle` and the node at offset `r_1 = x_1 - c_1`:
+///
+/// `col = (f(y_1) - f(y_0) - df/dx . (r_1 - r_0)) / (theta_1 - theta_0)`,
+///
+/// so that `H dz = f(y_1) - f(y_0)` exactly (`xi` differences unwrapped, see
+/// [`slip_increment`]), and a contact force along the rows does exactly the work `p . df` of the
+/// contact law. Where `f` is affine between `Q_1^T r_0` and `y_1` (on one flat facet or plane)
+/// the column is the secant in the rotation, `(f(Q_1^T r_0) - f(Q_0^T r_0)) / dtheta`, which
+/// tends to `df/dtheta`; the end-point `df/dtheta` would miss the second-order term
+/// `p_N (d^2 g/dtheta^2) dtheta^2 / 2` (about `p_N R dtheta^2 / 2` on a drum of radius `R`),
+/// energy created or lost every increment. Where `f` is curved or kinked in between (a vertex
+/// wedge or an edge passed), the column also carries the translation's remainder over `dtheta`;
+/// if that makes a component exceed [`MAX_COLUMN_LEVER`] `|r_0|`, the secant in the rotation
+/// alone is returned instead.
+///
+/// `None` if the turn is below [`MIN_SECANT_TURN`] or not finite, the frame is degenerate, or a
+/// projection is undefined: then the end-point derivative stands.
+pub fn rotation_column(
+    surface: &dyn RigidSurface,
+    frame: &RotatingFrame,
+    start: &IncrementStart,
+    end_offset: &Vector3<f64>,
+    end: &ContactKinematics,
+) -> Option<[f64; 3]> {
+    let turn = frame.angle - start.angle;
+    if !(turn.abs() >= MIN_SECANT_TURN && turn.is_finite()) {
+        return None;
+    }
+    let (axis, rotation) = frame.orientation()?;
+    let start_rotation = Rotation3::from_axis_angle(&axis, start.angle);
+    let before = surface.project(&start_rotation.inverse_transform_vector(&start.offset))?;
+    let change = |gap: f64, coords: &Vector2<f64>| {
+        let slip = slip_increment(surface, &before.coords, coords);
+        [gap - before.gap, slip[0], slip[1]]
+    };
+    let moved = end_offset - start.offset;
+    let whole = change(end.gap, &end.coords);
+    let column: [f64; 3] = std::array::from_fn(|k| (whole[k] - end.d_dx[k].dot(&moved)) / turn);
+    let bound = MAX_COLUMN_LEVER * start.offset.norm();
+    if column.iter().all(|c| c.abs() <= bound) {
+        return Some(column);
+    }
+    let turned = surface.project(&rotation.inverse_transform_vector(&start.offset))?;
+    let secant = change(turned.gap, &turned.coords).map(|d| d / turn);
+    secant.iter().all(|c| c.is_finite()).then_some(secant)
+}
+
 /// Slip increment `current - previous` between two convected-coordinate states, each periodic
 /// component unwrapped with its surface period `p` into `(-p/2, p/2]`.
 pub fn slip_increment(
@@ -305,6 +375,115 @@ mod tests {
                 check_derivatives(&drum, &frame, x)?;
             }
         }
+        Ok(())
+    }
+
+    /// The rotation column with the end-point `df/dx` gives the increment's change of gap and
+    /// slip exactly (to round-off), on one facet and across a facet's edge, where the
+    /// end-point `df/dtheta` misses a term of second order in the turn; on one facet it tends
+    /// to `df/dtheta` as the turn vanishes.
+    #[test]
+    fn rotation_column_makes_the_rows_a_discrete_gradient() -> Result<(), ContactError> {
+        let drum = crate::facets::FacetedCylinder::new(0.2, Vector3::z(), 72, 0.0)?;
+        let axis = Vector3::z();
+        let (c0, c1) = (
+            Vector3::new(0.01, 0.0, 0.0),
+            Vector3::new(0.012, -0.001, 0.0),
+        );
+        let theta0 = 0.3;
+        let at = |angle: f64, body: f64, radius: f64| {
+            Rotation3::from_axis_angle(&Vector3::z_axis(), angle)
+                * Vector3::new(body.cos(), body.sin(), 0.0)
+                * radius
+        };
+        let none = || ContactError::InvalidSurface("no rotation column".into());
+        // (turn, end body angle, deg): within the facet of 0-5 degrees, then past its edge
+        for (turn_deg, end_deg) in [(0.4, 2.7), (3.0, 6.5)] {
+            let theta1 = theta0 + f64::to_radians(turn_deg);
+            let r0 = at(theta0, 2.0_f64.to_radians(), 0.1995);
+            let r1 = at(theta1, f64::to_radians(end_deg), 0.1993);
+            let start = RotatingFrame {
+                center: c0,
+                axis,
+                angle: theta0,
+            };
+            let end = RotatingFrame {
+                center: c1,
+                axis,
+                angle: theta1,
+            };
+            let k0 = eval(&drum, &start, &(c0 + r0))?;
+            let k1 = eval(&drum, &end, &(c1 + r1))?;
+            let change = difference(&drum, &k1, &k0);
+            let begin = IncrementStart {
+                angle: theta0,
+                offset: r0,
+            };
+            let column = rotation_column(&drum, &end, &begin, &r1, &k1).ok_or_else(none)?;
+            let turn = theta1 - theta0;
+            for c in 0..2 {
+                let predicted = k1.d_dx[c].dot(&(r1 - r0)) + column[c] * turn;
+                assert_relative_eq!(predicted, change[c], epsilon = 1e-14);
+                let tangent = k1.d_dx[c].dot(&(r1 - r0)) + k1.d_dangle[c] * turn;
+                assert!(
+                    (tangent - change[c]).abs() > 1e-8,
+                    "{c}: the end-point row is exact"
+                );
+            }
+        }
+        let r0 = at(theta0, 2.0_f64.to_radians(), 0.1995);
+        let begin = IncrementStart {
+            angle: theta0,
+            offset: r0,
+        };
+        let start = RotatingFrame {
+            center: c0,
+            axis,
+            angle: theta0,
+        };
+        let k0 = eval(&drum, &start, &(c0 + r0))?;
+        let close = RotatingFrame {
+            angle: theta0 + 1e-6,
+            ..start
+        };
+        let still = eval(&drum, &close, &(c0 + r0))?;
+        let limit = rotation_column(&drum, &close, &begin, &r0, &still).ok_or_else(none)?;
+        for (secant, derivative) in limit.iter().zip(k0.d_dangle).take(2) {
+            assert_relative_eq!(*secant, derivative, epsilon = 1e-6);
+        }
+        let stopped = RotatingFrame {
+            angle: theta0 + 0.1 * MIN_SECANT_TURN,
+            ..start
+        };
+        assert!(rotation_column(&drum, &stopped, &begin, &r0, &still).is_none());
+        Ok(())
+    }
+
+    /// A turn that is tiny against the node's motion over a vertex would divide the remainder of
+    /// the translation by it: the column falls back to the secant in the rotation, of the size
+    /// of the lever arm.
+    #[test]
+    fn rotation_column_stays_of_the_lever_arm_size() -> Result<(), ContactError> {
+        let drum = crate::facets::FacetedCylinder::new(0.2, Vector3::z(), 72, 0.0)?;
+        let frame = RotatingFrame {
+            center: Vector3::zeros(),
+            axis: Vector3::z(),
+            angle: 1e-6,
+        };
+        let at = |body: f64| Vector3::new(body.cos(), body.sin(), 0.0) * 0.1995;
+        // from one facet over the vertex at 5 degrees onto the next one
+        let (r0, r1) = (at(4.0_f64.to_radians()), at(6.0_f64.to_radians()));
+        let begin = IncrementStart {
+            angle: 0.0,
+            offset: r0,
+        };
+        let end = eval(&drum, &frame, &r1)?;
+        let column = rotation_column(&drum, &frame, &begin, &r1, &end)
+            .ok_or_else(|| ContactError::InvalidSurface("no rotation column".into()))?;
+        for c in column {
+            assert!(c.abs() <= MAX_COLUMN_LEVER * r0.norm(), "{c}");
+        }
+        assert_relative_eq!(column[1], end.d_dangle[1], epsilon = 1e-4);
         Ok(())
     }
 

@@ -29,7 +29,8 @@ pub use coulomb::{
 pub use error::ContactError;
 pub use facets::FacetedCylinder;
 pub use kinematics::{
-    ContactKinematics, RotatingFrame, evaluate, gap_discrete_gradient, slip_increment,
+    ContactKinematics, IncrementStart, MAX_COLUMN_LEVER, MIN_SECANT_TURN, RotatingFrame, evaluate,
+    gap_discrete_gradient, rotation_column, slip_increment,
 };
 pub use plane::RigidPlane;
 pub use surface::{AnalyticCylinder, DiscreteGradient, Projection, RigidSurface};

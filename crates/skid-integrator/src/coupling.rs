@@ -27,7 +27,8 @@ use skid_contact::coulomb::{
 };
 use skid_contact::error::ContactError;
 use skid_contact::kinematics::{
-    ContactKinematics, RotatingFrame, evaluate, gap_discrete_gradient, slip_increment,
+    ContactKinematics, IncrementStart, RotatingFrame, evaluate, gap_discrete_gradient,
+    rotation_column, slip_increment,
 };
 
 use crate::error::{IncrementFailure, LinearFailure};
@@ -454,8 +455,12 @@ pub fn solve_contact_forces(
 /// between the start and current positions instead of the current normal: the contact force
 /// acts along it, so its work over the increment, `p_N H_N dx`, is exactly `p_N dg` (zero for a
 /// node sliding along the drum at zero gap). With the current normal a loaded node moving `ds`
-/// along the circle of radius R gains `p_N ds^2 / (2 R)` per increment. `u` stays the exact gap,
-/// so a converged increment satisfies the contact law exactly either way.
+/// along the circle of radius R gains `p_N ds^2 / (2 R)` per increment. Against any other
+/// surface the rotation column is the one that makes the rows a discrete gradient over the
+/// increment ([`skid_contact::rotation_column`]), so that the work is exact there too; with the
+/// end-point derivative a node pressed on a facet of a drum turning by `dtheta` gains or loses
+/// about `p_N R dtheta^2 / 2` per increment. `u` stays the
+/// exact gap and slip, so a converged increment satisfies the contact law exactly either way.
 ///
 /// # Errors
 /// [`IncrementFailure::NoProjection`] if a node has no projection on its master surface.
@@ -502,6 +507,17 @@ pub fn contact_rows<const D: usize>(
                     kin.d2_dx2[0] = secant.jacobian;
                     kin.d2_dx_dangle[0] = Vector3::zeros();
                     kin.d2_dangle2[0] = 0.0;
+                } else {
+                    let begin = IncrementStart {
+                        angle: dofs.body_angle(x0, pair.body),
+                        offset,
+                    };
+                    let end_offset = pos - frame.center;
+                    if let Some(column) =
+                        rotation_column(pair.surface.as_ref(), &frame, &begin, &end_offset, &kin)
+                    {
+                        kin.d_dangle = column;
+                    }
                 }
             }
             let slip = slip_increment(pair.surface.as_ref(), &previous[k], &kin.coords);
