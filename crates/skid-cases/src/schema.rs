@@ -440,6 +440,7 @@ mod tests {
                     iterations: 25,
                     force_residual: 1e-3,
                     contact_residual: 0.0,
+                    worst: None,
                 },
             ),
             (

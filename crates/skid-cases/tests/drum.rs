@@ -125,6 +125,26 @@ fn contact_forces_on_a_turning_facet_do_exactly_the_work_of_the_contact_law() {
     assert!(residual.abs() < 0.05, "energy residual {residual} J");
 }
 
+/// A run that Newton cannot finish says where its residual is worst.
+#[test]
+fn an_unconverged_increment_names_where_its_residual_is_worst() {
+    let (s, _dir) = run(&["solver.max_newton_iterations=1", "solver.max_cutbacks=0"]);
+    assert_eq!(s.status, "failed");
+    assert_eq!(s.failure.as_deref(), Some("newton not converged"));
+    let error = s.error.expect("a diagnosis");
+    let worst = error
+        .split("; worst ")
+        .nth(1)
+        .expect("the worst residual is named");
+    assert!(
+        worst.starts_with("force at node ")
+            || worst.starts_with("force on rigid body ")
+            || worst.starts_with("moment on rigid body ")
+            || worst.starts_with("contact of node "),
+        "{error}"
+    );
+}
+
 #[test]
 fn without_friction_the_drum_keeps_its_speed() {
     let (s, dir) = run(&["contact.mu=0", "steps[1].duration=0.01"]);

@@ -18,6 +18,30 @@ pub enum EquationKind {
     Rotation,
 }
 
+/// Whose motion a global equation carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EquationOwner {
+    /// Component `component` (0 = x, 1 = y, 2 = z) of a mesh node's displacement.
+    Node {
+        /// Node index in the mesh.
+        node: usize,
+        /// Displacement component.
+        component: usize,
+    },
+    /// A rigid body's translation along `component`.
+    BodyTranslation {
+        /// Body index in the model.
+        body: usize,
+        /// Translation component.
+        component: usize,
+    },
+    /// A rigid body's rotation.
+    BodyRotation {
+        /// Body index in the model.
+        body: usize,
+    },
+}
+
 /// Global equation numbers of every node component and rigid-body motion.
 #[derive(Clone, Debug)]
 pub struct DofMap<const D: usize> {
@@ -129,6 +153,24 @@ impl<const D: usize> DofMap<D> {
             .collect()
     }
 
+    /// Whose motion equation `eq` carries: a rigid body's (also for the nodes tied to it) or a
+    /// node's; `None` beyond the last equation.
+    pub fn owner(&self, eq: usize) -> Option<EquationOwner> {
+        let bodies = self.body_translation.iter().zip(&self.body_rotation);
+        for (body, (translation, rotation)) in bodies.enumerate() {
+            if let Some(component) = translation.iter().position(|e| *e == Some(eq)) {
+                return Some(EquationOwner::BodyTranslation { body, component });
+            }
+            if *rotation == Some(eq) {
+                return Some(EquationOwner::BodyRotation { body });
+            }
+        }
+        self.node.iter().enumerate().find_map(|(node, eqs)| {
+            let component = eqs.iter().position(|e| *e == Some(eq))?;
+            Some(EquationOwner::Node { node, component })
+        })
+    }
+
     /// Displacement of a node, `u_i = x[eq(node, i)]` (0 for fixed components).
     pub fn node_displacement(&self, x: &DVector<f64>, node: usize) -> SVector<f64, D> {
         gather(&self.node[node], x)
@@ -175,6 +217,18 @@ mod tests {
         assert_eq!(map.node_displacement(&x, 3)[1], -0.004);
         assert_eq!(map.body_angle(&x, 1), 1.5);
         assert_eq!(map.body_equations(0), vec![4]);
+        let translation = Some(EquationOwner::BodyTranslation {
+            body: 0,
+            component: 1,
+        });
+        assert_eq!(map.owner(4), translation);
+        assert_eq!(map.owner(5), Some(EquationOwner::BodyRotation { body: 1 }));
+        let node = Some(EquationOwner::Node {
+            node: 1,
+            component: 1,
+        });
+        assert_eq!(map.owner(3), node);
+        assert_eq!(map.owner(6), None);
     }
 
     #[test]

@@ -6,6 +6,8 @@
 
 use thiserror::Error;
 
+use crate::dof::EquationOwner;
+
 /// An inconsistent model (caught before any numerics run).
 #[derive(Debug, Error)]
 #[non_exhaustive]
@@ -27,7 +29,8 @@ pub enum ModelError {
 pub enum IncrementFailure {
     /// Newton-Raphson did not converge within the iteration limit.
     #[error(
-        "Newton did not converge in {iterations} iterations (force residual {force_residual:.3e}, contact residual {contact_residual:.3e})"
+        "Newton did not converge in {iterations} iterations (force residual {force_residual:.3e}, contact residual {contact_residual:.3e}{})",
+        worst.map(|w| format!("; worst {w}")).unwrap_or_default()
     )]
     NewtonNotConverged {
         /// Iterations performed.
@@ -36,6 +39,9 @@ pub enum IncrementFailure {
         force_residual: f64,
         /// Last scaled contact (kinematic) residual.
         contact_residual: f64,
+        /// Where the residual furthest above its tolerance is largest (`None` if no residual
+        /// was measured).
+        worst: Option<WorstResidual>,
     },
     /// A residual, increment or contact force became NaN or infinite.
     #[error("non-finite values in Newton iteration {iteration}")]
@@ -84,6 +90,39 @@ pub enum IncrementFailure {
         /// Node index.
         node: usize,
     },
+}
+
+/// Where a Newton iteration's residual is largest: the equation of the largest force residual,
+/// or the candidate of the largest contact residual, whichever is further above its tolerance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WorstResidual {
+    /// The force (or moment) residual of one equation.
+    Equation(EquationOwner),
+    /// The contact residual (gap, slip or Coulomb law) of one candidate.
+    Contact {
+        /// Contact pair index.
+        pair: usize,
+        /// The candidate's slave node.
+        node: usize,
+    },
+}
+
+impl std::fmt::Display for WorstResidual {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let axis = |component: usize| ["x", "y", "z"].get(component).copied().unwrap_or("?");
+        match *self {
+            Self::Equation(EquationOwner::Node { node, component }) => {
+                write!(f, "force at node {node} ({})", axis(component))
+            }
+            Self::Equation(EquationOwner::BodyTranslation { body, component }) => {
+                write!(f, "force on rigid body {body} ({})", axis(component))
+            }
+            Self::Equation(EquationOwner::BodyRotation { body }) => {
+                write!(f, "moment on rigid body {body}")
+            }
+            Self::Contact { pair, node } => write!(f, "contact of node {node} in pair {pair}"),
+        }
+    }
 }
 
 /// Why a linear system could not be solved.

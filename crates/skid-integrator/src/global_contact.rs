@@ -866,20 +866,27 @@ pub fn contact_weights(k: SparseColMatRef<'_, usize, f64>, rows: &ContactRows) -
 /// is from the exact Coulomb law (a penetration, a slip while sticking, a force off the cone
 /// or on an open contact, each converted by the candidate's weight).
 pub fn law_residual(rows: &ContactRows, r: &DVector<f64>, rho: &[f64]) -> f64 {
+    law_residuals(rows, r, rho).fold(0.0, f64::max)
+}
+
+/// Each candidate's `||Phi_c(u_c, r_c)||_inf / rho_c` (see [`law_residual`]).
+pub fn law_residuals<'a>(
+    rows: &'a ContactRows,
+    r: &'a DVector<f64>,
+    rho: &'a [f64],
+) -> impl Iterator<Item = f64> + 'a {
     let d = rows.components;
-    (0..rows.len())
-        .map(|c| {
-            let block = c * d..(c + 1) * d;
-            let law = LocalLaw::evaluate(
-                d,
-                rows.mu[c],
-                rho[c],
-                &r.as_slice()[block.clone()],
-                &rows.u.as_slice()[block],
-            );
-            law.phi[..d].iter().fold(0.0_f64, |a, p| a.max(p.abs())) / rho[c]
-        })
-        .fold(0.0, f64::max)
+    (0..rows.len()).map(move |c| {
+        let block = c * d..(c + 1) * d;
+        let law = LocalLaw::evaluate(
+            d,
+            rows.mu[c],
+            rho[c],
+            &r.as_slice()[block.clone()],
+            &rows.u.as_slice()[block],
+        );
+        law.phi[..d].iter().fold(0.0_f64, |a, p| a.max(p.abs())) / rho[c]
+    })
 }
 
 #[cfg(test)]

@@ -40,9 +40,9 @@ use nalgebra::{DVector, Vector2};
 use crate::assembly::{Assembler, InternalState, external_forces};
 use crate::coupling::{ContactRows, contact_rows, contact_step};
 use crate::dof::EquationKind;
-use crate::error::IncrementFailure;
+use crate::error::{IncrementFailure, WorstResidual};
 use crate::global_contact::{
-    GlobalContactSolver, QUASI_DEFINITE_FROM, contact_weights, law_residual,
+    GlobalContactSolver, QUASI_DEFINITE_FROM, contact_weights, law_residuals,
 };
 use crate::hht::{Hht, IncrementEnds};
 use crate::loads::LoadInstant;
@@ -331,6 +331,7 @@ fn solve_increment_with<const D: usize>(
         IncrementKind::Dynamic { .. } => Some(&x - &start.x),
     };
     let mut halvings = 0;
+    let mut worst = None;
     // The forces before the last global step, to go back half way with the step.
     let mut forces_before: Option<DVector<f64>> = None;
     // The factorization of the last contact step (see the contact step below).
@@ -405,20 +406,34 @@ fn solve_increment_with<const D: usize>(
             let r = forces.r();
             let contact_force = rows.transpose_times(r, n);
             let full = &residual - &contact_force;
-            let force_residual = scaled_force_residual(
+            let (force_residual, force_worst) = scaled_force_residual(
                 model,
                 &full,
                 &[&internal.force, &f_ext, &inertia, &contact_force],
                 length,
             );
-            let contact_residual = match forces {
-                _ if rows.is_empty() => 0.0,
-                LastForces::Linearised { r, u, rho } => {
-                    (&rows.u - u).amax().max(law_residual(&rows, r, rho)) / length
+            let d = rows.components;
+            let (contact_residual, contact_worst) = match forces {
+                _ if rows.is_empty() => (0.0, None),
+                LastForces::Linearised { r, u, rho } => largest(
+                    law_residuals(&rows, r, rho)
+                        .zip((&rows.u - u).as_slice().chunks(d.max(1)))
+                        .map(|(law, du)| du.iter().fold(law, |a, v| a.max(v.abs())) / length),
+                ),
+                LastForces::Law { r, rho } => {
+                    largest(law_residuals(&rows, r, rho).map(|law| law / length))
                 }
-                LastForces::Law { r, rho } => law_residual(&rows, r, rho) / length,
             };
             counters.residuals.push((force_residual, contact_residual));
+            worst = if force_residual / newton.force_tolerance
+                >= contact_residual / newton.contact_tolerance
+            {
+                force_worst
+                    .and_then(|eq| model.dofs().owner(eq))
+                    .map(WorstResidual::Equation)
+            } else {
+                contact_worst.and_then(|c| candidate(model, c))
+            };
             if !force_residual.is_finite() || !contact_residual.is_finite() {
                 return Err(IncrementFailure::NonFinite { iteration });
             }
@@ -441,6 +456,7 @@ fn solve_increment_with<const D: usize>(
                     iterations: iteration,
                     force_residual,
                     contact_residual,
+                    worst,
                 });
             }
             // Semismooth Newton can cycle between two sets of contact branches, each step
@@ -557,6 +573,7 @@ fn solve_increment_with<const D: usize>(
         iterations: max_iterations,
         force_residual,
         contact_residual,
+        worst,
     })
 }
 
@@ -613,14 +630,15 @@ const QUASI_STATIC_SHIFT: f64 = 1e-6;
 /// increment fails (and is cut back).
 const MAX_STEP_HALVINGS: usize = 4;
 
-/// `max_i |R_i| / s_i` with `s` the largest magnitude among the given force vectors; moments
-/// are divided by the model size so that both compare as forces.
+/// `max_i |R_i| / s` with `s` the largest magnitude among the given force vectors, and the
+/// equation `i` where it is reached (`None` without equations); moments are divided by the
+/// model size so that both compare as forces.
 fn scaled_force_residual<const D: usize>(
     model: &Model<D>,
     residual: &DVector<f64>,
     forces: &[&DVector<f64>],
     length: f64,
-) -> f64 {
+) -> (f64, Option<usize>) {
     let kinds = model.dofs().kinds();
     let as_force = |i: usize, v: f64| match kinds[i] {
         EquationKind::Translation => v.abs(),
@@ -632,12 +650,32 @@ fn scaled_force_residual<const D: usize>(
             scale = scale.max(as_force(i, v));
         }
     }
-    let worst = residual
-        .iter()
-        .enumerate()
-        .map(|(i, &v)| as_force(i, v))
-        .fold(0.0, f64::max);
-    if scale > 0.0 { worst / scale } else { worst }
+    let (worst, at) = largest(residual.iter().enumerate().map(|(i, &v)| as_force(i, v)));
+    (if scale > 0.0 { worst / scale } else { worst }, at)
+}
+
+/// The largest of `values` and its position (0 and `None` if empty; a NaN wins, so that it is
+/// reported where it appeared).
+fn largest(values: impl Iterator<Item = f64>) -> (f64, Option<usize>) {
+    values.enumerate().fold((0.0, None), |(best, at), (i, v)| {
+        if v > best || v.is_nan() && !best.is_nan() || at.is_none() {
+            (v, Some(i))
+        } else {
+            (best, at)
+        }
+    })
+}
+
+/// The contact pair and slave node of candidate `c` (candidates numbered pair by pair).
+fn candidate<const D: usize>(model: &Model<D>, c: usize) -> Option<WorstResidual> {
+    let mut first = 0;
+    for (pair, contact) in model.contacts().iter().enumerate() {
+        if let Some(&node) = contact.nodes.get(c - first) {
+            return Some(WorstResidual::Contact { pair, node });
+        }
+        first += contact.nodes.len();
+    }
+    None
 }
 
 /// The rates of quasi-static equations over an increment of size `h` from `x_n` to `x`: the
@@ -796,5 +834,15 @@ mod tests {
         assert!(!is_cycling(&cycle[1..]));
         let force_only = [(9.59e-3, 1.44e-3), (9.60e-3, 1.35e-3), (9.589e-3, 1.0e-5)];
         assert!(!is_cycling(&force_only));
+    }
+
+    /// The worst residual is where the largest one is, or where a NaN first appeared.
+    #[test]
+    fn the_largest_residual_and_its_position() {
+        assert_eq!(largest([0.5, 2.0, 1.0].into_iter()), (2.0, Some(1)));
+        let (value, at) = largest([0.5, f64::NAN, 3.0, f64::NAN].into_iter());
+        assert!(value.is_nan() && at == Some(1));
+        assert_eq!(largest([0.0, 0.0].into_iter()), (0.0, Some(0)));
+        assert_eq!(largest(std::iter::empty()), (0.0, None));
     }
 }

@@ -42,7 +42,7 @@ pub mod stepper;
 #[cfg(test)]
 mod test_support;
 
-pub use error::{IncrementFailure, LinearFailure, ModelError, RunError};
+pub use error::{IncrementFailure, LinearFailure, ModelError, RunError, WorstResidual};
 pub use loads::{Amplitude, ConcentratedLoad, GravityLoad, LoadInstant, LoadTarget, Loads};
 pub use model::{ContactPair, Model, PressureLoad, SolidPart, Tie};
 pub use state::State;
