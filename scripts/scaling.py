@@ -1,17 +1,20 @@
 #!/usr/bin/env python3
 """Cost against problem size: the 3D analytical-drum case at a ladder of pad meshes, with each
-contact solve, each level run twice (the static preload and a few dynamic increments, then
-the same with more), so that the cost of a dynamic increment is the difference of the two wall
-times over the difference of their increments and the preload is not counted.
+contact solve, each level run once (the static preload, then a few dynamic increments); the
+cost of a dynamic increment is the dynamic step's own wall time (summary.json, `steps`) over its
+increments, so the preload is not counted.
 
 For every level it records the equations and contact candidates (summary.json), the wall time,
 the dynamic increment's cost in time, Newton iterations and factorizations, and the peak
-resident memory of the longer run's process (from wait4); it writes validation/scaling.json,
+resident memory of the run's process (from wait4); it writes validation/scaling.json,
 then `skid report --scaling` renders validation/scaling.md with the fitted exponents and the
 plots scaling.svg and scaling-memory.svg.
 
-Usage: scripts/scaling.py [--max-equations N] [--reduced-max-equations N] [--timeout S]
-                          [--methods reduced,global] [--threads N] [--out DIR]
+Usage: scripts/scaling.py [--min-equations N] [--max-equations N] [--reduced-max-equations N]
+                          [--timeout S] [--methods reduced,global] [--threads N] [--out DIR]
+                          [--update]
+With --update, the levels run replace those of the same mesh and contact solve in the existing
+scaling.json, and the others are kept.
 A run that takes longer than the timeout is stopped and recorded as such; larger levels of
 that contact solve are then skipped.
 """
@@ -32,7 +35,7 @@ CASE = ROOT / "cases" / "drum" / "3d-analytic.json"
 # circumferential x radial x axial elements: from the benchmark pad to about 1e5 equations
 MESHES = [(10, 1, 1), (20, 2, 2), (20, 4, 4), (40, 4, 4), (40, 8, 8), (60, 8, 12),
           (80, 12, 16), (100, 16, 20)]
-DYNAMIC_INCREMENTS = (2, 6)
+DYNAMIC_INCREMENTS = 4
 DT = 1e-4
 
 
@@ -41,6 +44,11 @@ def equations(mesh):
     estimate used to skip levels before running them."""
     c, r, a = mesh
     return 3 * (c + 1) * (r + 1) * (a + 1)
+
+
+def parse_mesh(text):
+    """The (circumferential, radial, axial) element counts of a record's "c x r x a"."""
+    return tuple(int(n) for n in text.split(" x "))
 
 
 def run_once(mesh, method, increments, threads, timeout):
@@ -80,39 +88,34 @@ def run_once(mesh, method, increments, threads, timeout):
     for key in ("status", "equations", "contact_candidates", "increments", "newton_iterations",
                 "contact_fallbacks", "tangent_factorizations", "lu_factorizations",
                 "preconditioner_factorizations", "krylov_iterations", "wall_time_s",
-                "assembly_s", "linear_solve_s", "contact_solve_s"):
+                "assembly_s", "linear_solve_s", "contact_solve_s", "steps"):
         record[key] = summary.get(key)
     return record
 
 
-FACTORIZATIONS = ("tangent_factorizations", "lu_factorizations", "preconditioner_factorizations")
-
-
 def run(mesh, method, threads, timeout):
-    """Runs one level twice (DYNAMIC_INCREMENTS); returns the longer run's record with the
-    cost of a dynamic increment from the difference of the two."""
-    short = run_once(mesh, method, DYNAMIC_INCREMENTS[0], threads, timeout)
-    if short.get("status") != "completed":
-        return short
-    record = run_once(mesh, method, DYNAMIC_INCREMENTS[1], threads, timeout)
+    """Runs one level; returns its record with the cost of a dynamic increment taken from the
+    dynamic step's own record."""
+    record = run_once(mesh, method, DYNAMIC_INCREMENTS, threads, timeout)
     if record.get("status") != "completed":
         return record
-    steps = record["increments"] - short["increments"]
-    if steps <= 0:
-        record["status"] = "no dynamic increments between the two runs"
+    step = record.pop("steps", [])[-1:]
+    if not step or step[0]["increments"] <= 0:
+        record["status"] = "no dynamic increments in the run"
         return record
-    difference = lambda key: record[key] - short[key]
-    iterations = difference("newton_iterations")
-    record["dynamic_increment_s"] = difference("wall_time_s") / steps
-    record["dynamic_iteration_s"] = difference("wall_time_s") / max(iterations, 1)
-    record["dynamic_newton_per_increment"] = iterations / steps
-    record["dynamic_factorizations_per_increment"] = sum(
-        difference(k) for k in FACTORIZATIONS) / steps
+    step = step[0]
+    increments = step["increments"]
+    record["dynamic_increment_s"] = step["wall_time_s"] / increments
+    record["dynamic_iteration_s"] = step["wall_time_s"] / max(step["newton_iterations"], 1)
+    record["dynamic_newton_per_increment"] = step["newton_iterations"] / increments
+    record["dynamic_factorizations_per_increment"] = step["factorizations"] / increments
+    record["dynamic_krylov_per_increment"] = step["krylov_iterations"] / increments
     return record
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--min-equations", type=int, default=0)
     parser.add_argument("--max-equations", type=int, default=120_000)
     parser.add_argument("--reduced-max-equations", type=int, default=25_000,
                         help="the reduced path's dense Delassus operator beyond this is slow")
@@ -120,6 +123,8 @@ def main():
     parser.add_argument("--methods", default="reduced,global")
     parser.add_argument("--threads", type=int, default=1)
     parser.add_argument("--out", default=str(ROOT / "validation"))
+    parser.add_argument("--update", action="store_true",
+                        help="keep the records of scaling.json for the levels not run")
     args = parser.parse_args()
     if not SKID.is_file():
         sys.exit(f"scaling: {SKID} not found; run cargo build --release first")
@@ -127,7 +132,7 @@ def main():
     for method in args.methods.split(","):
         limit = args.reduced_max_equations if method == "reduced" else args.max_equations
         for mesh in MESHES:
-            if equations(mesh) > min(limit, args.max_equations):
+            if not args.min_equations <= equations(mesh) <= min(limit, args.max_equations):
                 continue
             record = run(mesh, method, args.threads, args.timeout)
             records.append(record)
@@ -139,8 +144,20 @@ def main():
                 break
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.update and (out / "scaling.json").is_file():
+        earlier = json.loads((out / "scaling.json").read_text())
+        if (earlier.get("threads"), earlier.get("dynamic_increments")) != (
+                args.threads, DYNAMIC_INCREMENTS):
+            sys.exit(f"scaling: --update at --threads {args.threads} with {DYNAMIC_INCREMENTS} "
+                     f"dynamic increments, but the existing records were measured at "
+                     f"{earlier.get('threads')} threads with "
+                     f"{earlier.get('dynamic_increments')}")
+        run_now = {(r["mesh"], r["method"]) for r in records}
+        kept = [r for r in earlier["records"] if (r["mesh"], r["method"]) not in run_now]
+        records = sorted(kept + records, key=lambda r: (r["method"] != "reduced",
+                                                        equations(parse_mesh(r["mesh"]))))
     study = {"case": str(CASE.relative_to(ROOT)), "dt": DT, "threads": args.threads,
-             "dynamic_increments": list(DYNAMIC_INCREMENTS), "records": records}
+             "dynamic_increments": DYNAMIC_INCREMENTS, "records": records}
     (out / "scaling.json").write_text(json.dumps(study, indent=2) + "\n")
     report = subprocess.run([str(SKID), "report", "--scaling", str(out / "scaling.json"),
                              "--out", str(out / "scaling.md")])

@@ -10,38 +10,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 mod common;
-use common::{shipped, skid};
-
-/// Keys of `summary.json` (at any depth) and `batch.json` that hold wall times.
-const TIMING_KEYS: [&str; 4] = [
-    "wall_time_s",
-    "assembly_s",
-    "linear_solve_s",
-    "contact_solve_s",
-];
-
-/// `value` without its [`TIMING_KEYS`], at any depth; panics if it held none of them, so that a
-/// renamed timing field cannot make the comparison fail for the wrong reason or pass unseen.
-fn without_timings(mut value: Value) -> Value {
-    fn strip(value: &mut Value, removed: &mut usize) {
-        match value {
-            Value::Object(map) => {
-                for key in TIMING_KEYS {
-                    if map.remove(key).is_some() {
-                        *removed += 1;
-                    }
-                }
-                map.values_mut().for_each(|v| strip(v, removed));
-            }
-            Value::Array(items) => items.iter_mut().for_each(|v| strip(v, removed)),
-            _ => {}
-        }
-    }
-    let mut removed = 0;
-    strip(&mut value, &mut removed);
-    assert!(removed > 0, "no timing field found in {value}");
-    value
-}
+use common::{shipped, skid, without_timings};
 
 /// The shipped case `relative`, renamed `name`, its last step shortened to `duration` s,
 /// written into `dir`; returns the new file.

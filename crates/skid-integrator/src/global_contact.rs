@@ -42,9 +42,13 @@
 //!   tangent changes little from one iteration or increment to the next, but every candidate
 //!   that changed branch since adds iterations, see [`GlobalContactSolver::reuse_budget`]),
 //!   then those of this system's `S`;
-//! - by a new sparse LU factorization with partial pivoting.
+//! - by a new sparse LU factorization with partial pivoting, below [`LU_UNTIL`] unknowns
+//!   (above, the GMRES on this system's factors gets more iterations instead).
 //!
-//! An iterative result counts only if its true residual is below its tolerance.
+//! An iterative result counts only if its true residual is below its tolerance. Then each
+//! sliding candidate's tangential rows are solved exactly for its friction (see
+//! [`exact_friction_rows`]), so that friction is `mu` times the normal force to Newton's
+//! convergence, not to GMRES's tolerance.
 //!
 //! Each candidate's forces enter scaled by its weight `rho_c`, the unknown being
 //! `dy_c = dr_c / rho_c` (a length), so that every block of the matrix is a stiffness and the
@@ -102,6 +106,19 @@ pub const QUASI_DEFINITE_FROM: usize = 2000;
 /// GMRES iterations on the quasi-definite preconditioner of this system's `S` before the
 /// matrix is factorized.
 const QUASI_DEFINITE_MAX_ITERATIONS: usize = 30;
+/// Systems of this many unknowns or more are never LU-factorized: the LU's fill (its column
+/// ordering comes from `A^T A`) grows faster than the machine's memory (measured peak resident
+/// memory of a short run of the 3D pad, the LU taken in the static preload: 1.8 GB at 21,000
+/// unknowns, 8.2 GB at 54,000, 20.7 GB at 108,000). GMRES on this system's quasi-definite
+/// factors gets [`WITHOUT_LU_MAX_ITERATIONS`] instead, and a system it does not solve fails
+/// the Newton iteration (the increment is then solved by the reduced path, or cut back). Below
+/// it the LU stays: reused as GMRES's preconditioner over later iterations and increments, it
+/// took a dynamic increment of 54,000 unknowns 1.0 s, against 8.5 s on fresh quasi-definite
+/// factors.
+const LU_UNTIL: usize = 60_000;
+/// GMRES iterations on the quasi-definite preconditioner of this system's `S` for systems that
+/// are not LU-factorized.
+const WITHOUT_LU_MAX_ITERATIONS: usize = 200;
 /// GMRES iterations on the quasi-definite factors of an earlier system beyond those of the
 /// factorized system, with no candidate changing branch (see
 /// [`GlobalContactSolver::reuse_budget`]); measured on `3d-refined`: 11-13 against 7-8.
@@ -210,6 +227,9 @@ pub struct GlobalContactSolver {
     /// Systems of at least this many equations are preconditioned by the quasi-definite
     /// approximation ([`QUASI_DEFINITE_FROM`] unless set otherwise).
     pub quasi_definite_from: usize,
+    /// Systems of at least this many equations are never LU-factorized ([`LU_UNTIL`] unless set
+    /// otherwise).
+    pub lu_until: usize,
     analysed: Option<Analysed>,
     factors: Option<Factors>,
     /// The compressed values of the matrix `factors` factorize (of the analysed pattern): what
@@ -238,6 +258,7 @@ impl Default for GlobalContactSolver {
     fn default() -> Self {
         Self {
             quasi_definite_from: QUASI_DEFINITE_FROM,
+            lu_until: LU_UNTIL,
             analysed: None,
             factors: None,
             factored_values: None,
@@ -581,6 +602,17 @@ impl GlobalContactSolver {
             if let Some(z) = self.iterate_quasi_definite(matrix, rhs, unknowns, approximation) {
                 return Ok(z);
             }
+            if rhs.len() >= self.lu_until {
+                return Err(IncrementFailure::linear(
+                    SYSTEM,
+                    LinearFailure::Solver(format!(
+                        "GMRES on the quasi-definite preconditioner did not reach {INEXACT_TOLERANCE:e} \
+                         of the residual in {WITHOUT_LU_MAX_ITERATIONS} iterations (no LU \
+                         factorization from {} unknowns)",
+                        self.lu_until
+                    )),
+                ));
+            }
         }
         self.counts.lu_factorizations += 1;
         self.factorize(matrix)?;
@@ -619,7 +651,8 @@ impl GlobalContactSolver {
     /// GMRES on `matrix z = rhs` preconditioned by the `L D L^T` factorization of its
     /// symmetric quasi-definite approximation `S` (lower-triangle entries `pairs` with
     /// `values`; see [`crate::quasi_definite`]); `Some(z)` if its true relative residual
-    /// reaches [`INEXACT_TOLERANCE`] within [`QUASI_DEFINITE_MAX_ITERATIONS`].
+    /// reaches [`INEXACT_TOLERANCE`] within [`QUASI_DEFINITE_MAX_ITERATIONS`] (or
+    /// [`WITHOUT_LU_MAX_ITERATIONS`] from [`GlobalContactSolver::lu_until`] unknowns).
     fn iterate_quasi_definite(
         &mut self,
         matrix: SparseColMatRef<'_, usize, f64>,
@@ -639,11 +672,16 @@ impl GlobalContactSolver {
             .factorize(rhs.len(), unknowns, pairs, &values, self.order.as_deref())
             .ok()?;
         let preconditioner = &self.quasi_definite;
+        let budget = if rhs.len() >= self.lu_until {
+            WITHOUT_LU_MAX_ITERATIONS
+        } else {
+            QUASI_DEFINITE_MAX_ITERATIONS
+        };
         let (z, iterations) = checked_gmres(
             matrix,
             rhs,
             |x, out| preconditioner.precondition(x, out),
-            (INEXACT_TOLERANCE, QUASI_DEFINITE_MAX_ITERATIONS),
+            (INEXACT_TOLERANCE, budget),
             &mut self.counts.krylov_iterations,
         )?;
         self.preconditioner_branches = Some(branches);
@@ -917,7 +955,10 @@ mod tests {
     /// to the solution of the reduced (Delassus) path: the same forces to 1e-8 relative and the
     /// same step, with open, sticking and sliding candidates among them. Its last steps
     /// converge quadratically.
-    fn global_iteration_solves_the_reduced_problem<const D: usize>(quasi_definite_from: usize) {
+    fn global_iteration_solves_the_reduced_problem<const D: usize>(
+        quasi_definite_from: usize,
+        lu_until: usize,
+    ) {
         let model = block_on_drum::<D>();
         let n = model.dofs().len();
         let x = DVector::zeros(n);
@@ -968,6 +1009,7 @@ mod tests {
         let rho = contact_weights(k.as_ref(), &rows);
         let mut solver = GlobalContactSolver {
             quasi_definite_from,
+            lu_until,
             ..Default::default()
         };
         let (mut dx, mut r) = (DVector::zeros(n), DVector::zeros(rows.rows.len()));
@@ -1047,20 +1089,23 @@ mod tests {
 
     #[test]
     fn global_iteration_solves_the_reduced_problem_2d() {
-        global_iteration_solves_the_reduced_problem::<2>(QUASI_DEFINITE_FROM);
+        global_iteration_solves_the_reduced_problem::<2>(QUASI_DEFINITE_FROM, LU_UNTIL);
     }
 
     #[test]
     fn global_iteration_solves_the_reduced_problem_3d() {
-        global_iteration_solves_the_reduced_problem::<3>(QUASI_DEFINITE_FROM);
+        global_iteration_solves_the_reduced_problem::<3>(QUASI_DEFINITE_FROM, LU_UNTIL);
     }
 
     /// The same on the preconditioned path (GMRES on the quasi-definite factors, in the
-    /// nested-dissection order) that systems of 2,000 equations and more take.
+    /// nested-dissection order) that systems of 2,000 equations and more take, with the LU
+    /// factorization as the last resort or, as from [`LU_UNTIL`] equations, without it.
     #[test]
     fn preconditioned_global_iteration_solves_the_reduced_problem() {
-        global_iteration_solves_the_reduced_problem::<2>(0);
-        global_iteration_solves_the_reduced_problem::<3>(0);
+        for lu_until in [LU_UNTIL, 0] {
+            global_iteration_solves_the_reduced_problem::<2>(0, lu_until);
+            global_iteration_solves_the_reduced_problem::<3>(0, lu_until);
+        }
     }
 
     /// Earlier factors are reused where the iterations they are expected to add cost less

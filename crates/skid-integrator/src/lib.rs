@@ -48,5 +48,5 @@ pub use model::{ContactPair, Model, PressureLoad, SolidPart, Tie};
 pub use state::State;
 pub use stepper::{
     Adaptive, Checkpoint, IncrementReport, Observer, RunStatistics, Settings, Step, StepKind,
-    resume, run,
+    StepStatistics, resume, run,
 };

@@ -553,6 +553,25 @@ pub struct RunStatistics {
     pub solves: SolveCounts,
     /// Wall time of the whole run.
     pub wall_time: Duration,
+    /// The part of each step reached, in order.
+    #[serde(default)]
+    pub steps: Vec<StepStatistics>,
+}
+
+/// The cost of one step of a run.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StepStatistics {
+    /// The step's name.
+    pub name: String,
+    /// Its converged increments.
+    pub increments: usize,
+    /// Their Newton iterations.
+    pub newton_iterations: usize,
+    /// Factorizations and GMRES iterations (all attempts).
+    pub solves: SolveCounts,
+    /// Wall time spent in the step: every attempt, the outputs and restart files of its
+    /// increments included.
+    pub wall_time: Duration,
 }
 
 /// The state before the first step: undeformed, rigid bodies at their initial velocities,
@@ -953,6 +972,9 @@ impl<const D: usize> Run<'_, D> {
             increment: 0,
             adaptive: None,
         });
+        stats.steps.resize_with(index + 1, StepStatistics::default);
+        stats.steps[index].name.clone_from(&step.name);
+        let (spent, started) = (stats.steps[index].wall_time, Instant::now());
         let mut consecutive_failures = 0;
         while progress < 1.0 - 1e-12 {
             let dp = size.min(1.0 - progress);
@@ -982,6 +1004,9 @@ impl<const D: usize> Run<'_, D> {
                 &mut stats.timings,
             );
             stats.solves.add_between(&before, &workspace.counts());
+            stats.steps[index]
+                .solves
+                .add_between(&before, &workspace.counts());
             match solved {
                 Ok((mut next, counters)) => {
                     let mut next_size = None;
@@ -1010,6 +1035,9 @@ impl<const D: usize> Run<'_, D> {
                     stats.fixed_point_iterations += counters.fixed_point_iterations;
                     stats.contact_newton_steps += counters.contact_newton_steps;
                     stats.contact_fallbacks += counters.contact_fallbacks;
+                    let cost = &mut stats.steps[index];
+                    cost.increments += 1;
+                    cost.newton_iterations += counters.newton_iterations;
                     self.observer.on_increment(
                         model,
                         &IncrementReport {
@@ -1029,6 +1057,7 @@ impl<const D: usize> Run<'_, D> {
                         size = (size * settings.cutback.growth_factor).min(nominal);
                         successes = 0;
                     }
+                    stats.steps[index].wall_time = spent + started.elapsed();
                     self.offer_checkpoint(progress >= 1.0 - 1e-12, workspace, |workspace| {
                         Checkpoint {
                             state: state.clone(),
@@ -1048,6 +1077,7 @@ impl<const D: usize> Run<'_, D> {
                     })?;
                 }
                 Err(cause) => {
+                    stats.steps[index].wall_time = spent + started.elapsed();
                     stats.cutbacks += 1;
                     *stats
                         .cutback_causes
@@ -1076,6 +1106,7 @@ impl<const D: usize> Run<'_, D> {
                 }
             }
         }
+        stats.steps[index].wall_time = spent + started.elapsed();
         Ok(state)
     }
 }

@@ -49,6 +49,25 @@ pub struct RunCost {
     pub linear_solve_s: f64,
     /// Of which: conic solves, s.
     pub contact_solve_s: f64,
+    /// The cost of each step reached, in order.
+    pub steps: Vec<StepCost>,
+}
+
+/// The cost of one step of a run.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct StepCost {
+    /// The step's name.
+    pub step: String,
+    /// Its converged increments.
+    pub increments: usize,
+    /// Their Newton iterations.
+    pub newton_iterations: usize,
+    /// Factorizations of every kind (tangent, LU, quasi-definite), all attempts.
+    pub factorizations: usize,
+    /// GMRES iterations, all attempts.
+    pub krylov_iterations: usize,
+    /// Wall time spent in the step (outputs of its increments included), s.
+    pub wall_time_s: f64,
 }
 
 impl From<&RunStatistics> for RunCost {
@@ -73,6 +92,20 @@ impl From<&RunStatistics> for RunCost {
             assembly_s: stats.timings.assembly.as_secs_f64(),
             linear_solve_s: stats.timings.linear_solve.as_secs_f64(),
             contact_solve_s: stats.timings.contact_solve.as_secs_f64(),
+            steps: stats
+                .steps
+                .iter()
+                .map(|s| StepCost {
+                    step: s.name.clone(),
+                    increments: s.increments,
+                    newton_iterations: s.newton_iterations,
+                    factorizations: s.solves.tangent_factorizations
+                        + s.solves.lu_factorizations
+                        + s.solves.preconditioner_factorizations,
+                    krylov_iterations: s.solves.krylov_iterations,
+                    wall_time_s: s.wall_time.as_secs_f64(),
+                })
+                .collect(),
         }
     }
 }

@@ -22,8 +22,8 @@ pub struct ScalingStudy {
     pub dt: f64,
     /// `--threads` of the runs.
     pub threads: usize,
-    /// The dynamic increments of the two runs per level whose difference is the dynamic cost.
-    pub dynamic_increments: [usize; 2],
+    /// The dynamic increments of each level's run.
+    pub dynamic_increments: usize,
     /// The levels.
     pub records: Vec<ScalingRecord>,
 }
@@ -41,18 +41,20 @@ pub struct ScalingRecord {
     pub equations: Option<usize>,
     /// Contact candidates.
     pub contact_candidates: Option<usize>,
-    /// Wall time of the longer run, s.
+    /// Wall time of the run, s.
     pub wall_time_s: Option<f64>,
-    /// Wall time per dynamic increment: the difference of the two runs over the difference of
-    /// their dynamic increments, s.
+    /// Wall time per dynamic increment: the dynamic step's wall time over its increments, s.
     pub dynamic_increment_s: Option<f64>,
-    /// Wall time per Newton iteration of the dynamic increments, likewise, s.
+    /// Wall time per Newton iteration of the dynamic step, s.
     pub dynamic_iteration_s: Option<f64>,
     /// Newton iterations per dynamic increment.
     pub dynamic_newton_per_increment: Option<f64>,
     /// Factorizations (tangent, LU and preconditioner) per dynamic increment.
     pub dynamic_factorizations_per_increment: Option<f64>,
-    /// The largest resident set of the longer run's process, MB.
+    /// GMRES iterations per dynamic increment.
+    #[serde(default)]
+    pub dynamic_krylov_per_increment: Option<f64>,
+    /// The largest resident set of the run's process, MB.
     pub peak_memory_mb: Option<f64>,
 }
 
@@ -128,16 +130,15 @@ pub fn section(
     let _ = writeln!(
         text,
         "`scripts/scaling.py` (`{}`): `{}` at a ladder of pad meshes (circumferential x radial \
-         x axial), each level run twice, with {} and {} dynamic increments of {} s after the \
-         static preload, at `--threads {}`; the cost of a dynamic increment is the difference \
-         of the two runs' wall times over the difference of their increments, so the preload \
-         is not counted. Peak memory: the largest resident set of the longer run's process. \
+         x axial), each level run once, with {} dynamic increments of {} s after the static \
+         preload, at `--threads {}`; the cost of a dynamic increment is the dynamic step's own \
+         wall time over its increments, so the preload is not counted. Peak memory: the \
+         largest resident set of the run's process (the preload's included). \
          The exponent `p` of `cost ~ n^p` (n equations) is fitted by least squares over the \
          completed levels.\n",
         source.display(),
         study.case,
-        study.dynamic_increments[0],
-        study.dynamic_increments[1],
+        study.dynamic_increments,
         study.dt,
         study.threads
     );
@@ -146,8 +147,8 @@ pub fn section(
     text.push_str(
         "| contact solve | mesh | equations | contact candidates | status | per dynamic \
          increment [s] | per Newton iteration [s] | Newton iterations per increment | \
-         factorizations per increment | peak memory [MB] |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n",
+         factorizations per increment | GMRES iterations per increment | peak memory [MB] |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let number = |v: Option<f64>, digits: usize| {
         v.map_or_else(|| "n/a".to_string(), |v| format!("{v:.digits$}"))
@@ -156,7 +157,7 @@ pub fn section(
     for r in &study.records {
         let _ = writeln!(
             text,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.method,
             r.mesh,
             count(r.equations),
@@ -166,6 +167,7 @@ pub fn section(
             number(r.dynamic_iteration_s, 4),
             number(r.dynamic_newton_per_increment, 2),
             number(r.dynamic_factorizations_per_increment, 2),
+            number(r.dynamic_krylov_per_increment, 1),
             number(r.peak_memory_mb, 0),
         );
     }
@@ -244,13 +246,14 @@ mod tests {
             dynamic_iteration_s: Some(t / 3.0),
             dynamic_newton_per_increment: Some(3.0),
             dynamic_factorizations_per_increment: Some(1.5),
+            dynamic_krylov_per_increment: Some(9.0),
             peak_memory_mb: Some(n as f64 / 100.0),
         };
         let study = ScalingStudy {
             case: "cases/drum/3d-analytic.json".into(),
             dt: 1e-4,
             threads: 1,
-            dynamic_increments: [2, 6],
+            dynamic_increments: 4,
             records: vec![
                 record("10 x 1 x 1", 100, 1e-3, "completed"),
                 record("40 x 8 x 8", 10_000, 1e-1, "completed"),

@@ -6,6 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use serde_json::Value;
+
 /// The `skid` binary of this build.
 pub fn skid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_skid"))
@@ -75,4 +77,36 @@ pub fn files_with(extension: &str) -> Vec<PathBuf> {
 /// Every entry of the corpus.
 pub fn entries() -> Vec<Entry> {
     files_with("expect").iter().map(|p| read_entry(p)).collect()
+}
+
+/// Keys of `summary.json` (at any depth, the per-step costs included) and `batch.json` that
+/// hold wall times.
+pub const TIMING_KEYS: [&str; 4] = [
+    "wall_time_s",
+    "assembly_s",
+    "linear_solve_s",
+    "contact_solve_s",
+];
+
+/// `value` without its [`TIMING_KEYS`], at any depth; panics if it held none of them, so that a
+/// renamed timing field cannot make the comparison fail for the wrong reason or pass unseen.
+pub fn without_timings(mut value: Value) -> Value {
+    fn strip(value: &mut Value, removed: &mut usize) {
+        match value {
+            Value::Object(map) => {
+                for key in TIMING_KEYS {
+                    if map.remove(key).is_some() {
+                        *removed += 1;
+                    }
+                }
+                map.values_mut().for_each(|v| strip(v, removed));
+            }
+            Value::Array(items) => items.iter_mut().for_each(|v| strip(v, removed)),
+            _ => {}
+        }
+    }
+    let mut removed = 0;
+    strip(&mut value, &mut removed);
+    assert!(removed > 0, "no timing field found in {value}");
+    value
 }
