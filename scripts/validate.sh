@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The drum validation: builds skid (release); runs every drum idealization of cases/drum and
 # every hard case of cases/hard in parallel, and the convergence study (scripts/convergence.sh);
-# writes the report validation/report.md (benchmark, hard cases, convergence) with its plots;
+# runs the verification scenes of cases/verification (block on a flat and an incline, Hertz);
+# writes the report validation/report.md (benchmark, hard cases, convergence, verification)
+# with its plots;
 # checks that the input decks of cases/inp stop where their case files do (scripts/check_decks.py);
 # and checks the 2D benchmark's convergence in time step, its insensitivity to the pad density,
 # that the conic (clarabel) Coulomb solve gives the run of the default Newton-first one, and
@@ -22,8 +24,11 @@ hard=(${HARD_CASES:-cases/hard})
 rm -rf out/hard # runs of cases left out must not stay in the report
 "$skid" batch "${hard[@]}" --out out/hard || status=1
 SKID="$skid" scripts/convergence.sh out/convergence || status=1
+# the verification scenes by their files (the deck 2d-block-on-incline.inp repeats a name)
+rm -rf out/verification
+"$skid" batch cases/verification/*.json --out out/verification >/dev/null || status=1
 "$skid" report --runs out/drum --hard out/hard --convergence out/convergence \
-    --out validation/report.md || status=1
+    --verification out/verification --out validation/report.md || status=1
 
 out=out/validation
 mkdir -p "$out"

@@ -6,12 +6,15 @@
 //!   steps and settings), each problem reported with its field path;
 //! - [`history`]: the generic `history.csv` (every body's motions, every pair's resultants,
 //!   the energy ledger);
-//! - [`summary`]: the generic `summary.json`.
+//! - [`summary`]: the generic `summary.json`;
+//! - [`contact_nodes`]: every contact candidate's position and forces at the end of the run
+//!   (`contact_nodes.csv`).
 //!
 //! A case file of the drum benchmark is generated into a model file by
 //! [`crate::drum::model_spec`], and runs through the same [`build()`].
 
 pub mod build;
+pub mod contact_nodes;
 pub mod history;
 pub mod spec;
 pub mod summary;

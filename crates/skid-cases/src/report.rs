@@ -6,7 +6,10 @@
 //!   (DRUM.md section 3), with [`plot`]'s omega plots;
 //! - the hard cases ([`hard`]): checks derived from each run's case;
 //! - the convergence study ([`convergence`]): t_stop and e_slide against mesh and time-step
-//!   refinement with observed orders, and Newton residual histories.
+//!   refinement with observed orders, and Newton residual histories;
+//! - the cost against problem size ([`scaling`]);
+//! - the verification scenes ([`verification`]): runs of `cases/verification` against their
+//!   analytic answers (Hertz contact, [`hertz`]; Coulomb friction).
 //!
 //! The sweep report ([`sweep`]) is a report of its own: the runs of parameter sweeps, merged
 //! from the batch directories of their shards.
@@ -17,10 +20,12 @@
 pub mod convergence;
 pub mod format;
 pub mod hard;
+pub mod hertz;
 pub mod markdown;
 pub mod plot;
 pub mod scaling;
 pub mod sweep;
+pub mod verification;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -258,7 +263,11 @@ pub fn e_slide(run: &History, t_stop: f64, omega0: f64, reference: &History) -> 
     Some(worst)
 }
 
-fn read(path: &Path) -> Result<String, ReportError> {
+/// The text of `path`.
+///
+/// # Errors
+/// [`ReportError::Read`].
+pub(crate) fn read(path: &Path) -> Result<String, ReportError> {
     std::fs::read_to_string(path).map_err(|source| ReportError::Read {
         path: path.to_path_buf(),
         source,
@@ -361,6 +370,9 @@ pub struct ReportSources<'a> {
     /// The measurements of cost against problem size (`scaling.json` of
     /// `scripts/scaling.py`).
     pub scaling: Option<&'a Path>,
+    /// Runs of the verification scenes (`skid batch cases/verification/*.json`), one
+    /// subdirectory per run.
+    pub verification: Option<&'a Path>,
 }
 
 /// What [`write_report`] wrote and found.
@@ -397,6 +409,13 @@ fn regenerate(sources: &ReportSources<'_>, out: &Path) -> String {
         let dir = scaling.parent().unwrap_or(Path::new("."));
         commands.push(format!("scripts/scaling.py --out {}", dir.display()));
         let _ = write!(report, " --scaling {}", scaling.display());
+    }
+    if let Some(verification) = sources.verification {
+        commands.push(format!(
+            "skid batch cases/verification/*.json --out {}",
+            verification.display()
+        ));
+        let _ = write!(report, " --verification {}", verification.display());
     }
     let _ = write!(report, " --out {}", out.display());
     commands.push(report);
@@ -460,6 +479,14 @@ pub fn write_report(sources: &ReportSources<'_>, out: &Path) -> Result<ReportOut
         text.push('\n');
         text.push_str(&section);
         files.extend(plots);
+    }
+    if let Some(verification_dir) = sources.verification {
+        let runs = verification::load(verification_dir)?;
+        let (section, n, plots) = verification::section(verification_dir, &runs, dir)?;
+        text.push('\n');
+        text.push_str(&section);
+        files.extend(plots);
+        counts += n;
     }
     let _ = write!(text, "\n## All checks\n\n{}\n", counts.line());
     write_atomic(out, &text).map_err(|source| ReportError::Write {

@@ -26,6 +26,7 @@ use crate::csv_out::CsvMark;
 use crate::deck::{is_deck, read_model};
 use crate::fields::{self, DrumOutline, FieldWriter};
 use crate::history::DrumRecorder;
+use crate::model_file::contact_nodes;
 use crate::model_file::history::ModelRecorder;
 use crate::model_file::summary::{ModelSummary, summarize as summarize_model};
 use crate::model_file::{self, ModelSpec, declares_model};
@@ -471,6 +472,7 @@ fn clear_outputs(dir: &Path) -> Result<(), CaseError> {
     for stale in [
         "history.csv",
         NEWTON_CSV,
+        contact_nodes::CONTACT_NODES_CSV,
         "summary.json",
         CASE_JSON,
         MODEL_JSON,
@@ -574,6 +576,10 @@ fn run_model_in<const D: usize>(
     );
     let record = history.finish().map_err(output(history_path))?;
     newton.finish().map_err(output(dir.join(NEWTON_CSV)))?;
+    if let Ok(state) = &result {
+        let path = dir.join(contact_nodes::CONTACT_NODES_CSV);
+        contact_nodes::write(dir, &scene.model, state).map_err(output(path))?;
+    }
     let summary = summarize_model(
         &spec.name,
         &scene.model,

@@ -107,8 +107,10 @@ enum Command {
         shard: Option<String>,
     },
     /// The validation report (markdown with SVG plots): the benchmark runs against a reference
-    /// run, the hard-case checks, the convergence study; each section from its own directory.
-    /// With none of --runs, --hard, --convergence, --sweep: the benchmark section of `out`.
+    /// run, the hard-case checks, the convergence study, the cost against problem size, the
+    /// verification scenes against their analytic answers; each section from its own
+    /// directory. With none of --runs, --hard, --convergence, --scaling, --verification,
+    /// --sweep: the benchmark section of `out`.
     /// With --sweep: the sweep report instead, merged from batch directories.
     Report {
         /// Benchmark runs: one subdirectory per run (summary.json, history.csv).
@@ -128,10 +130,15 @@ enum Command {
         /// Cost against problem size: the scaling.json of `scripts/scaling.py`.
         #[arg(long)]
         scaling: Option<PathBuf>,
+        /// Verification scenes (`skid batch cases/verification/*.json`): one subdirectory per
+        /// run, each checked against the analytic answer of its model (Hertz contact, Coulomb
+        /// friction).
+        #[arg(long, value_name = "DIR")]
+        verification: Option<PathBuf>,
         /// Sweep report: the sweep runs listed by the batch.json of each directory (one
         /// `skid batch` of sweep files, or its shards), one table per sweep in run order.
         #[arg(long, num_args = 1.., value_name = "DIR",
-              conflicts_with_all = ["runs", "reference", "hard", "convergence", "scaling"])]
+              conflicts_with_all = ["runs", "reference", "hard", "convergence", "scaling", "verification"])]
         sweep: Vec<PathBuf>,
         /// The markdown report; the plots are written beside it [default: validation/report.md,
         /// with --sweep out/sweep.md].
@@ -210,6 +217,7 @@ fn main() -> ExitCode {
             hard,
             convergence,
             scaling,
+            verification,
             sweep,
             out,
         } => {
@@ -218,8 +226,8 @@ fn main() -> ExitCode {
                 return report::run_sweep(&sweep, &out);
             }
             let out = out.unwrap_or_else(|| PathBuf::from("validation/report.md"));
-            let runs = match (&runs, &hard, &convergence, &scaling) {
-                (None, None, None, None) => Some(PathBuf::from("out")),
+            let runs = match (&runs, &hard, &convergence, &scaling, &verification) {
+                (None, None, None, None, None) => Some(PathBuf::from("out")),
                 _ => runs,
             };
             let sources = ReportSources {
@@ -228,6 +236,7 @@ fn main() -> ExitCode {
                 hard: hard.as_deref(),
                 convergence: convergence.as_deref(),
                 scaling: scaling.as_deref(),
+                verification: verification.as_deref(),
             };
             report::run(&sources, &out)
         }

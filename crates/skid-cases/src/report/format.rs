@@ -1,4 +1,4 @@
-//! Number formatting and check counts shared by the report's sections.
+//! Number formatting, check lists and check counts shared by the report's sections.
 
 use std::fmt::Write as _;
 
@@ -31,6 +31,51 @@ impl Counts {
             self.passed, self.failed, self.skipped
         );
         s
+    }
+}
+
+/// An acceptance list being written: one markdown line per check, and the counts.
+#[derive(Debug, Default)]
+pub struct Checks {
+    /// The list so far.
+    pub text: String,
+    /// Its counts.
+    pub counts: Counts,
+}
+
+impl Checks {
+    /// A check that `value < limit`; `None` (not measurable) fails, `why` says why.
+    pub fn check(&mut self, label: &str, value: Option<f64>, limit: f64, why: &str) {
+        match value {
+            Some(v) => self.record(label, v < limit, Sig(v).to_string()),
+            None => self.record(label, false, why.to_string()),
+        }
+    }
+
+    /// [`Self::check`] of a relative difference, shown in percent.
+    pub fn check_fraction(&mut self, label: &str, value: Option<f64>, limit: f64, why: &str) {
+        match value {
+            Some(v) => self.record(label, v < limit, format!("{} %", Sig(100.0 * v))),
+            None => self.record(label, false, why.to_string()),
+        }
+    }
+
+    /// A check that passed (`ok`) or failed, with what it found.
+    pub fn record(&mut self, label: &str, ok: bool, shown: String) {
+        let verdict = if ok {
+            self.counts.passed += 1;
+            "PASS"
+        } else {
+            self.counts.failed += 1;
+            "FAIL"
+        };
+        let _ = writeln!(self.text, "- **{verdict}** {label}: {shown}");
+    }
+
+    /// A check that could not be made, and why.
+    pub fn skip(&mut self, label: &str, why: &str) {
+        self.counts.skipped += 1;
+        let _ = writeln!(self.text, "- SKIPPED {label}: {why}");
     }
 }
 

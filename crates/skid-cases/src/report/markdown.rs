@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::format::{Counts, Sig, percent, show};
+use super::format::{Checks, Counts, percent, show};
 use super::plot::{DIFFERENCE_SVG, OMEGA_SVG};
 use super::{Run, e_slide};
 
@@ -33,46 +33,6 @@ const BENCHMARK: [&str; 9] = [
     "3d-c3d4",
     "3d-analytic-fine",
 ];
-
-/// The acceptance list being written.
-struct Checks {
-    text: String,
-    counts: Counts,
-}
-
-impl Checks {
-    /// A check that `value < limit`; `None` (not measurable) fails, `why` says why.
-    fn check(&mut self, label: &str, value: Option<f64>, limit: f64, why: &str) {
-        match value {
-            Some(v) => self.record(label, v < limit, Sig(v).to_string()),
-            None => self.record(label, false, why.to_string()),
-        }
-    }
-
-    /// [`Self::check`] of a relative difference, shown in percent.
-    fn check_fraction(&mut self, label: &str, value: Option<f64>, limit: f64, why: &str) {
-        match value {
-            Some(v) => self.record(label, v < limit, format!("{} %", Sig(100.0 * v))),
-            None => self.record(label, false, why.to_string()),
-        }
-    }
-
-    fn record(&mut self, label: &str, ok: bool, shown: String) {
-        let verdict = if ok {
-            self.counts.passed += 1;
-            "PASS"
-        } else {
-            self.counts.failed += 1;
-            "FAIL"
-        };
-        let _ = writeln!(self.text, "- **{verdict}** {label}: {shown}");
-    }
-
-    fn skip(&mut self, label: &str, why: &str) {
-        self.counts.skipped += 1;
-        let _ = writeln!(self.text, "- SKIPPED {label}: {why}");
-    }
-}
 
 /// `|a - b| / min(|a|, |b|)`: the relative difference, symmetric and the stricter of the two.
 fn relative(a: f64, b: f64) -> f64 {
@@ -130,10 +90,7 @@ fn table(runs: &[Run], measures: &[Measures], out: &mut String) {
 }
 
 fn acceptance(runs: &[Run], measures: &[Measures], reference: usize) -> Checks {
-    let mut c = Checks {
-        text: String::new(),
-        counts: Counts::default(),
-    };
+    let mut c = Checks::default();
     let no_stop = "the drum did not stop";
     for (i, (run, m)) in runs.iter().zip(measures).enumerate() {
         let name = &run.name;

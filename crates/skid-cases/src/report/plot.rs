@@ -18,6 +18,8 @@ pub const HARD_OMEGA_SVG: &str = "hard-omega.svg";
 pub const NEWTON_SVG: &str = "newton.svg";
 /// File name of the plot of cost against problem size.
 pub const SCALING_SVG: &str = "scaling.svg";
+/// File name of the Hertz contact pressure plot of the verification section.
+pub const HERTZ_SVG: &str = "hertz-pressure.svg";
 
 /// The time axis of the benchmark plots.
 const TIME_AXIS: &str = "t [s] (from the start of the dynamic step)";
@@ -350,6 +352,54 @@ pub fn plot_log_log(
         }
         draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)
     })
+}
+
+/// `hertz-pressure.svg`: the contact pressure of a Hertz run, `p / p0` against `|x| / a`, its
+/// nodes with `x >= 0` and those with `x <= 0` (mirrored) as two curves, and the analytic
+/// `sqrt(1 - x^2 / a^2)` (dashed) out to `x = a`; `profile` holds `(x, p)` in order of x.
+///
+/// # Errors
+/// [`ReportError`] if the plot cannot be drawn or written.
+pub fn plot_hertz_pressure(
+    title: &str,
+    profile: &[(f64, f64)],
+    (half_width, peak): (f64, f64),
+    path: &Path,
+) -> Result<(), ReportError> {
+    let scaled = |&(x, p): &(f64, f64)| (x.abs() / half_width, p / peak);
+    let right: Vec<(f64, f64)> = profile.iter().filter(|p| p.0 >= 0.0).map(scaled).collect();
+    let mut left: Vec<(f64, f64)> = profile.iter().filter(|p| p.0 <= 0.0).map(scaled).collect();
+    left.reverse();
+    let analytic = (0..=100)
+        .map(|k| {
+            let s = f64::from(k) / 100.0;
+            (s, (1.0 - s * s).sqrt())
+        })
+        .collect();
+    let curves = [
+        Curve {
+            label: "FE, x >= 0".into(),
+            points: right,
+            dashed: false,
+        },
+        Curve {
+            label: "FE, x <= 0 (mirrored)".into(),
+            points: left,
+            dashed: false,
+        },
+        Curve {
+            label: "Hertz p0 sqrt(1 - x^2/a^2)".into(),
+            points: analytic,
+            dashed: true,
+        },
+    ];
+    draw(
+        path,
+        title,
+        ("|x| / a (a, p0: Hertz)", "p / p0"),
+        &curves,
+        SeriesLabelPosition::UpperRight,
+    )
 }
 
 #[cfg(test)]

@@ -1,0 +1,460 @@
+//! The verification section of the report: the scenes of `cases/verification` whose answer is
+//! known, checked against it from their run directories (`skid batch cases/verification/*.json
+//! --out DIR`: each run's `model.json`, `summary.json`, `history.csv`, `contact_nodes.csv`).
+//! Every scene is recognised by what its model holds, and its analytic answer computed from
+//! that model:
+//!
+//! - Hertz ([`hertz`]): a rigid cylinder pressed frictionlessly on an elastic block, one run
+//!   per mesh level: a table of half-width and peak pressure against the mesh, checks on the
+//!   finest level (peak pressure within [`PEAK_TOLERANCE`], half-width within one element)
+//!   and on convergence (the half-width error shrinks with every refinement; the peak
+//!   pressure's change from one level to the next shrinks too, so that it converges, to
+//!   whatever the finite block and finite strain make of Hertz's answer), and the pressure
+//!   plot of the finest level;
+//! - Coulomb friction (any other scene with a frictional pair): the friction resultant never
+//!   exceeds `mu` times the normal one, `|T| <= mu N (1 + tol)`, in any increment; and in the
+//!   last increment in which every closed contact slides (there must be one), `|T| = mu N` to
+//!   [`COULOMB_TOLERANCE`] (in 3D the slip directions settle first, and the resultant of
+//!   forces in different directions is short of `mu N` until they have).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::format::{Checks, Counts, Sig, percent, show};
+use super::hertz::{self, HertzMeasure, HertzScene};
+use super::plot::{HERTZ_SVG, plot_hertz_pressure};
+use super::{ReportError, read};
+use crate::csv_out::CsvTable;
+use crate::model_file::ModelSpec;
+use crate::model_file::contact_nodes::CONTACT_NODES_CSV;
+use crate::runner::MODEL_JSON;
+
+/// Largest relative error of the finest Hertz level's peak pressure.
+pub const PEAK_TOLERANCE: f64 = 0.03;
+/// Relative tolerance of the Coulomb checks (the history carries 10 significant digits).
+pub const COULOMB_TOLERANCE: f64 = 1e-6;
+
+/// The fields of a model run's `summary.json` this section reads.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+pub struct SceneSummary {
+    /// `"completed"` or `"failed"`.
+    pub status: String,
+    /// Why the run stopped early, if it did.
+    #[serde(default)]
+    pub error: Option<String>,
+    /// Wall time of the run, s.
+    pub wall_time_s: f64,
+}
+
+/// One run of a verification scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneRun {
+    /// The run's directory name.
+    pub name: String,
+    /// The run directory.
+    pub dir: PathBuf,
+    /// The model as run (`model.json`).
+    pub spec: ModelSpec,
+    /// Its summary.
+    pub summary: SceneSummary,
+}
+
+impl SceneRun {
+    fn completed(&self) -> bool {
+        self.summary.status == "completed"
+    }
+}
+
+/// Reads every subdirectory of `dir` that holds a `summary.json` and a `model.json` (runs of
+/// model files), sorted by name.
+///
+/// # Errors
+/// [`ReportError`] if `dir` cannot be listed, a run's files are malformed, or there is none.
+pub fn load(dir: &Path) -> Result<Vec<SceneRun>, ReportError> {
+    let list = |source| ReportError::Read {
+        path: dir.to_path_buf(),
+        source,
+    };
+    let mut dirs = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(list)? {
+        let run = entry.map_err(list)?.path();
+        if run.join("summary.json").is_file() && run.join(MODEL_JSON).is_file() {
+            dirs.push(run);
+        }
+    }
+    if dirs.is_empty() {
+        return Err(ReportError::NoRuns(dir.to_path_buf()));
+    }
+    dirs.sort();
+    dirs.into_iter()
+        .map(|run| {
+            let parse = |path: PathBuf, what: &str| {
+                let text = read(&path)?;
+                Ok::<_, ReportError>((text, path, what.to_string()))
+            };
+            let (text, path, what) = parse(run.join(MODEL_JSON), "the model as run")?;
+            let spec: ModelSpec = serde_json::from_str(&text).map_err(|e| ReportError::Parse {
+                path: path.clone(),
+                message: format!("expected {what} (written by skid run): {e}"),
+            })?;
+            let (text, path, what) = parse(run.join("summary.json"), "a model run's summary")?;
+            let summary = serde_json::from_str(&text).map_err(|e| ReportError::Parse {
+                path: path.clone(),
+                message: format!("expected {what}: {e}"),
+            })?;
+            let name = run
+                .file_name()
+                .map_or_else(|| spec.name.clone(), |n| n.to_string_lossy().into());
+            Ok(SceneRun {
+                name,
+                dir: run,
+                spec,
+                summary,
+            })
+        })
+        .collect()
+}
+
+/// A completed Hertz run and what it measured.
+struct HertzLevel<'a> {
+    run: &'a SceneRun,
+    scene: HertzScene,
+    measure: HertzMeasure,
+}
+
+impl HertzLevel<'_> {
+    /// `(p_FE(0) - p0) / p0`.
+    fn peak_error(&self) -> f64 {
+        self.measure.peak_pressure / self.scene.peak_pressure() - 1.0
+    }
+
+    /// `a_FE - a`, m.
+    fn width_error(&self) -> f64 {
+        self.measure.half_width - self.scene.half_width()
+    }
+}
+
+/// The verification section for `runs` (read from `dir`), its plots written into `plots`:
+/// the text, the counts of its checks and the plot files.
+///
+/// # Errors
+/// [`ReportError`] if a completed run's `contact_nodes.csv` or `history.csv` is absent or
+/// malformed, or a plot cannot be written.
+pub fn section(
+    dir: &Path,
+    runs: &[SceneRun],
+    plots: &Path,
+) -> Result<(String, Counts, Vec<PathBuf>), ReportError> {
+    let mut out = format!(
+        "## Verification scenes\n\n\
+         Runs in `{}` (`skid batch cases/verification/*.json`), each checked against the \
+         analytic answer of its model as run.\n\n",
+        dir.display()
+    );
+    let mut checks = Checks::default();
+    let mut files = Vec::new();
+    let mut unchecked = Vec::new();
+    let mut hertz_runs = Vec::new();
+    let mut coulomb_runs = Vec::new();
+    for run in runs {
+        if let Some(scene) = HertzScene::recognise(&run.spec) {
+            hertz_runs.push((run, scene));
+        } else if run.spec.contact.iter().any(|p| p.mu > 0.0) {
+            coulomb_runs.push(run);
+        } else {
+            unchecked.push(run.name.as_str());
+        }
+    }
+    if !hertz_runs.is_empty() {
+        let (text, file) = hertz_section(&hertz_runs, plots, &mut checks)?;
+        out.push_str(&text);
+        files.extend(file);
+    }
+    if !coulomb_runs.is_empty() {
+        out.push_str(&coulomb_section(&coulomb_runs, &mut checks)?);
+    }
+    for name in unchecked {
+        checks.skip(
+            &format!("{name}: its checks"),
+            "no analytic answer known for it",
+        );
+    }
+    let counts = checks.counts;
+    let _ = write!(
+        out,
+        "### Acceptance\n\n{}\n{}\n",
+        checks.text,
+        counts.line()
+    );
+    Ok((out, counts, files))
+}
+
+/// The Hertz part of the section: table, plot and checks (see the module documentation).
+fn hertz_section(
+    runs: &[(&SceneRun, HertzScene)],
+    plots: &Path,
+    checks: &mut Checks,
+) -> Result<(String, Option<PathBuf>), ReportError> {
+    let mut levels = Vec::new();
+    for (run, scene) in runs {
+        if !run.completed() {
+            checks.record(
+                &format!("{}: status", run.name),
+                false,
+                run.summary
+                    .error
+                    .clone()
+                    .unwrap_or_else(|| run.summary.status.clone()),
+            );
+            continue;
+        }
+        let path = run.dir.join(CONTACT_NODES_CSV);
+        let nodes = hertz::read_candidates(&read(&path)?, &path, &scene.pair)?;
+        match hertz::measure(&nodes, scene.thickness) {
+            Ok(measure) => levels.push(HertzLevel {
+                run,
+                scene: scene.clone(),
+                measure,
+            }),
+            Err(why) => checks.record(&format!("{}: Hertz measures", run.name), false, why),
+        }
+    }
+    // Coarsest first.
+    levels.sort_by(|a, b| {
+        (b.measure.centre_element / b.scene.half_width())
+            .total_cmp(&(a.measure.centre_element / a.scene.half_width()))
+    });
+    let mut out = String::from(
+        "### Hertz: rigid cylinder on an elastic block (plane strain)\n\n\
+         `E* = E / (1 - nu^2)`, `a = sqrt(4 P R / (pi E*))`, `p0 = 2 P / (pi a)`, \
+         `p(x) = p0 sqrt(1 - x^2 / a^2)`, with `E` and `nu` the small-strain moduli of the \
+         material as run (`G = 2 (C10 + C01)`, `K = 2 / D1`) and `P` the cylinder's load over \
+         the thickness. The pressure of a node is its normal force over its tributary area (half \
+         its two segments, deformed, times the thickness; nominal: the reference segments); \
+         `p_FE(0)` is that of the node at x = 0; `a_FE` is half the reference distance between \
+         the outermost nodes carrying force, short of the discrete contact's edge by up to one \
+         element `h_edge`. `h` is the element size at the centre. RMS: of \
+         `(p_FE - p) / p0` over the nodes with |x| <= a.\n\n\
+         | run | a / h | closed nodes | a [mm] | a_FE [mm] | (a_FE - a) / h_edge \
+         | p0 [kPa] | p_FE(0) [kPa] | p_FE(0) vs p0 [%] | nominal p_FE(0) vs p0 [%] \
+         | RMS [% of p0] | resultant vs P [%] | wall time [s] |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for l in &levels {
+        let (s, m) = (&l.scene, &l.measure);
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} |",
+            l.run.name,
+            Sig(s.half_width() / m.centre_element),
+            m.closed,
+            Sig(1e3 * s.half_width()),
+            Sig(1e3 * m.half_width),
+            Sig(l.width_error() / m.edge_element),
+            Sig(1e-3 * s.peak_pressure()),
+            Sig(1e-3 * m.peak_pressure),
+            Sig(100.0 * l.peak_error()),
+            Sig(100.0 * (m.nominal_peak_pressure / s.peak_pressure() - 1.0)),
+            percent(hertz::profile_error(s, &m.profile)),
+            Sig(100.0 * (m.resultant / s.load - 1.0)),
+            l.run.summary.wall_time_s,
+        );
+    }
+    let Some(finest) = levels.last() else {
+        return Ok((out, None));
+    };
+    let name = &finest.run.name;
+    let plot = plots.join(HERTZ_SVG);
+    plot_hertz_pressure(
+        &format!("Hertz contact pressure, {name}"),
+        &finest.measure.profile,
+        (finest.scene.half_width(), finest.scene.peak_pressure()),
+        &plot,
+    )?;
+    let _ = write!(
+        out,
+        "\n![p(x) / p0 of {name} against Hertz]({HERTZ_SVG})\n\n"
+    );
+    checks.check_fraction(
+        &format!(
+            "{name} (finest): peak pressure within {} % of Hertz",
+            100.0 * PEAK_TOLERANCE
+        ),
+        Some(finest.peak_error().abs()),
+        PEAK_TOLERANCE,
+        "",
+    );
+    let edge = finest.measure.edge_element;
+    checks.record(
+        &format!("{name} (finest): half-width within one element (h_edge) of Hertz"),
+        finest.width_error().abs() <= edge,
+        format!(
+            "a_FE - a = {} mm, h_edge = {} mm",
+            Sig(1e3 * finest.width_error()),
+            Sig(1e3 * edge)
+        ),
+    );
+    if levels.len() < 3 {
+        checks.skip(
+            "Hertz: convergence with refinement",
+            "fewer than three mesh levels",
+        );
+        return Ok((out, Some(plot)));
+    }
+    for pair in levels.windows(2) {
+        let (coarse, fine) = (&pair[0], &pair[1]);
+        checks.record(
+            &format!(
+                "{} -> {}: the half-width error shrinks",
+                coarse.run.name, fine.run.name
+            ),
+            fine.width_error().abs() < coarse.width_error().abs(),
+            format!(
+                "{} mm -> {} mm",
+                Sig(1e3 * coarse.width_error()),
+                Sig(1e3 * fine.width_error())
+            ),
+        );
+    }
+    for three in levels.windows(3) {
+        let [p0, p1, p2] = [0, 1, 2].map(|k| three[k].measure.peak_pressure);
+        let (first, second) = ((p1 - p0).abs(), (p2 - p1).abs());
+        let ratio = three[0].measure.centre_element / three[1].measure.centre_element;
+        checks.record(
+            &format!(
+                "{} -> {} -> {}: the peak pressure converges (its change shrinks)",
+                three[0].run.name, three[1].run.name, three[2].run.name
+            ),
+            second < first,
+            format!(
+                "changes {} % then {} % of p0, observed order {}",
+                Sig(100.0 * first / three[0].scene.peak_pressure()),
+                Sig(100.0 * second / three[0].scene.peak_pressure()),
+                Sig((first / second).ln() / ratio.ln())
+            ),
+        );
+    }
+    Ok((out, Some(plot)))
+}
+
+/// The Coulomb part of the section (see the module documentation).
+fn coulomb_section(runs: &[&SceneRun], checks: &mut Checks) -> Result<String, ReportError> {
+    let mut out = String::from(
+        "### Coulomb friction of the block scenes\n\n\
+         Per frictional pair, from `history.csv`: the largest `|T| / (mu N)` over all \
+         increments, and `|T| / (mu N)` in the last increment in which every closed contact \
+         slides.\n\n\
+         | run | pair | mu | increments | max \\|T\\| / (mu N) | last sliding increment \
+         | there: \\|T\\| / (mu N) |\n|---|---|---|---|---|---|---|\n",
+    );
+    for run in runs {
+        if !run.completed() {
+            checks.record(
+                &format!("{}: status", run.name),
+                false,
+                run.summary
+                    .error
+                    .clone()
+                    .unwrap_or_else(|| run.summary.status.clone()),
+            );
+            continue;
+        }
+        let path = run.dir.join("history.csv");
+        let text = read(&path)?;
+        for pair in run.spec.contact.iter().filter(|p| p.mu > 0.0) {
+            let rows = friction_rows(&text, &path, &pair.name, run.spec.dimension)?;
+            let ratio =
+                |r: &FrictionRow| (r.normal > 0.0).then(|| r.tangential / (pair.mu * r.normal));
+            let worst = rows
+                .iter()
+                .filter_map(ratio)
+                .fold(None, |w: Option<f64>, v| Some(w.map_or(v, |w| w.max(v))));
+            let last_sliding = rows
+                .iter()
+                .rposition(|r| r.active > 0 && r.sliding == r.active);
+            let last = last_sliding.map(|k| &rows[k]);
+            let _ = writeln!(
+                out,
+                "| {} | {} | {} | {} | {} | {} | {} |",
+                run.name,
+                pair.name,
+                pair.mu,
+                rows.len(),
+                show(worst),
+                last_sliding
+                    .map_or_else(|| "none".into(), |k| format!("{} of {}", k + 1, rows.len())),
+                show(last.and_then(ratio)),
+            );
+            let label = format!("{} ({})", run.name, pair.name);
+            checks.record(
+                &format!("{label}: |T| <= mu N in every increment"),
+                worst.is_some_and(|w| w <= 1.0 + COULOMB_TOLERANCE),
+                format!("largest |T| / (mu N) {}", show(worst)),
+            );
+            checks.record(
+                &format!("{label}: |T| = mu N in the last increment in which every contact slides"),
+                last.and_then(ratio)
+                    .is_some_and(|v| (v - 1.0).abs() <= COULOMB_TOLERANCE),
+                last.map_or_else(
+                    || "no increment in which every closed contact slides".into(),
+                    |r| {
+                        format!(
+                            "{} contacts sliding, |T| / (mu N) = {}",
+                            r.sliding,
+                            show(ratio(r))
+                        )
+                    },
+                ),
+            );
+        }
+    }
+    Ok(out)
+}
+
+/// A pair's resultants in one increment of the history.
+struct FrictionRow {
+    normal: f64,
+    /// `|T|`, the norm of the friction resultant.
+    tangential: f64,
+    active: usize,
+    sliding: usize,
+}
+
+/// The rows of `pair` in a model run's `history.csv` text of dimension `dimension`.
+fn friction_rows(
+    text: &str,
+    path: &Path,
+    pair: &str,
+    dimension: usize,
+) -> Result<Vec<FrictionRow>, ReportError> {
+    let table = CsvTable::new(text, path)?;
+    let names: Vec<String> = (1..dimension)
+        .map(|k| format!("tangential_force_{k}"))
+        .chain(["normal_force", "active", "sliding"].map(String::from))
+        .map(|what| format!("{pair}.{what}"))
+        .collect();
+    let columns = names
+        .iter()
+        .map(|n| table.column(n))
+        .collect::<Result<Vec<_>, _>>()?;
+    let (tangential, rest) = columns.split_at(dimension - 1);
+    let [normal, active, sliding] = [rest[0], rest[1], rest[2]];
+    let mut rows = Vec::new();
+    for row in table {
+        let row = row?;
+        let mut t2 = 0.0;
+        for &c in tangential {
+            let t: f64 = row.number(c)?;
+            t2 += t * t;
+        }
+        rows.push(FrictionRow {
+            normal: row.number(normal)?,
+            tangential: t2.sqrt(),
+            active: row.number(active)?,
+            sliding: row.number(sliding)?,
+        });
+    }
+    Ok(rows)
+}
