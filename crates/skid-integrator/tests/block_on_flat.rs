@@ -337,11 +337,16 @@ fn bits(state: &State) -> String {
     serde_json::to_string(state).expect("state as JSON")
 }
 
-/// The counters of `stats` (its wall times zeroed).
+/// The counters of `stats` (its wall times, the steps' included, zeroed).
 fn counters(stats: &RunStatistics) -> RunStatistics {
+    let mut steps = stats.steps.clone();
+    for step in &mut steps {
+        step.wall_time = Default::default();
+    }
     RunStatistics {
         timings: Default::default(),
         wall_time: Default::default(),
+        steps,
         ..stats.clone()
     }
 }
