@@ -2,8 +2,8 @@
 # The drum validation: builds skid (release); runs every drum idealization of cases/drum and
 # every hard case of cases/hard in parallel, and the convergence study (scripts/convergence.sh);
 # runs the verification scenes of cases/verification (block on a flat and an incline, Hertz);
-# writes the report validation/report.md (benchmark, hard cases, convergence, verification)
-# with its plots;
+# writes the report validation/report.md (benchmark, hard cases, convergence, verification, and
+# the last measured scaling study and stress sweep of validation/) with its plots;
 # checks that the input decks of cases/inp stop where their case files do (scripts/check_decks.py);
 # and checks the 2D benchmark's convergence in time step, its insensitivity to the pad density,
 # that the conic (clarabel) Coulomb solve gives the run of the default Newton-first one, and
@@ -27,8 +27,13 @@ SKID="$skid" scripts/convergence.sh out/convergence || status=1
 # the verification scenes by their files (the deck 2d-block-on-incline.inp repeats a name)
 rm -rf out/verification
 "$skid" batch cases/verification/*.json --out out/verification >/dev/null || status=1
+# the cost against problem size and the stress sweep, as last measured (scripts/scaling.py and
+# scripts/stress.py take too long to run here)
+measured=()
+[ -f validation/scaling.json ] && measured+=(--scaling validation/scaling.json)
+[ -f validation/stress.json ] && measured+=(--stress validation/stress.json)
 "$skid" report --runs out/drum --hard out/hard --convergence out/convergence \
-    --verification out/verification --out validation/report.md || status=1
+    --verification out/verification "${measured[@]}" --out validation/report.md || status=1
 
 out=out/validation
 mkdir -p "$out"

@@ -8,6 +8,7 @@
 //! - the convergence study ([`convergence`]): t_stop and e_slide against mesh and time-step
 //!   refinement with observed orders, and Newton residual histories;
 //! - the cost against problem size ([`scaling`]);
+//! - the stress sweep of the solver ([`stress`]);
 //! - the verification scenes ([`verification`]): runs of `cases/verification` against their
 //!   analytic answers (Hertz contact, [`hertz`]; Coulomb friction).
 //!
@@ -24,6 +25,7 @@ pub mod hertz;
 pub mod markdown;
 pub mod plot;
 pub mod scaling;
+pub mod stress;
 pub mod sweep;
 pub mod verification;
 
@@ -370,6 +372,8 @@ pub struct ReportSources<'a> {
     /// The measurements of cost against problem size (`scaling.json` of
     /// `scripts/scaling.py`).
     pub scaling: Option<&'a Path>,
+    /// The records of the stress sweep (`stress.json` of `scripts/stress.py`).
+    pub stress: Option<&'a Path>,
     /// Runs of the verification scenes (`skid batch cases/verification/*.json`), one
     /// subdirectory per run.
     pub verification: Option<&'a Path>,
@@ -409,6 +413,11 @@ fn regenerate(sources: &ReportSources<'_>, out: &Path) -> String {
         let dir = scaling.parent().unwrap_or(Path::new("."));
         commands.push(format!("scripts/scaling.py --out {}", dir.display()));
         let _ = write!(report, " --scaling {}", scaling.display());
+    }
+    if let Some(stress) = sources.stress {
+        let dir = stress.parent().unwrap_or(Path::new("."));
+        commands.push(format!("scripts/stress.py --results {}", dir.display()));
+        let _ = write!(report, " --stress {}", stress.display());
     }
     if let Some(verification) = sources.verification {
         commands.push(format!(
@@ -479,6 +488,14 @@ pub fn write_report(sources: &ReportSources<'_>, out: &Path) -> Result<ReportOut
         text.push('\n');
         text.push_str(&section);
         files.extend(plots);
+    }
+    if let Some(stress_file) = sources.stress {
+        let sweep = stress::load(stress_file)?;
+        let (section, n, plots) = stress::section(stress_file, &sweep, dir)?;
+        text.push('\n');
+        text.push_str(&section);
+        files.extend(plots);
+        counts += n;
     }
     if let Some(verification_dir) = sources.verification {
         let runs = verification::load(verification_dir)?;

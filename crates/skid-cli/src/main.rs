@@ -108,9 +108,9 @@ enum Command {
     },
     /// The validation report (markdown with SVG plots): the benchmark runs against a reference
     /// run, the hard-case checks, the convergence study, the cost against problem size, the
-    /// verification scenes against their analytic answers; each section from its own
-    /// directory. With none of --runs, --hard, --convergence, --scaling, --verification,
-    /// --sweep: the benchmark section of `out`.
+    /// verification scenes against their analytic answers, the stress sweep; each section from
+    /// its own directory or file. With none of --runs, --hard, --convergence, --scaling,
+    /// --verification, --stress, --sweep: the benchmark section of `out`.
     /// With --sweep: the sweep report instead, merged from batch directories.
     Report {
         /// Benchmark runs: one subdirectory per run (summary.json, history.csv).
@@ -130,6 +130,9 @@ enum Command {
         /// Cost against problem size: the scaling.json of `scripts/scaling.py`.
         #[arg(long)]
         scaling: Option<PathBuf>,
+        /// The stress sweep of the solver: the stress.json of `scripts/stress.py`.
+        #[arg(long, value_name = "FILE")]
+        stress: Option<PathBuf>,
         /// Verification scenes (`skid batch cases/verification/*.json`): one subdirectory per
         /// run, each checked against the analytic answer of its model (Hertz contact, Coulomb
         /// friction).
@@ -138,7 +141,8 @@ enum Command {
         /// Sweep report: the sweep runs listed by the batch.json of each directory (one
         /// `skid batch` of sweep files, or its shards), one table per sweep in run order.
         #[arg(long, num_args = 1.., value_name = "DIR",
-              conflicts_with_all = ["runs", "reference", "hard", "convergence", "scaling", "verification"])]
+              conflicts_with_all = ["runs", "reference", "hard", "convergence", "scaling", "stress",
+                                    "verification"])]
         sweep: Vec<PathBuf>,
         /// The markdown report; the plots are written beside it [default: validation/report.md,
         /// with --sweep out/sweep.md].
@@ -217,6 +221,7 @@ fn main() -> ExitCode {
             hard,
             convergence,
             scaling,
+            stress,
             verification,
             sweep,
             out,
@@ -226,8 +231,8 @@ fn main() -> ExitCode {
                 return report::run_sweep(&sweep, &out);
             }
             let out = out.unwrap_or_else(|| PathBuf::from("validation/report.md"));
-            let runs = match (&runs, &hard, &convergence, &scaling, &verification) {
-                (None, None, None, None, None) => Some(PathBuf::from("out")),
+            let runs = match (&runs, &hard, &convergence, &scaling, &stress, &verification) {
+                (None, None, None, None, None, None) => Some(PathBuf::from("out")),
                 _ => runs,
             };
             let sources = ReportSources {
@@ -236,6 +241,7 @@ fn main() -> ExitCode {
                 hard: hard.as_deref(),
                 convergence: convergence.as_deref(),
                 scaling: scaling.as_deref(),
+                stress: stress.as_deref(),
                 verification: verification.as_deref(),
             };
             report::run(&sources, &out)

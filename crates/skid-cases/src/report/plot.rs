@@ -20,6 +20,8 @@ pub const NEWTON_SVG: &str = "newton.svg";
 pub const SCALING_SVG: &str = "scaling.svg";
 /// File name of the Hertz contact pressure plot of the verification section.
 pub const HERTZ_SVG: &str = "hertz-pressure.svg";
+/// File name of the stress sweep's plot of energy balance against time step.
+pub const STRESS_SVG: &str = "stress-energy.svg";
 
 /// The time axis of the benchmark plots.
 const TIME_AXIS: &str = "t [s] (from the start of the dynamic step)";
@@ -351,6 +353,70 @@ pub fn plot_log_log(
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color));
         }
         draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)
+    })
+}
+
+/// A scatter plot titled `title` on log scales in both axes: one set of points per `(label,
+/// [(x, y)])` (points with a non-positive value are left out), and a dashed horizontal line
+/// at `limit`'s value, labelled, if given: `stress-energy.svg` (each run's energy error
+/// against its time step, and the limit).
+///
+/// # Errors
+/// [`ReportError`] if the plot cannot be drawn or written.
+pub fn plot_scatter_log_log(
+    title: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+    (x_label, y_label): (&str, &str),
+    limit: Option<(String, f64)>,
+    path: &Path,
+) -> Result<(), ReportError> {
+    let positive = |p: &&(f64, f64)| p.0 > 0.0 && p.1 > 0.0 && p.0.is_finite() && p.1.is_finite();
+    let all = || series.iter().flat_map(|(_, p)| p.iter()).filter(positive);
+    let x = log_range(all().map(|p| p.0));
+    let y = log_range(all().map(|p| p.1).chain(limit.as_ref().map(|l| l.1)));
+    write_svg(path, |root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, ("sans-serif", 22))
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(72)
+            .build_cartesian_2d(x.clone().log_scale(), y.log_scale())
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .x_label_formatter(&|v| format!("{v:.0e}"))
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        for (k, (label, points)) in series.iter().enumerate() {
+            let color = Palette99::pick(k).to_rgba();
+            let points: Vec<(f64, f64)> = points.iter().filter(positive).copied().collect();
+            chart
+                .draw_series(
+                    points
+                        .into_iter()
+                        .map(|p| Circle::new(p, 3, color.filled())),
+                )
+                .map_err(|e| e.to_string())?
+                .label(label.as_str())
+                .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
+        }
+        if let Some((label, value)) = &limit {
+            let style = BLACK.stroke_width(2);
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(x.start, *value), (x.end, *value)],
+                    8,
+                    6,
+                    style,
+                ))
+                .map_err(|e| e.to_string())?
+                .label(label.as_str())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
+        }
+        draw_legend(&mut chart, SeriesLabelPosition::LowerRight)
     })
 }
 
