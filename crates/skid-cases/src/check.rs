@@ -14,7 +14,7 @@ use crate::model_file::{self, ModelSpec, Scene, declares_model};
 use crate::runner::read_deck_model;
 use crate::schema::Case;
 use crate::sweep::{declares_sweep, load_sweep};
-use crate::validate::{CaseError, load_case};
+use crate::validate::{CaseError, load_case, memory};
 
 /// The check of one input: a file, or one run of a sweep file.
 #[derive(Debug)]
@@ -63,7 +63,7 @@ pub fn check_path(path: &Path, overrides: &[String]) -> Vec<Checked> {
 }
 
 /// What an input that builds amounts to.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct CheckReport {
     /// What the file is: `case file`, `model file` or `deck`.
     pub kind: &'static str,
@@ -83,14 +83,20 @@ pub struct CheckReport {
     pub steps: usize,
     /// What skid reads differently from a deck's requests (empty for JSON files).
     pub notes: Vec<String>,
+    /// The memory a case file's run needs at least, bytes (the estimate that refuses a case too
+    /// large for the machine, [`crate::validate::memory`]); `None` for model files and decks.
+    pub memory_bytes: Option<f64>,
 }
 
 impl CheckReport {
-    /// The counts on one line: `case file, 2D, 1234 equations, ...`.
+    /// The counts on one line: `case file, 2D, 1234 equations, ...`, and the memory estimate.
     pub fn line(&self) -> String {
+        let memory = self.memory_bytes.map_or_else(String::new, |bytes| {
+            format!(", at least {} of memory", memory::human(bytes))
+        });
         format!(
             "{} '{}', {}D, {} equations, {} elements, {} rigid bodies, {} contact candidates, {} \
-             steps",
+             steps{memory}",
             self.kind,
             self.name,
             self.dimension,
@@ -137,7 +143,10 @@ fn check_case(case: &Case, source: &Path) -> Result<CheckReport, CaseError> {
         3 => counts(&case_scene::<3>(case, source)?),
         d => return Err(bad_dimension(source, d)),
     };
-    Ok(report("case file", &case.name, case.dimension, n))
+    Ok(CheckReport {
+        memory_bytes: Some(memory::estimate(case).iter().map(|t| t.bytes).sum()),
+        ..report("case file", &case.name, case.dimension, n)
+    })
 }
 
 /// Builds a model file's model.
@@ -228,5 +237,6 @@ fn report(
         contact_candidates,
         steps,
         notes: Vec::new(),
+        memory_bytes: None,
     }
 }

@@ -109,7 +109,8 @@ fn every_shipped_input_checks_ok_and_nothing_is_written() {
         analytic.contains("case file '2d-analytic', 2D,")
             && analytic.contains(" 10 elements, ")
             && analytic.contains(" 11 contact candidates, ")
-            && analytic.ends_with(" 2 steps)"),
+            && analytic.contains(" 2 steps, at least ")
+            && analytic.ends_with(" kB of memory)"),
         "{analytic}"
     );
     assert!(
