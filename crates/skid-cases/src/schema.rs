@@ -300,9 +300,9 @@ pub struct SolverSpec {
 
 impl Default for SolverSpec {
     fn default() -> Self {
-        let newton = skid_integrator::increment::NewtonSettings::default();
+        let newton = skid_integrator::settings::NewtonSettings::default();
         let coulomb = skid_contact::coulomb::CoulombSettings::default();
-        let cutback = skid_integrator::stepper::CutbackSettings::default();
+        let cutback = skid_integrator::settings::CutbackSettings::default();
         Self {
             max_newton_iterations: newton.max_iterations,
             force_tolerance: newton.force_tolerance,
@@ -339,7 +339,7 @@ impl From<CoulombMethodSpec> for skid_contact::coulomb::CoulombMethod {
 }
 
 /// How each Newton iteration obtains its contact forces (see
-/// `skid_integrator::increment::ContactSolve`).
+/// `skid_integrator::settings::ContactSolve`).
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum ContactSolveSpec {

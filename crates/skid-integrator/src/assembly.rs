@@ -12,7 +12,7 @@ use skid_fem::error::FemError;
 use skid_fem::pressure::pressure_face_forces;
 use skid_fem::solid::{ElementResponse, Tangent};
 
-use crate::coupling::{ContactRows, contact_coordinates};
+use crate::contact_rows::{ContactRows, contact_coordinates};
 use crate::error::{IncrementFailure, LinearFailure, ModelError};
 use crate::loads::LoadInstant;
 use crate::mixed::MixedPressures;
@@ -49,7 +49,7 @@ pub struct Assembler {
     pattern: SparsePattern,
     scatter: Vec<ElementScatter>,
     /// Per contact candidate (pairs in order, then their nodes), where its local coordinates'
-    /// stiffness goes (see [`crate::coupling::contact_coordinates`]).
+    /// stiffness goes (see [`crate::contact_rows::contact_coordinates`]).
     contact_scatter: Vec<ElementScatter>,
     diagonal: Vec<usize>,
     slot_position: Vec<(usize, usize)>,

@@ -1,12 +1,9 @@
-//! Contact rows of the Newton system and its reduction to the exact-Coulomb problem.
+//! The reduction of a contact-coupled Newton step to the exact-Coulomb problem in the contact
+//! forces (the reference path; [`crate::global_contact`] is the sparse one).
 //!
-//! For every contact candidate `c` (a slave node of a pair) the local quantities
-//! `u_c = (g, Delta s_1[, Delta s_2])` (normal gap at the end of the increment and the slip
-//! increment in the master surface's convected coordinates) are linearised in the global
-//! unknowns: `u_c(x + dx) ~ u_c(x) + H_c dx`. The rows of `H` hold the derivatives with respect
-//! to the node's components and the carrying body's translation and rotation.
-//!
-//! One Newton step solves `K_eff dx = -R + H^T r`, hence `dx = dx_0 + Z r` with
+//! With the contact rows `H` of [`crate::contact_rows`] (`u_c(x + dx) ~ u_c(x) + H_c dx` for the
+//! gap and slip of every candidate), one Newton step solves `K_eff dx = -R + H^T r`, hence
+//! `dx = dx_0 + Z r` with
 //! `dx_0 = -K_eff^{-1} R` and `Z = K_eff^{-1} H^T`, and the local quantities become
 //! `u = W r + q` with the Delassus operator `W = H Z` and `q = u(x) + H dx_0`. The contact
 //! forces `r` then come from the exact Coulomb law in (W, q) (see `skid_contact::coulomb`), and
@@ -21,166 +18,20 @@
 //! them open; one that the step would push into the surface joins the near set and the step is
 //! repeated.
 
-use nalgebra::{DMatrix, DVector, Vector2, Vector3};
+use nalgebra::DVector;
 use skid_contact::coulomb::{
     CoulombSettings, CoulombSolution, FrictionProblem, natural_map_length_error, solve_coulomb,
 };
 use skid_contact::error::ContactError;
-use skid_contact::kinematics::{
-    ContactKinematics, IncrementStart, RotatingFrame, evaluate, gap_discrete_gradient,
-    rotation_column, slip_increment,
-};
 
-use crate::error::{IncrementFailure, LinearFailure};
-use skid_fem::cell::embed;
+use crate::error::IncrementFailure;
 
 use std::time::Instant;
 
 use crate::assembly::Assembler;
-use crate::increment::Timings;
-use crate::model::Model;
+use crate::contact_rows::ContactRows;
+use crate::cost::Timings;
 use crate::sparse::Factorization;
-
-/// Linearised contact kinematics at one configuration.
-#[derive(Clone, Debug)]
-pub struct ContactRows {
-    /// Components per contact: 1 normal + (D - 1) tangential.
-    pub components: usize,
-    /// Sparse rows of H: (equation, coefficient); `components` rows per contact.
-    pub rows: Vec<Vec<(usize, f64)>>,
-    /// Current local quantities u (gap, slip increment per tangent), per row.
-    pub u: DVector<f64>,
-    /// Current convected coordinates per contact.
-    pub coords: Vec<Vector2<f64>>,
-    /// Friction coefficient per contact.
-    pub mu: Vec<f64>,
-    /// Per row, the second derivatives of its `u` in the candidate's local coordinates
-    /// `z = (node position [D], body translation [D], body angle)` (see [`contact_coordinates`]),
-    /// a symmetric `(2D + 1)^2` matrix.
-    pub curvature: Vec<DMatrix<f64>>,
-}
-
-impl ContactRows {
-    /// Number of contact candidates.
-    pub fn len(&self) -> usize {
-        self.coords.len()
-    }
-
-    /// True if there are no candidates.
-    pub fn is_empty(&self) -> bool {
-        self.coords.is_empty()
-    }
-
-    /// `H^T r`: the generalized contact forces on the equations.
-    pub fn transpose_times(&self, r: &DVector<f64>, n: usize) -> DVector<f64> {
-        let mut f = DVector::zeros(n);
-        for (row, &rk) in self.rows.iter().zip(r.iter()) {
-            for &(eq, c) in row {
-                f[eq] += c * rk;
-            }
-        }
-        f
-    }
-
-    /// The stiffness of the contact forces `r` of candidate `c` on its local coordinates:
-    /// `-sum_k r_k d^2 u_k / dz^2` over the candidate's rows. The force on the equations is
-    /// `H^T r`, so the residual `R - H^T r` has the derivative `K - H^T dr/dx - sum_k r_k
-    /// d^2 u_k/dx^2`; this is the last term, the geometric stiffness of contact on a curved or
-    /// rotating surface (a normal force on a convex drum softens the tangential motion by
-    /// `r_N / rho`). `None` for a candidate without force.
-    pub fn curvature_stiffness(&self, c: usize, r: &DVector<f64>) -> Option<DMatrix<f64>> {
-        let d = self.components;
-        let forces = (c * d..(c + 1) * d).map(|row| (row, r.get(row).copied().unwrap_or(0.0)));
-        forces
-            .filter(|&(_, force)| force != 0.0)
-            .map(|(row, force)| &self.curvature[row] * -force)
-            .reduce(|k, term| k + term)
-    }
-
-    /// `H dx`.
-    pub fn times(&self, dx: &DVector<f64>) -> DVector<f64> {
-        DVector::from_iterator(
-            self.rows.len(),
-            self.rows
-                .iter()
-                .map(|row| row.iter().map(|&(eq, c)| c * dx[eq]).sum()),
-        )
-    }
-
-    /// Indices of the rows of the given candidates, `components` per candidate.
-    fn row_indices(&self, candidates: &[usize]) -> Vec<usize> {
-        let d = self.components;
-        candidates
-            .iter()
-            .flat_map(|&c| (c * d)..(c + 1) * d)
-            .collect()
-    }
-
-    /// The equations the rows of the given candidates involve, sorted.
-    pub fn equations(&self, candidates: &[usize]) -> Vec<usize> {
-        let mut eqs: Vec<usize> = self
-            .row_indices(candidates)
-            .into_iter()
-            .flat_map(|k| self.rows[k].iter().map(|&(eq, _)| eq))
-            .collect();
-        eqs.sort_unstable();
-        eqs.dedup();
-        eqs
-    }
-
-    /// The Delassus operator `W = H_S K^{-1} H_S^T` of the rows `H_S` of the given candidates.
-    ///
-    /// `H_S` only involves equations `C` that the factorization eliminates last, so
-    /// `W = H_S (K^{-1})_CC H_S^T` with the dense block `(K^{-1})_CC` of the size of `C` (see
-    /// [`Factorization::trailing_inverse`]).
-    ///
-    /// # Errors
-    /// [`IncrementFailure::LinearSolve`] if a row involves an equation outside the trailing set.
-    pub fn delassus(
-        &self,
-        factor: &Factorization,
-        candidates: &[usize],
-    ) -> Result<DMatrix<f64>, IncrementFailure> {
-        let mut position = std::collections::HashMap::new();
-        for (k, &eq) in factor.trailing().iter().enumerate() {
-            position.insert(eq, k);
-        }
-        let local: Vec<Vec<(usize, f64)>> = self
-            .row_indices(candidates)
-            .into_iter()
-            .map(|k| &self.rows[k])
-            .map(|row| {
-                row.iter()
-                    .map(|&(eq, c)| position.get(&eq).map(|&k| (k, c)))
-                    .collect::<Option<Vec<_>>>()
-            })
-            .collect::<Option<_>>()
-            .ok_or_else(|| {
-                IncrementFailure::linear(
-                    "Delassus operator",
-                    LinearFailure::Structure(
-                        "a contact row involves an equation the factorization does not \
-                         eliminate last"
-                            .into(),
-                    ),
-                )
-            })?;
-        let inverse = factor.trailing_inverse();
-        let m = local.len();
-        // G = (K^-1)_CC H_C^T, column by column
-        let mut g = DMatrix::zeros(inverse.nrows(), m);
-        for (j, row) in local.iter().enumerate() {
-            for &(k, c) in row {
-                g.column_mut(j).axpy(c, &inverse.column(k), 1.0);
-            }
-        }
-        // W = H_C G
-        let w = DMatrix::from_fn(m, m, |i, j| {
-            local[i].iter().map(|&(k, c)| c * g[(k, j)]).sum::<f64>()
-        });
-        Ok((&w + w.transpose()) * 0.5)
-    }
-}
 
 /// Gap below which a candidate is near contact, as a fraction of the model size.
 const NEAR_GAP_FRACTION: f64 = 0.001;
@@ -444,153 +295,14 @@ pub fn solve_contact_forces(
     }
 }
 
-/// Evaluates the contact rows of all pairs at displacement `x`. `previous` holds the convected
-/// coordinates at the start of the increment (one per candidate, pair by pair); `held` marks
-/// equations whose increment is zero in this step (their columns are dropped).
-///
-/// `start` is the displacement at the start of a dynamic increment (`None` for rows at the
-/// start itself and for static equilibrium, which needs the normal at the solution). Against a
-/// surface with a discrete gap gradient (the analytical circle and cylinder, see
-/// [`skid_contact::RigidSurface::gap_discrete_gradient`]) the normal row is that gradient
-/// between the start and current positions instead of the current normal: the contact force
-/// acts along it, so its work over the increment, `p_N H_N dx`, is exactly `p_N dg` (zero for a
-/// node sliding along the drum at zero gap). With the current normal a loaded node moving `ds`
-/// along the circle of radius R gains `p_N ds^2 / (2 R)` per increment. Against any other
-/// surface the rotation column is the one that makes the rows a discrete gradient over the
-/// increment ([`skid_contact::rotation_column`]), so that the work is exact there too; with the
-/// end-point derivative a node pressed on a facet of a drum turning by `dtheta` gains or loses
-/// about `p_N R dtheta^2 / 2` per increment. `u` stays the
-/// exact gap and slip, so a converged increment satisfies the contact law exactly either way.
-///
-/// # Errors
-/// [`IncrementFailure::NoProjection`] if a node has no projection on its master surface.
-pub fn contact_rows<const D: usize>(
-    model: &Model<D>,
-    x: &DVector<f64>,
-    start: Option<&DVector<f64>>,
-    previous: &[Vector2<f64>],
-    held: &[bool],
-) -> Result<ContactRows, IncrementFailure> {
-    let components = D;
-    let dofs = model.dofs();
-    let mut out = ContactRows {
-        components,
-        rows: Vec::new(),
-        u: DVector::zeros(0),
-        coords: Vec::new(),
-        mu: Vec::new(),
-        curvature: Vec::new(),
-    };
-    let mut u = Vec::new();
-    let mut k = 0;
-    for (p, pair) in model.contacts().iter().enumerate() {
-        let body = &model.bodies()[pair.body];
-        let frame = RotatingFrame {
-            center: embed(&(body.reference_point + dofs.body_displacement(x, pair.body))),
-            axis: body.rotation_axis.unwrap_or_else(Vector3::z),
-            angle: dofs.body_angle(x, pair.body),
-        };
-        let start_center =
-            start.map(|x0| embed(&(body.reference_point + dofs.body_displacement(x0, pair.body))));
-        for &node in &pair.nodes {
-            let pos = model.node_position(x, node);
-            let mut kin = evaluate(pair.surface.as_ref(), &frame, &pos)
-                .ok_or(IncrementFailure::NoProjection { pair: p, node })?;
-            if let (Some(x0), Some(c0)) = (start, start_center) {
-                let offset = model.node_position(x0, node) - c0;
-                if let Some(secant) =
-                    gap_discrete_gradient(pair.surface.as_ref(), &frame, &offset, &pos)
-                {
-                    // the surface is invariant under the body's rotation: no angle terms
-                    kin.d_dx[0] = secant.gradient;
-                    kin.d_dangle[0] = 0.0;
-                    kin.d2_dx2[0] = secant.jacobian;
-                    kin.d2_dx_dangle[0] = Vector3::zeros();
-                    kin.d2_dangle2[0] = 0.0;
-                } else {
-                    let begin = IncrementStart {
-                        angle: dofs.body_angle(x0, pair.body),
-                        offset,
-                    };
-                    let end_offset = pos - frame.center;
-                    if let Some(column) =
-                        rotation_column(pair.surface.as_ref(), &frame, &begin, &end_offset, &kin)
-                    {
-                        kin.d_dangle = column;
-                    }
-                }
-            }
-            let slip = slip_increment(pair.surface.as_ref(), &previous[k], &kin.coords);
-            for comp in 0..components {
-                let mut row: Vec<(usize, f64)> = Vec::with_capacity(2 * D + 1);
-                let mut add = |eq: Option<usize>, c: f64| {
-                    if let Some(eq) = eq
-                        && !held[eq]
-                        && c != 0.0
-                    {
-                        match row.iter_mut().find(|(e, _)| *e == eq) {
-                            Some(entry) => entry.1 += c,
-                            None => row.push((eq, c)),
-                        }
-                    }
-                };
-                for i in 0..D {
-                    add(dofs.node(node)[i], kin.d_dx[comp][i]);
-                    // Moving the body by dc moves the body-frame point by -Q^T dc.
-                    add(dofs.body_translation(pair.body)[i], -kin.d_dx[comp][i]);
-                }
-                add(dofs.body_rotation(pair.body), kin.d_dangle[comp]);
-                out.rows.push(row);
-                out.curvature.push(local_curvature::<D>(&kin, comp));
-                u.push(if comp == 0 { kin.gap } else { slip[comp - 1] });
-            }
-            out.coords.push(kin.coords);
-            out.mu.push(pair.mu);
-            k += 1;
-        }
-    }
-    out.u = DVector::from_vec(u);
-    Ok(out)
-}
-
-/// The equations of a candidate's local coordinates `z = (node position [D], body translation
-/// [D], body angle)`, `None` where fixed: the order of [`ContactRows::curvature`].
-pub fn contact_coordinates<const D: usize>(
-    model: &Model<D>,
-    pair: usize,
-    node: usize,
-) -> Vec<Option<usize>> {
-    let dofs = model.dofs();
-    let body = model.contacts()[pair].body;
-    dofs.node(node)
-        .iter()
-        .chain(dofs.body_translation(body))
-        .copied()
-        .chain([dofs.body_rotation(body)])
-        .collect()
-}
-
-/// Second derivatives of component `comp` of `u` in the local coordinates of
-/// [`contact_coordinates`]. The node position `x` and the body translation `c` enter only as
-/// `x - c`, so with `A = d^2u/dx^2`, `b = d^2u/dx dtheta` and `s = d^2u/dtheta^2`:
-/// `[[A, -A, b], [-A, A, -b], [b^T, -b^T, s]]`.
-fn local_curvature<const D: usize>(kin: &ContactKinematics, comp: usize) -> DMatrix<f64> {
-    let a = &kin.d2_dx2[comp];
-    let b = &kin.d2_dx_dangle[comp];
-    let m = 2 * D + 1;
-    let sign = |i: usize| if i < D { 1.0 } else { -1.0 };
-    DMatrix::from_fn(m, m, |i, j| match (i, j) {
-        (i, j) if i == 2 * D && j == 2 * D => kin.d2_dangle2[comp],
-        (i, j) if i == 2 * D => sign(j) * b[j % D],
-        (i, j) if j == 2 * D => sign(i) * b[i % D],
-        (i, j) => sign(i) * sign(j) * a[(i % D, j % D)],
-    })
-}
-
 #[cfg(test)]
 mod tests {
+    use nalgebra::{DMatrix, Vector2};
+
     use super::*;
-    use crate::assembly::Assembler;
+    use crate::contact_rows::contact_rows;
+    use crate::error::LinearFailure;
+    use crate::model::Model;
     use crate::test_support::block_on_drum;
 
     /// `H dx` predicts the change of gaps and slips for a small motion of nodes and drum.

@@ -18,7 +18,7 @@
 //! ```
 //!
 //! where `K` is the effective tangent with the curvature stiffness of the forces `r` (see
-//! [`crate::coupling::ContactRows::curvature_stiffness`]), so that the first block row is the
+//! [`crate::contact_rows::ContactRows::curvature_stiffness`]), so that the first block row is the
 //! exact linearisation of `R - H^T r`. An open candidate has `Phi_r = I`, `Phi_u = 0` (its new
 //! force is zero), a sticking one `H_c dx = -u_c`, a sliding one `u_N = 0` with its friction on
 //! the cone's edge (its tangential rows balanced by `T = d d^T + P / f`, see
@@ -73,9 +73,9 @@ use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 use skid_contact::coulomb::alart_curnier::{LocalBranch, LocalLaw};
 
-use crate::coupling::{ContactRows, contact_coordinates};
+use crate::contact_rows::{ContactRows, contact_coordinates};
+use crate::cost::SolveCounts;
 use crate::error::{IncrementFailure, LinearFailure};
-use crate::increment::SolveCounts;
 use crate::krylov::gmres;
 use crate::model::Model;
 use crate::ordering::global_system_order;
@@ -931,8 +931,9 @@ pub fn law_residuals<'a>(
 mod tests {
     use super::*;
     use crate::assembly::Assembler;
-    use crate::coupling::{contact_rows, contact_step};
-    use crate::increment::Timings;
+    use crate::contact_rows::contact_rows;
+    use crate::cost::Timings;
+    use crate::coupling::contact_step;
     use crate::test_support::block_on_drum;
     use nalgebra::Vector2;
     use skid_contact::coulomb::CoulombSettings;

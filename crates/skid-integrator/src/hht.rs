@@ -30,7 +30,7 @@
 //! velocity jump, its work on the kinetic energy is exactly `p . H dx`: the normal part
 //! `p_N dg <= 0` (a closing contact can only absorb energy), the tangential part the frictional
 //! dissipation `-p_T . ds >= 0`. `H_N dx = dg` needs the normal row to be a discrete gradient of
-//! the gap over the increment on a curved surface (see `crate::coupling::contact_rows`): along
+//! the gap over the increment on a curved surface (see `crate::contact_rows::contact_rows`): along
 //! the end-of-increment normal a loaded node sliding `ds` along a drum of radius R gains
 //! `p_N ds^2 / (2 R)` per increment. Smooth forces keep the second-order accuracy and
 //! unconditional linear stability of HHT, whose spectral radius at infinite frequency is

@@ -33,43 +33,22 @@
 //! `F = H^T p` and action equals reaction. Their rate is the mean one, `v = (x - x_n)/h`,
 //! `a = 0`. The regularisation and the mass shift use the solid's density all the same.
 
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use nalgebra::{DVector, Vector2};
 
 use crate::assembly::{Assembler, InternalState, external_forces};
-use crate::coupling::{ContactRows, contact_rows, contact_step};
+use crate::contact_rows::{ContactRows, contact_rows};
+use crate::cost::{SolveCounts, Timings};
+use crate::coupling::contact_step;
 use crate::dof::EquationKind;
 use crate::error::{IncrementFailure, WorstResidual};
-use crate::global_contact::{
-    GlobalContactSolver, QUASI_DEFINITE_FROM, contact_weights, law_residuals,
-};
+use crate::global_contact::{GlobalContactSolver, contact_weights, law_residuals};
 use crate::hht::{Hht, IncrementEnds};
 use crate::loads::LoadInstant;
 use crate::model::Model;
+use crate::settings::{ContactSolve, Settings};
 use crate::state::{ContactPointState, EnergyLedger, State};
-use crate::stepper::Settings;
-
-/// Newton settings.
-#[derive(Clone, Debug, PartialEq)]
-pub struct NewtonSettings {
-    /// Iteration limit per increment.
-    pub max_iterations: usize,
-    /// Relative force residual tolerance.
-    pub force_tolerance: f64,
-    /// Contact kinematic tolerance, relative to the model size.
-    pub contact_tolerance: f64,
-}
-
-impl Default for NewtonSettings {
-    fn default() -> Self {
-        Self {
-            max_iterations: 25,
-            force_tolerance: 1e-6,
-            contact_tolerance: 1e-9,
-        }
-    }
-}
 
 /// What kind of increment to take.
 #[derive(Clone, Copy, Debug)]
@@ -116,42 +95,6 @@ impl IncrementKind {
     }
 }
 
-/// Wall time spent in the parts of the Newton loop.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Timings {
-    /// Element loop, loads and contact kinematics.
-    pub assembly: Duration,
-    /// Numeric factorizations and triangular solves (including the Delassus operator).
-    pub linear_solve: Duration,
-    /// Conic (clarabel) solves and their fixed point.
-    pub contact_solve: Duration,
-}
-
-/// Factorizations and iterative solves of the linear systems.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub struct SolveCounts {
-    /// Cholesky factorizations of the effective tangent (contact-free steps, the reduced
-    /// contact path).
-    pub tangent_factorizations: usize,
-    /// Sparse LU factorizations of the global contact system.
-    pub lu_factorizations: usize,
-    /// `L D L^T` factorizations of its quasi-definite approximation.
-    pub preconditioner_factorizations: usize,
-    /// GMRES iterations (each one solve with a factorization and one product with the matrix).
-    pub krylov_iterations: usize,
-}
-
-impl SolveCounts {
-    /// Adds the work done between the snapshots `before` and `after` of a workspace's counts.
-    pub fn add_between(&mut self, before: &Self, after: &Self) {
-        self.tangent_factorizations += after.tangent_factorizations - before.tangent_factorizations;
-        self.lu_factorizations += after.lu_factorizations - before.lu_factorizations;
-        self.preconditioner_factorizations +=
-            after.preconditioner_factorizations - before.preconditioner_factorizations;
-        self.krylov_iterations += after.krylov_iterations - before.krylov_iterations;
-    }
-}
-
 /// Counters of one converged increment.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct IncrementCounters {
@@ -167,42 +110,6 @@ pub struct IncrementCounters {
     pub contact_fallbacks: usize,
     /// Scaled (force, contact) residuals at each convergence check.
     pub residuals: Vec<(f64, f64)>,
-}
-
-/// How each Newton iteration obtains its contact forces.
-///
-/// Both give the same converged increments (the same forces to the Coulomb tolerance); they
-/// differ in cost. Measured on 2 cores (release), `3d-refined` (9,965 equations) full
-/// spin-down: global 1125 s (3738 Newton iterations), reduced 461 s (2962), the same t_stop to
-/// 5e-9; so the reduced path stays the default for now.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum ContactSolve {
-    /// Displacement step and forces together from one sparse system (see
-    /// [`crate::global_contact`]); an increment it does not converge is solved again by
-    /// [`ContactSolve::Reduced`] before any cutback.
-    Global,
-    /// The exact Coulomb problem in the forces alone, on the Delassus operator of the contact
-    /// set (see [`crate::coupling`]): dense, cubic in the contact candidates.
-    #[default]
-    Reduced,
-}
-
-impl ContactSolve {
-    /// The faster path for `model`: [`ContactSolve::Global`] for a model with a quasi-static
-    /// solid (held only by its contacts, its tangent without them is singular, which the
-    /// reduced path must regularise by a mass shift that slows Newton down) or whose global
-    /// system has [`QUASI_DEFINITE_FROM`] unknowns or more (preconditioned GMRES there costs
-    /// less than the dense Delassus operator: on `3d-refined`, 9,965 unknowns, 4 ms of
-    /// spin-down took 16.2 s against 27.6 s); [`ContactSolve::Reduced`] otherwise.
-    pub fn preferred_for<const D: usize>(model: &Model<D>) -> Self {
-        let candidates: usize = model.contacts().iter().map(|p| p.nodes.len()).sum();
-        let unknowns = model.dofs().len() + D * candidates;
-        if model.part().quasi_static || unknowns >= QUASI_DEFINITE_FROM {
-            Self::Global
-        } else {
-            Self::Reduced
-        }
-    }
 }
 
 /// The workspace an increment reuses: the tangent's assembler and the global contact solver.

@@ -10,13 +10,15 @@
 //! - [`assembly`]: internal forces, tangent, lumped masses and follower pressure on that pattern;
 //! - [`mixed`]: the element pressures of the mixed (u-p) tangent between Newton iterates;
 //! - [`hht`]: the HHT-alpha / Newmark relations between displacement, velocity and acceleration;
-//! - [`coupling`]: the contact rows H (gap and slip linearised in the global unknowns) and the
-//!   reduction of one Newton step to the exact-Coulomb problem in the contact forces (the dense
-//!   reference path);
+//! - [`contact_rows`]: the contact rows H (gap and slip linearised in the global unknowns);
+//! - [`coupling`]: the reduction of one Newton step to the exact-Coulomb problem in the contact
+//!   forces (the dense reference path);
 //! - [`global_contact`]: one Newton step of unknowns and contact forces together, on a sparse
 //!   unsymmetric system, solved by GMRES ([`krylov`]) preconditioned with the factors of a
 //!   symmetric quasi-definite approximation ([`quasi_definite`]) in a nested-dissection
 //!   order ([`ordering`]);
+//! - [`settings`]: Newton's, the Coulomb solve's, the contact path's and the cutback's settings;
+//! - [`cost`]: the wall time and linear solves a Newton loop spends;
 //! - [`increment`]: Newton-Raphson for one increment (static or dynamic);
 //! - [`stepper`]: steps, automatic cutback, and reporting of converged increments.
 //!
@@ -24,6 +26,8 @@
 //! path serves both.
 
 pub mod assembly;
+pub mod contact_rows;
+pub mod cost;
 pub mod coupling;
 pub mod dof;
 pub mod error;
@@ -36,6 +40,7 @@ pub mod mixed;
 pub mod model;
 pub mod ordering;
 pub mod quasi_definite;
+pub mod settings;
 pub mod sparse;
 pub mod state;
 pub mod stepper;
@@ -43,10 +48,13 @@ pub mod stepper;
 mod test_support;
 
 pub use error::{IncrementFailure, LinearFailure, ModelError, RunError, WorstResidual};
-pub use loads::{Amplitude, ConcentratedLoad, GravityLoad, LoadInstant, LoadTarget, Loads};
-pub use model::{ContactPair, Model, PressureLoad, SolidPart, Tie};
+pub use loads::{
+    Amplitude, ConcentratedLoad, GravityLoad, LoadInstant, LoadTarget, Loads, PressureLoad,
+};
+pub use model::{ContactPair, Model, SolidPart, Tie};
+pub use settings::Settings;
 pub use state::State;
 pub use stepper::{
-    Adaptive, Checkpoint, IncrementReport, Observer, RunStatistics, Settings, Step, StepKind,
-    StepStatistics, resume, run,
+    Adaptive, Checkpoint, IncrementReport, Observer, RunStatistics, Step, StepKind, StepStatistics,
+    resume, run,
 };

@@ -13,7 +13,6 @@ use nalgebra::{DVector, SVector, Vector3};
 
 use crate::dof::DofMap;
 use crate::error::ModelError;
-use crate::model::PressureLoad;
 use skid_fem::rigid::RigidBody;
 use skid_fem::solid::OnePointSolid;
 
@@ -145,6 +144,21 @@ pub struct GravityLoad<const D: usize> {
     /// Elements loaded (`None`: every element and every rigid body).
     pub elements: Option<Vec<usize>>,
     /// Time variation (`None`: the ramp).
+    pub amplitude: Option<Amplitude>,
+}
+
+/// A uniform follower pressure on a set of faces (positive pushes into the solid).
+///
+/// The nodal forces follow the current face geometry. Their load stiffness, which is
+/// unsymmetric, is not assembled: it vanishes when the loaded face translates rigidly (as the
+/// pad's back face tied to the plate does), and otherwise Newton converges linearly.
+#[derive(Clone, Debug)]
+pub struct PressureLoad {
+    /// Faces (node lists with outward orientation).
+    pub faces: Vec<Vec<usize>>,
+    /// Pressure at load factor 1, Pa.
+    pub pressure: f64,
+    /// Time variation (`None`: the ramp, see [`crate::loads`]).
     pub amplitude: Option<Amplitude>,
 }
 

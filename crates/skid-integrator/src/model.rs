@@ -12,7 +12,7 @@ use skid_fem::solid::OnePointSolid;
 
 use crate::dof::DofMap;
 use crate::error::ModelError;
-use crate::loads::{Amplitude, DeadLoad, Loads, Scene};
+use crate::loads::{DeadLoad, Loads, PressureLoad, Scene};
 
 /// The deformable solid: mesh, material and section data.
 #[derive(Debug)]
@@ -43,21 +43,6 @@ pub struct Tie {
     pub body: usize,
     /// Tied nodes.
     pub nodes: Vec<usize>,
-}
-
-/// A uniform follower pressure on a set of faces (positive pushes into the solid).
-///
-/// The nodal forces follow the current face geometry. Their load stiffness, which is
-/// unsymmetric, is not assembled: it vanishes when the loaded face translates rigidly (as the
-/// pad's back face tied to the plate does), and otherwise Newton converges linearly.
-#[derive(Clone, Debug)]
-pub struct PressureLoad {
-    /// Faces (node lists with outward orientation).
-    pub faces: Vec<Vec<usize>>,
-    /// Pressure at load factor 1, Pa.
-    pub pressure: f64,
-    /// Time variation (`None`: the ramp, see [`crate::loads`]).
-    pub amplitude: Option<Amplitude>,
 }
 
 /// Frictional contact between slave nodes of the solid and a surface carried by a rigid body.

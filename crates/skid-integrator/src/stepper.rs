@@ -25,20 +25,18 @@ use std::time::{Duration, Instant};
 
 use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
-use skid_contact::coulomb::CoulombSettings;
 
 use crate::assembly::{Assembler, external_forces};
-use crate::coupling::contact_rows;
+use crate::contact_rows::contact_rows;
+use crate::cost::{SolveCounts, Timings};
 use crate::dof::EquationKind;
 use crate::error::{IncrementFailure, RunError};
 use crate::global_contact::{GlobalContactSolver, GlobalSolverMemory};
 use crate::hht::Hht;
-use crate::increment::{
-    ContactSolve, IncrementCounters, IncrementKind, NewtonSettings, SolveCounts, Timings,
-    Workspace, solve_increment,
-};
+use crate::increment::{IncrementCounters, IncrementKind, Workspace, solve_increment};
 use crate::loads::LoadInstant;
 use crate::model::Model;
+use crate::settings::Settings;
 use crate::state::{ContactPointState, EnergyLedger, State};
 
 /// What a step does.
@@ -274,47 +272,6 @@ impl HeldMotion {
             Some(BodyMotion::Rotation) => dofs.body_rotation(self.body).into_iter().collect(),
         }
     }
-}
-
-/// Cutback settings.
-#[derive(Clone, Debug, PartialEq)]
-pub struct CutbackSettings {
-    /// Factor applied to the increment size after a failure.
-    pub factor: f64,
-    /// Consecutive cutbacks allowed before the run stops.
-    pub max_cutbacks: usize,
-    /// Successful increments before the size grows again.
-    pub growth_after: usize,
-    /// Growth factor (the size never exceeds the nominal one).
-    pub growth_factor: f64,
-    /// Smallest increment, as a fraction of the nominal one: a failure that would need a
-    /// smaller one stops the run (crawling on with vanishing increments only hides it).
-    pub min_fraction: f64,
-}
-
-impl Default for CutbackSettings {
-    fn default() -> Self {
-        Self {
-            factor: 0.25,
-            max_cutbacks: 8,
-            growth_after: 3,
-            growth_factor: 2.0,
-            min_fraction: 1e-4,
-        }
-    }
-}
-
-/// All solver settings.
-#[derive(Clone, Debug, Default)]
-pub struct Settings {
-    /// Newton settings.
-    pub newton: NewtonSettings,
-    /// Exact-Coulomb solver settings.
-    pub coulomb: CoulombSettings,
-    /// How each Newton iteration obtains its contact forces.
-    pub contact_solve: ContactSolve,
-    /// Cutback settings.
-    pub cutback: CutbackSettings,
 }
 
 /// What the observer is told about a converged increment.

@@ -6,10 +6,10 @@ mod common;
 
 use nalgebra::Vector3;
 use skid_contact::plane::RigidPlane;
-use skid_integrator::increment::ContactSolve;
+use skid_integrator::settings::ContactSolve;
+use skid_integrator::settings::Settings;
 use skid_integrator::stepper::{
-    Adaptive, Checkpoint, IncrementReport, Observer, RunStatistics, Settings, Step, StepKind,
-    resume, run,
+    Adaptive, Checkpoint, IncrementReport, Observer, RunStatistics, Step, StepKind, resume, run,
 };
 use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie};
 

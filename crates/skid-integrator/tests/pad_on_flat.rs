@@ -9,7 +9,8 @@ mod common;
 
 use nalgebra::Vector3;
 use skid_contact::plane::RigidPlane;
-use skid_integrator::stepper::{IncrementReport, Observer, Settings, Step, StepKind, run};
+use skid_integrator::settings::Settings;
+use skid_integrator::stepper::{IncrementReport, Observer, Step, StepKind, run};
 use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie};
 
 const LENGTH: f64 = 0.1;

@@ -14,10 +14,9 @@ mod common;
 use nalgebra::{SVector, Vector3};
 use skid_contact::plane::RigidPlane;
 use skid_fem::rigid::RigidBody;
-use skid_integrator::increment::ContactSolve;
-use skid_integrator::stepper::{
-    HeldMotion, IncrementReport, Observer, Settings, Step, StepKind, run,
-};
+use skid_integrator::settings::ContactSolve;
+use skid_integrator::settings::Settings;
+use skid_integrator::stepper::{HeldMotion, IncrementReport, Observer, Step, StepKind, run};
 use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie};
 
 const MU: f64 = 0.3;

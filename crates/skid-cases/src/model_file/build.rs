@@ -12,10 +12,9 @@ use skid_fem::cell::{embed, face_corners};
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
-use skid_integrator::increment::{ContactSolve, NewtonSettings};
-use skid_integrator::stepper::{
-    Adaptive, BodyMotion, CutbackSettings, HeldMotion, Settings, Step, StepKind,
-};
+use skid_integrator::settings::{ContactSolve, NewtonSettings};
+use skid_integrator::settings::{CutbackSettings, Settings};
+use skid_integrator::stepper::{Adaptive, BodyMotion, HeldMotion, Step, StepKind};
 use skid_integrator::{ContactPair, Model, SolidPart, Tie};
 
 mod loads;
