@@ -19,8 +19,10 @@ use serde::Serialize;
 
 use crate::atomic::write_atomic;
 use crate::deck::is_deck;
-use crate::model_file::{ModelSpec, declares_model, parse_model};
-use crate::runner::{RunSummary, read_deck_model, run_case, run_model};
+use crate::model_file::parse_model;
+use crate::model_spec::{ModelSpec, declares_model};
+use crate::runner::{RunSummary, run_case, run_model};
+use crate::scene::read_deck_model;
 use crate::schema::Case;
 use crate::sweep::{SweepRun, declares_sweep, load_sweep};
 use crate::validate::load_case;

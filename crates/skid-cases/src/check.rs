@@ -9,9 +9,9 @@ use std::path::Path;
 use skid_integrator::Model;
 
 use crate::deck::is_deck;
-use crate::drum;
-use crate::model_file::{self, ModelSpec, Scene, declares_model};
-use crate::runner::read_deck_model;
+use crate::model_file::{self, Scene};
+use crate::model_spec::{ModelSpec, declares_model};
+use crate::scene::{case_scene, model_scene, read_deck_model};
 use crate::schema::Case;
 use crate::sweep::{declares_sweep, load_sweep};
 use crate::validate::{CaseError, load_case, memory};
@@ -170,42 +170,6 @@ fn bad_dimension(source: &Path, dimension: usize) -> CaseError {
         field: "dimension".into(),
         message: format!("expected 2 or 3, got {dimension}"),
     }
-}
-
-/// The scene of a validated case, as run.
-///
-/// # Errors
-/// [`CaseError::Model`] if the model cannot be built.
-pub(crate) fn case_scene<const D: usize>(
-    case: &Case,
-    source: &Path,
-) -> Result<Scene<D>, CaseError> {
-    drum::build::<D>(case).map_err(|message| CaseError::Model {
-        path: source.to_path_buf(),
-        message,
-    })
-}
-
-/// The scene of a model, as run.
-///
-/// # Errors
-/// [`CaseError::Invalid`] naming the field at fault.
-pub(crate) fn model_scene<const D: usize>(
-    spec: &ModelSpec,
-    source: &Path,
-) -> Result<Scene<D>, CaseError> {
-    let invalid = |field: String, message: String| CaseError::Invalid {
-        path: source.to_path_buf(),
-        field,
-        message,
-    };
-    if spec.output.field_interval.is_some() {
-        return Err(invalid(
-            "output.field_interval".into(),
-            "ParaView field output is written for drum case files only so far; remove it".into(),
-        ));
-    }
-    model_file::build::<D>(spec).map_err(|e| invalid(e.field, e.message))
 }
 
 /// The counts of a scene: equations, elements, bodies, contact candidates, steps.

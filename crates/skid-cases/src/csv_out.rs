@@ -22,7 +22,7 @@ use csv::StringRecord;
 use serde::{Deserialize, Serialize};
 
 use crate::atomic::partial_path;
-use crate::restart::Fnv1a;
+use crate::fingerprint::Fnv1a;
 
 /// How much of a [`PartialCsv`] was on disk at a restart point: its length and the hash of
 /// those bytes.

@@ -1,4 +1,4 @@
-//! Abaqus-style input decks, read into the same [`crate::model_file::ModelSpec`] as model files.
+//! Abaqus-style input decks, read into the same [`crate::model_spec::ModelSpec`] as model files.
 //!
 //! - [`keywords`]: the keyword layer: keyword blocks with parameters and data lines, comments,
 //!   continuation lines and `*INCLUDE`, each with its file and line.
@@ -50,7 +50,7 @@ use std::path::Path;
 
 use keywords::{DeckError, Location, read_deck};
 
-use crate::model_file::ModelSpec;
+use crate::model_spec::ModelSpec;
 
 /// A deck read into a model, with what skid reads differently from the deck's requests.
 #[derive(Clone, Debug)]

@@ -17,20 +17,16 @@ use skid_fem::tetra::{TetMesh, compact_triangles};
 
 use crate::deck::mesh::ElementKind;
 use crate::deck::write::{RigidElements, write_deck};
-use crate::model_file::spec::ContactPairSpec;
-use crate::model_file::spec::{
+use crate::model_file::{self, Scene};
+use crate::model_spec::ContactPairSpec;
+use crate::model_spec::{
     BoundarySpec, Dof, ElementBlockSpec, ElementType, LoadSpec, ModelStepSpec, PartSpec,
     RigidBodySpec, RigidSurfaceSpec, SectionSpec, SlaveSpec, StepBoundarySpec, TieSpec,
 };
-use crate::model_file::{self, MODEL_FORMAT_VERSION, ModelSpec, Scene};
-use crate::schema::{Case, ContactFormulation, DrumSurfaceSpec, FacetElement, StepSpec};
-
-/// Index of the drum among the model's rigid bodies.
-pub const DRUM: usize = 0;
-/// Index of the back plate among the model's rigid bodies.
-pub const BACK_PLATE: usize = 1;
-/// Names of the rigid bodies, by index (as case files name them in a step's `hold`).
-pub const BODY_NAMES: [&str; 2] = ["drum", "back_plate"];
+use crate::model_spec::{MODEL_FORMAT_VERSION, ModelSpec};
+use crate::schema::{
+    BACK_PLATE, BODY_NAMES, Case, ContactFormulation, DRUM, DrumSurfaceSpec, FacetElement, StepSpec,
+};
 
 /// Builds the scene of a validated case in dimension `D` (which must equal `case.dimension`):
 /// the case's model file ([`model_spec`]) built as any model file is.

@@ -43,7 +43,7 @@ use skid_integrator::stepper::{IncrementReport, Observer};
 use skid_integrator::{Model, State};
 
 use crate::atomic::write_atomic;
-use crate::drum::DRUM;
+use crate::schema::DRUM;
 
 /// Subdirectory of a case's output directory that holds the field output.
 pub const FIELDS_DIR: &str = "fields";

@@ -15,9 +15,9 @@ use skid_integrator::Model;
 use skid_integrator::state::EnergyLedger;
 use skid_integrator::stepper::{IncrementReport, Observer};
 
+use crate::contact_totals::pair_totals;
 use crate::csv_out::{CsvMark, PartialCsv};
-use crate::drum::{BACK_PLATE, DRUM};
-use crate::model_file::history::pair_totals;
+use crate::schema::{BACK_PLATE, DRUM};
 
 /// Column names of `history.csv`.
 pub const COLUMNS: [&str; 23] = [

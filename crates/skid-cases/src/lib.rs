@@ -4,16 +4,20 @@
 //! - [`validate`]: reading a case with field-level error messages and overrides;
 //! - [`deck`]: Abaqus-style input decks (the keyword subset of the scenes) read into a model
 //!   file, and models written as decks;
-//! - [`model_file`]: the general model file (any scene) and building it into a model;
+//! - [`model_spec`]: the general model format (any scene), the serialization of `ModelSpec`;
+//! - [`model_file`]: reading model files and building them into a model, and their outputs;
 //! - [`drum`]: the drum scene of a case (any idealization, 2D or 3D) as a model file or deck;
 //! - [`history`]: the per-increment history of the drum (`history.csv`);
+//! - [`contact_totals`]: every contact pair's resultants in a state, for any history;
 //! - [`newton`]: the Newton residuals of every increment (`newton.csv`);
 //! - [`atomic`]: output files that are complete or absent (written aside, then renamed);
 //! - [`csv_out`]: CSV tables, written quoted and complete-or-absent, read by column name;
 //! - [`summary`]: stop time, spin-down straightness, post-stop motion, energy balance;
 //! - [`fields`]: ParaView field output (VTU frames and a PVD collection);
+//! - [`scene`]: any input read and built into the scene that is run;
 //! - [`runner`]: running one case into an output directory, or resuming an interrupted run;
 //! - [`restart`]: the restart files an interrupted run is resumed from;
+//! - [`fingerprint`]: the hash that tells whether a file is the one a restart was made with;
 //! - [`sweep`]: parameter sweeps over the fields of a case, model file or deck;
 //! - [`batch`]: running many cases in parallel, sweeps expanded, one shard of them or all;
 //! - [`check`]: reading and building an input without running it;
@@ -27,17 +31,21 @@ pub mod atomic;
 pub mod batch;
 pub mod bench;
 pub mod check;
+pub mod contact_totals;
 pub mod csv_out;
 pub mod deck;
 pub mod drum;
 pub mod fields;
+pub mod fingerprint;
 pub mod history;
 pub mod model_file;
+pub mod model_spec;
 pub mod newton;
 pub mod reference;
 pub mod report;
 pub mod restart;
 pub mod runner;
+pub mod scene;
 pub mod schema;
 pub mod summary;
 pub mod sweep;
@@ -47,9 +55,9 @@ pub use batch::{BatchEntry, BatchError, BatchStatus, Shard, collect_case_files, 
 pub use report::sweep::{SweepOutcome, write_sweep_report};
 pub use report::{ReportError, ReportOutcome, ReportSources, write_report};
 pub use runner::{
-    Resumed, RunSummary, default_output_dir, read_deck_model, resume_run, run_case, run_case_file,
-    run_file,
+    Resumed, RunSummary, default_output_dir, resume_run, run_case, run_case_file, run_file,
 };
+pub use scene::read_deck_model;
 pub use schema::Case;
 pub use summary::Summary;
 pub use validate::{CaseError, load_case, parse_case};

@@ -1,7 +1,6 @@
-//! General model files: any scene the solver can run, as one JSON document ([`ModelSpec`]).
+//! General model files: any scene the solver can run, as one JSON document
+//! ([`crate::model_spec`] gives its format), read, built into a model and written out.
 //!
-//! - [`spec`]: the format (parts, rigid bodies, boundary conditions, ties, loads, contact
-//!   pairs, steps, solver and output settings);
 //! - [`mod@build`]: resolving names and checking values into a [`Scene`] (the integrator's model,
 //!   steps and settings), each problem reported with its field path;
 //! - [`history`]: the generic `history.csv` (every body's motions, every pair's resultants,
@@ -16,23 +15,14 @@
 pub mod build;
 pub mod contact_nodes;
 pub mod history;
-pub mod spec;
 pub mod summary;
 
 use std::path::Path;
 
-use serde_json::Value;
-
 pub use build::{Scene, SpecError, build};
-pub use spec::{MODEL_FORMAT_VERSION, ModelSpec};
 
+use crate::model_spec::ModelSpec;
 use crate::validate::{CaseError, parse_document};
-
-/// Whether text is a model file: JSON that declares `skid_model` (rather than a drum case
-/// file); text that is not JSON is not, and is left to the parser that reads it to report.
-pub fn declares_model(text: &str) -> bool {
-    serde_json::from_str::<Value>(text).is_ok_and(|v| v.get("skid_model").is_some())
-}
 
 /// Parses model-file text with `overrides` applied (`path` is only used in messages). Names
 /// and values are checked when the scene is built ([`build()`]).

@@ -1,6 +1,6 @@
 //! The contract of the input formats, generated from the Rust types that read them: the JSON
 //! Schema of case files ([`crate::schema::Case`]), of model files
-//! ([`crate::model_file::ModelSpec`]) and of sweep files ([`crate::sweep::SweepSpec`]), and a markdown reference rendered from that schema (one
+//! ([`crate::model_spec::ModelSpec`]) and of sweep files ([`crate::sweep::SweepSpec`]), and a markdown reference rendered from that schema (one
 //! table per type), so that neither can drift from the code. `skid schema` prints them; the
 //! copies shipped in `docs/` are checked against them by a test.
 
@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 use schemars::generate::SchemaSettings;
 use serde_json::{Map, Value};
 
-use crate::model_file::ModelSpec;
+use crate::model_spec::ModelSpec;
 use crate::schema::Case;
 use crate::sweep::SweepSpec;
 

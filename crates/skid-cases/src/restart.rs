@@ -38,43 +38,12 @@ pub const DEFAULT_RESTART_EVERY: usize = 100;
 /// Version of the restart file's layout.
 pub const RESTART_FORMAT: u32 = 3;
 
-/// The 64-bit FNV-1a hash, for telling whether a file is the one a restart file was made with.
-#[derive(Clone, Copy, Debug)]
-pub struct Fnv1a(u64);
-
-impl Default for Fnv1a {
-    fn default() -> Self {
-        Self(0xcbf2_9ce4_8422_2325)
-    }
-}
-
-impl Fnv1a {
-    /// Hashes `bytes` into the running hash.
-    pub fn update(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-
-    /// The hash as 16 hex digits.
-    pub fn hex(&self) -> String {
-        format!("{:016x}", self.0)
-    }
-
-    /// The hash of `bytes` as 16 hex digits.
-    pub fn of(bytes: &[u8]) -> String {
-        let mut hash = Self::default();
-        hash.update(bytes);
-        hash.hex()
-    }
-}
-
 /// The input a run was started with: the file in its output directory and its hash.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct InputIdentity {
     /// `case.json` or `model.json`.
     pub file: String,
-    /// FNV-1a hash of that file's text ([`Fnv1a`]).
+    /// FNV-1a hash of that file's text ([`crate::fingerprint::Fnv1a`]).
     pub fnv1a: String,
 }
 
@@ -160,13 +129,6 @@ impl RestartFile {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn fnv1a_matches_the_published_test_vectors() {
-        assert_eq!(Fnv1a::of(b""), "cbf29ce484222325");
-        assert_eq!(Fnv1a::of(b"a"), "af63dc4c8601ec8c");
-        assert_eq!(Fnv1a::of(b"foobar"), "85944171f73967e8");
-    }
 
     #[test]
     fn f64_survives_the_restart_json_bit_for_bit() {

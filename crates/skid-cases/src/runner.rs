@@ -21,19 +21,21 @@ use skid_integrator::{Model, RunError, State};
 use serde::Serialize;
 
 use crate::atomic::write_atomic;
-use crate::check::{case_scene, model_scene};
 use crate::csv_out::CsvMark;
-use crate::deck::{is_deck, read_model};
+use crate::deck::is_deck;
 use crate::fields::{self, DrumOutline, FieldWriter};
+use crate::fingerprint::Fnv1a;
 use crate::history::DrumRecorder;
 use crate::model_file::contact_nodes;
 use crate::model_file::history::ModelRecorder;
 use crate::model_file::summary::{ModelSummary, summarize as summarize_model};
-use crate::model_file::{self, ModelSpec, declares_model};
+use crate::model_file::{self};
+use crate::model_spec::{ModelSpec, declares_model};
 use crate::newton::{NEWTON_CSV, NewtonRecorder};
 use crate::restart::{
-    DEFAULT_RESTART_EVERY, Fnv1a, InputIdentity, RESTART_JSON, RecorderMemory, RestartFile,
+    DEFAULT_RESTART_EVERY, InputIdentity, RESTART_JSON, RecorderMemory, RestartFile,
 };
+use crate::scene::{case_scene, model_scene, read_deck_model};
 use crate::schema::Case;
 use crate::summary::{Summary, summarize};
 use crate::validate::{CaseError, load_case, parse_case};
@@ -250,23 +252,6 @@ pub fn resume_run(
         }
         .map(|s| Resumed::Continued(Box::new(RunSummary::Model(s)))),
     }
-}
-
-/// Reads an input deck into its model with `overrides` applied to the model's fields (as in a
-/// model file), with the notes on what skid reads differently from the deck's requests.
-///
-/// # Errors
-/// [`CaseError::Deck`] naming the deck line at fault, or a bad override.
-pub fn read_deck_model(
-    path: &Path,
-    overrides: &[String],
-) -> Result<(ModelSpec, Vec<String>), CaseError> {
-    let deck = read_model(path)?;
-    if overrides.is_empty() {
-        return Ok((deck.model, deck.notes));
-    }
-    let model = model_file::parse_model(&model_file::to_json(&deck.model), path, overrides)?;
-    Ok((model, deck.notes))
 }
 
 /// Default output directory of a case: `out/<case name>`.

@@ -11,6 +11,14 @@
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+/// Index of the drum among the rigid bodies of a drum case's model.
+pub const DRUM: usize = 0;
+/// Index of the back plate among the rigid bodies of a drum case's model.
+pub const BACK_PLATE: usize = 1;
+/// Names of the drum case's rigid bodies, by index (as case files name them in a step's
+/// `hold`).
+pub const BODY_NAMES: [&str; 2] = ["drum", "back_plate"];
+
 /// A complete case.
 #[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]

@@ -6,9 +6,8 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 use thiserror::Error;
 
-use crate::drum::BODY_NAMES;
 use crate::schema::{
-    Case, ContactFormulation, DrumSurfaceSpec, FacetElement, MaterialSpec, StepSpec,
+    BODY_NAMES, Case, ContactFormulation, DrumSurfaceSpec, FacetElement, MaterialSpec, StepSpec,
 };
 
 mod json;
@@ -118,7 +117,7 @@ pub fn load_case(path: &Path, overrides: &[String]) -> Result<Case, CaseError> {
 /// # Errors
 /// [`CaseError`] naming the field at fault.
 pub fn parse_case(text: &str, path: &Path, overrides: &[String]) -> Result<Case, CaseError> {
-    if crate::model_file::declares_model(text) {
+    if crate::model_spec::declares_model(text) {
         return Err(CaseError::Invalid {
             path: path.to_path_buf(),
             field: "skid_model".into(),

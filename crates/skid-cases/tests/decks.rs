@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use skid_cases::csv_out::CsvTable;
 use skid_cases::deck::read_model;
 use skid_cases::drum::{deck, model_spec};
-use skid_cases::model_file::spec::{ModelStepSpec, RigidSurfaceSpec, SlaveSpec};
+use skid_cases::model_spec::{ModelStepSpec, RigidSurfaceSpec, SlaveSpec};
 use skid_cases::restart::DEFAULT_RESTART_EVERY;
 use skid_cases::runner::run_model;
 use skid_cases::{RunSummary, load_case, run_file};
@@ -146,7 +146,7 @@ fn a_deck_written_by_hand_reads_to_the_drum_model() {
             .iter()
             .map(|l| {
                 let mut l = l.clone();
-                if let skid_cases::model_file::spec::LoadSpec::Pressure { surface, .. } = &mut l {
+                if let skid_cases::model_spec::LoadSpec::Pressure { surface, .. } = &mut l {
                     *surface = "pad_back".into();
                 }
                 l
@@ -491,10 +491,7 @@ ground, ENCASTRE
         } => {
             assert_eq!(*increments, 4);
             // ENCASTRE on a 2D body: x (y and rz are held by the model data)
-            assert_eq!(
-                boundary[0].dofs,
-                Some(vec![skid_cases::model_file::spec::Dof::X])
-            );
+            assert_eq!(boundary[0].dofs, Some(vec![skid_cases::model_spec::Dof::X]));
         }
         other => panic!("{other:?}"),
     }
@@ -511,7 +508,7 @@ ground, ENCASTRE
 /// tables the amplitudes the loads name; `OP=NEW` drops the loads of its keyword.
 #[test]
 fn concentrated_loads_gravity_and_amplitudes_map_onto_the_model() {
-    use skid_cases::model_file::spec::{AmplitudeSpec, LoadSpec};
+    use skid_cases::model_spec::{AmplitudeSpec, LoadSpec};
     let mesh = std::fs::read_to_string(repo("cases/inp/2d-pad-mesh.inc")).expect("mesh");
     let deck = std::fs::read_to_string(repo("cases/inp/2d-analytic-by-hand.inp")).expect("deck");
     let deck = deck

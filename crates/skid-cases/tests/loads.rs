@@ -10,8 +10,9 @@
 
 use std::path::{Path, PathBuf};
 
-use skid_cases::model_file::spec::LoadSpec;
-use skid_cases::model_file::{self, ModelSpec, parse_model};
+use skid_cases::model_file::{self, parse_model};
+use skid_cases::model_spec::LoadSpec;
+use skid_cases::model_spec::ModelSpec;
 use skid_integrator::stepper::{IncrementReport, Observer, run};
 use skid_integrator::{Model, State};
 

@@ -15,7 +15,8 @@ use skid_cases::atomic::write_atomic;
 use skid_cases::deck::is_deck;
 use skid_cases::deck::write::write_deck;
 use skid_cases::drum::{deck, model_spec};
-use skid_cases::model_file::{declares_model, parse_model, to_json};
+use skid_cases::model_file::{parse_model, to_json};
+use skid_cases::model_spec::declares_model;
 use skid_cases::{load_case, read_deck_model};
 
 /// Writes `input` (with `overrides`) to `out` as a model file or a deck; running the output

@@ -5,14 +5,6 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-/// Crates whose module graph still has cycles, with the reason; checked to still have one, so
-/// that the exemption goes once they are untangled.
-const STILL_TANGLED: &[(&str, &str)] = &[(
-    "skid-cases",
-    "its readers, writers, drum builder, checks and runner use each other; to be split by what \
-     each does",
-)];
-
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
@@ -148,17 +140,11 @@ fn no_crate_has_a_module_cycle() {
         let dir = entry.expect("entry").path();
         let name = dir.file_name().expect("name").to_string_lossy().to_string();
         let found = cycle(&graph(&dir));
-        match STILL_TANGLED.iter().find(|(n, _)| *n == name) {
-            Some((_, why)) => assert!(
-                found.is_some(),
-                "{name} has no module cycle any more: remove it from STILL_TANGLED ({why})"
-            ),
-            None => assert!(
-                found.is_none(),
-                "{name} has a module cycle: {}",
-                found.unwrap_or_default().join(" -> ")
-            ),
-        }
+        assert!(
+            found.is_none(),
+            "{name} has a module cycle: {}",
+            found.unwrap_or_default().join(" -> ")
+        );
         checked += 1;
     }
     assert!(checked >= 5, "found {checked} crates");

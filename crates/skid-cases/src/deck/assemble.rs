@@ -17,7 +17,7 @@ use super::read::{
     StepDef, SurfaceDef,
 };
 use super::rigid::{prism, triangles};
-use crate::model_file::spec::{
+use crate::model_spec::{
     BoundarySpec, ContactPairSpec, Dof, ElementBlockSpec, ElementType, LoadSpec,
     MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, PartSpec, RigidBodySpec, RigidSurfaceSpec,
     SectionSpec, SlaveSpec, StepBoundarySpec, TieSpec,

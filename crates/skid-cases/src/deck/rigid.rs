@@ -16,7 +16,7 @@ use std::f64::consts::TAU;
 
 use super::fields::{allow_parameters, at_most, field, line_error, real};
 use super::keywords::{Block, DeckError};
-use crate::model_file::spec::RigidSurfaceSpec;
+use crate::model_spec::RigidSurfaceSpec;
 
 /// One piece of a profile, from the end of the previous one.
 #[derive(Clone, Copy, Debug, PartialEq)]

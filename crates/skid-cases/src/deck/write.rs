@@ -17,7 +17,7 @@ use skid_contact::surface::AnalyticCylinder;
 use skid_fem::tetra::TetMesh;
 
 use super::mesh::ElementKind;
-use crate::model_file::spec::{
+use crate::model_spec::{
     Dof, LoadSpec, ModelSpec, ModelStepSpec, RigidBodySpec, RigidSurfaceSpec, SlaveSpec,
 };
 use crate::schema::{MaterialSpec, default_regularization_time};

@@ -19,7 +19,7 @@ use skid_integrator::{ContactPair, Model, SolidPart, Tie};
 
 mod loads;
 
-use super::spec::{
+use crate::model_spec::{
     BoundarySpec, Dof, MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, RigidSurfaceSpec, SlaveSpec,
     StepBoundarySpec,
 };
@@ -427,7 +427,7 @@ fn body_names(spec: &ModelSpec) -> Result<BTreeMap<&str, usize>, SpecError> {
 /// A rigid body whose motions are those `fixed` leaves free; at most one rotation may be free.
 fn rigid_body<const D: usize>(
     i: usize,
-    b: &super::spec::RigidBodySpec,
+    b: &crate::model_spec::RigidBodySpec,
     fixed: &BTreeSet<Dof>,
 ) -> Result<RigidBody<D>, SpecError> {
     let f = |name: &str| format!("rigid_bodies[{i}].{name}");

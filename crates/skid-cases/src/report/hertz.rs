@@ -28,8 +28,8 @@ use std::path::Path;
 
 use super::ReportError;
 use crate::csv_out::CsvTable;
-use crate::model_file::ModelSpec;
-use crate::model_file::spec::{LoadSpec, RigidSurfaceSpec};
+use crate::model_spec::ModelSpec;
+use crate::model_spec::{LoadSpec, RigidSurfaceSpec};
 use crate::schema::MaterialSpec;
 
 /// A Hertz scene: what its analytic answer needs.
@@ -71,7 +71,7 @@ impl HertzScene {
         else {
             return None;
         };
-        let [crate::model_file::spec::ModelStepSpec::Static { .. }] = spec.steps.as_slice() else {
+        let [crate::model_spec::ModelStepSpec::Static { .. }] = spec.steps.as_slice() else {
             return None;
         };
         let MaterialSpec::PolynomialN1 { c10, c01, d1 } = spec.part.section.material;

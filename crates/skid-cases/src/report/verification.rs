@@ -27,8 +27,8 @@ use super::hertz::{self, HertzMeasure, HertzScene};
 use super::plot::{HERTZ_SVG, plot_hertz_pressure};
 use super::{ReportError, read};
 use crate::csv_out::CsvTable;
-use crate::model_file::ModelSpec;
 use crate::model_file::contact_nodes::CONTACT_NODES_CSV;
+use crate::model_spec::ModelSpec;
 use crate::runner::MODEL_JSON;
 
 /// Largest relative error of the finest Hertz level's peak pressure.

@@ -3,7 +3,7 @@
 
 use super::loads::{InForce, apply_loads, model_loads};
 use super::*;
-use crate::model_file::spec::AmplitudeSpec;
+use crate::model_spec::AmplitudeSpec;
 
 pub(super) fn apply_model_boundary(
     defs: &Definitions,

@@ -4,7 +4,7 @@
 
 use super::*;
 use crate::deck::loads::{LoadChange, LoadKind};
-use crate::model_file::spec::AmplitudeSpec;
+use crate::model_spec::AmplitudeSpec;
 
 /// What a concentrated load acts on.
 #[derive(Clone, Debug, PartialEq)]

@@ -9,7 +9,7 @@ use skid_fem::rigid::RigidBody;
 use skid_integrator::{Amplitude, ConcentratedLoad, GravityLoad, LoadTarget, Loads, PressureLoad};
 
 use super::{SpecError, fail, finite_point, vector3};
-use crate::model_file::spec::{AmplitudeSpec, Dof, LoadSpec, ModelSpec};
+use crate::model_spec::{AmplitudeSpec, Dof, LoadSpec, ModelSpec};
 
 /// The amplitudes by name, each checked: a unique non-empty name, at least one point, finite
 /// times >= 0 that increase strictly, finite factors.

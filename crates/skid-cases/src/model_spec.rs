@@ -18,6 +18,12 @@ use crate::schema::{
 /// Format version a model file must declare in `skid_model`.
 pub const MODEL_FORMAT_VERSION: u32 = 1;
 
+/// Whether text is a model file: JSON that declares `skid_model` (rather than a drum case
+/// file); text that is not JSON is not, and is left to the parser that reads it to report.
+pub fn declares_model(text: &str) -> bool {
+    serde_json::from_str::<serde_json::Value>(text).is_ok_and(|v| v.get("skid_model").is_some())
+}
+
 /// A whole scene: one deformable part, rigid bodies, constraints, loads, contact, steps.
 #[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
