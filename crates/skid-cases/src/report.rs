@@ -374,7 +374,7 @@ pub struct ReportSources<'a> {
     pub scaling: Option<&'a Path>,
     /// The records of the stress sweep (`stress.json` of `scripts/stress.py`).
     pub stress: Option<&'a Path>,
-    /// Runs of the verification scenes (`skid batch cases/verification/*.json`), one
+    /// Runs of the verification scenes (`skid batch cases/verification`), one
     /// subdirectory per run.
     pub verification: Option<&'a Path>,
 }
@@ -421,7 +421,7 @@ fn regenerate(sources: &ReportSources<'_>, out: &Path) -> String {
     }
     if let Some(verification) = sources.verification {
         commands.push(format!(
-            "skid batch cases/verification/*.json --out {}",
+            "skid batch cases/verification --out {}",
             verification.display()
         ));
         let _ = write!(report, " --verification {}", verification.display());

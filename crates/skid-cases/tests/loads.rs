@@ -191,16 +191,17 @@ fn block_pushed<const D: usize>() {
 ///   = 0.005 g (sin a + mu cos a) = 0.0230 m/s^2` (to 1e-3; measured 1.4e-5).
 ///
 /// So the threshold lies within 0.5 % of the Coulomb value. The 2D scene's deck
-/// (`2d-block-on-incline.inp`: `*AMPLITUDE`, `*DLOAD` with `GRAV`, `*CLOAD` on the plate's
+/// (`2d-block-on-incline-deck.inp`: `*AMPLITUDE`, `*DLOAD` with `GRAV`, `*CLOAD` on the plate's
 /// reference node) reads to the same loads and amplitudes, bit for bit, and passes the same
 /// checks.
 #[test]
 fn a_block_on_an_incline_slides_up_exactly_past_the_coulomb_threshold() {
     block_on_incline::<2>(&scene_spec("2d-block-on-incline", &[]));
     block_on_incline::<3>(&scene_spec("3d-block-on-incline", &[]));
-    let deck = skid_cases::deck::read_model(&repo("cases/verification/2d-block-on-incline.inp"))
-        .expect("deck reads")
-        .model;
+    let deck =
+        skid_cases::deck::read_model(&repo("cases/verification/2d-block-on-incline-deck.inp"))
+            .expect("deck reads")
+            .model;
     let json = scene_spec("2d-block-on-incline", &[]);
     assert_eq!(
         (&deck.loads, &deck.amplitudes),

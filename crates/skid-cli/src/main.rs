@@ -133,7 +133,7 @@ enum Command {
         /// The stress sweep of the solver: the stress.json of `scripts/stress.py`.
         #[arg(long, value_name = "FILE")]
         stress: Option<PathBuf>,
-        /// Verification scenes (`skid batch cases/verification/*.json`): one subdirectory per
+        /// Verification scenes (`skid batch cases/verification`): one subdirectory per
         /// run, each checked against the analytic answer of its model (Hertz contact, Coulomb
         /// friction).
         #[arg(long, value_name = "DIR")]

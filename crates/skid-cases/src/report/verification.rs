@@ -1,5 +1,5 @@
 //! The verification section of the report: the scenes of `cases/verification` whose answer is
-//! known, checked against it from their run directories (`skid batch cases/verification/*.json
+//! known, checked against it from their run directories (`skid batch cases/verification
 //! --out DIR`: each run's `model.json`, `summary.json`, `history.csv`, `contact_nodes.csv`).
 //! Every scene is recognised by what its model holds, and its analytic answer computed from
 //! that model:
@@ -149,7 +149,7 @@ pub fn section(
 ) -> Result<(String, Counts, Vec<PathBuf>), ReportError> {
     let mut out = format!(
         "## Verification scenes\n\n\
-         Runs in `{}` (`skid batch cases/verification/*.json`), each checked against the \
+         Runs in `{}` (`skid batch cases/verification`), each checked against the \
          analytic answer of its model as run.\n\n",
         dir.display()
     );
