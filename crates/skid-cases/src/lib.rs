@@ -1,4 +1,5 @@
-//! Case files and the braking-drum benchmark.
+//! Inputs and runs: the formats (case files, model files, decks) read into the scene that is
+//! run, the run itself, and the outputs it writes.
 //!
 //! - [`schema`]: the JSON case-file format;
 //! - [`validate`]: reading a case with field-level error messages and overrides;
@@ -21,15 +22,13 @@
 //! - [`sweep`]: parameter sweeps over the fields of a case, model file or deck;
 //! - [`batch`]: running many cases in parallel, sweeps expanded, one shard of them or all;
 //! - [`check`]: reading and building an input without running it;
-//! - [`mod@bench`]: the cost of a case beside its error over a ladder of time steps;
 //! - [`reference`]: the JSON Schemas of case and model files and their markdown reference,
 //!   generated from the types;
-//! - [`report`]: the validation report: the benchmark runs, the hard cases, the convergence
-//!   study.
+//!
+//! The reports made from the runs' outputs are the crate `skid-report`'s.
 
 pub mod atomic;
 pub mod batch;
-pub mod bench;
 pub mod check;
 pub mod contact_totals;
 pub mod csv_out;
@@ -42,7 +41,6 @@ pub mod model_file;
 pub mod model_spec;
 pub mod newton;
 pub mod reference;
-pub mod report;
 pub mod restart;
 pub mod runner;
 pub mod scene;
@@ -52,8 +50,6 @@ pub mod sweep;
 pub mod validate;
 
 pub use batch::{BatchEntry, BatchError, BatchStatus, Shard, collect_case_files, run_batch};
-pub use report::sweep::{SweepOutcome, write_sweep_report};
-pub use report::{ReportError, ReportOutcome, ReportSources, write_report};
 pub use runner::{
     Resumed, RunSummary, default_output_dir, resume_run, run_case, run_case_file, run_file,
 };

@@ -379,7 +379,7 @@ pub struct OutputSpec {
 }
 
 /// Expectations on a run, for the checks of `skid report --hard`; every field is optional.
-/// The checks themselves are derived from the case (see `skid_cases::report::hard`); this only
+/// The checks themselves are derived from the case (see `skid_report::hard`); this only
 /// adjusts them where a case's physics departs from the assumptions of the defaults.
 #[derive(Clone, Debug, Default, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(default, deny_unknown_fields)]

@@ -1,5 +1,5 @@
 //! `skid bench`: the cost of each case beside its error over a ladder of time steps and the
-//! contact solves (see `skid_cases::bench`).
+//! contact solves (see `skid_report::bench`).
 //!
 //! Exit codes: 0 every run completed; 1 some run stopped early; 2 a case file or the settings
 //! are invalid; 3 results could not be written or read back.
@@ -8,8 +8,8 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use skid_cases::bench::{BenchError, BenchSettings, run_bench, write_bench_report};
 use skid_cases::load_case;
+use skid_report::bench::{BenchError, BenchSettings, run_bench, write_bench_report};
 
 /// Runs the bench of `cases` into `out` with `settings`; a line per level on stderr when it is
 /// a terminal.
@@ -27,7 +27,7 @@ pub fn run(cases: &[PathBuf], settings: &BenchSettings, out: &Path) -> ExitCode 
     let terminal = std::io::stderr().is_terminal();
     let total = loaded.len() * settings.levels * settings.methods.len();
     let mut done = 0;
-    let progress = |r: &skid_cases::bench::BenchRecord| {
+    let progress = |r: &skid_report::bench::BenchRecord| {
         done += 1;
         if terminal {
             eprintln!(
@@ -56,7 +56,7 @@ pub fn run(cases: &[PathBuf], settings: &BenchSettings, out: &Path) -> ExitCode 
     println!(
         "{} levels benchmarked; see {}",
         records.len(),
-        out.join(skid_cases::bench::BENCH_MD).display()
+        out.join(skid_report::bench::BENCH_MD).display()
     );
     if records.iter().all(|r| r.status == "completed") {
         ExitCode::SUCCESS

@@ -15,9 +15,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use skid_cases::ReportSources;
-use skid_cases::bench::{BenchMethod, BenchSettings};
 use skid_cases::reference::Format;
+use skid_report::ReportSources;
+use skid_report::bench::{BenchMethod, BenchSettings};
 
 #[derive(Parser)]
 #[command(

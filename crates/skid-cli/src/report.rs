@@ -10,7 +10,8 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use skid_cases::{ReportError, ReportSources, write_report, write_sweep_report};
+use skid_report::sweep::write_sweep_report;
+use skid_report::{ReportError, ReportSources, write_report};
 
 /// The exit code of a report that could not be written.
 fn failure(e: &ReportError) -> ExitCode {

@@ -31,8 +31,8 @@ use std::path::{Path, PathBuf};
 use super::format::{Counts, Sig, percent, plain, show};
 use super::plot::{HARD_OMEGA_SVG, plot_normalized_spin_down};
 use super::{ReportError, Run};
-use crate::runner::CASE_JSON;
-use crate::schema::{Case, ExpectedFailure, MaterialSpec};
+use skid_cases::runner::CASE_JSON;
+use skid_cases::schema::{Case, ExpectedFailure, MaterialSpec};
 
 /// Default relative tolerance of t_stop against the estimate. The estimate ignores the tilt of
 /// the contact normals on the curved drum (the independent model of DRUM.md 2.2 finds the
@@ -594,11 +594,11 @@ pub fn section(
 mod tests {
     use super::super::test_runs::spin_down;
     use super::*;
-    use crate::validate::parse_case;
+    use skid_cases::validate::parse_case;
 
     /// The shipped 2D benchmark case, with `overrides`.
     fn case(overrides: &[&str]) -> Case {
-        let text = include_str!("../../../../cases/drum/2d-analytic.json");
+        let text = include_str!("../../../cases/drum/2d-analytic.json");
         let overrides: Vec<String> = overrides.iter().map(|o| o.to_string()).collect();
         parse_case(text, Path::new("2d-analytic.json"), &overrides).expect("valid case")
     }

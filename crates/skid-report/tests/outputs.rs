@@ -4,9 +4,9 @@
 use std::path::Path;
 
 use skid_cases::csv_out::CsvTable;
-use skid_cases::report::convergence::hardest_increment;
-use skid_cases::report::load_run;
 use skid_cases::{parse_case, run_case};
+use skid_report::convergence::hardest_increment;
+use skid_report::load_run;
 
 const CASE_2D: &str = include_str!("../../../cases/drum/2d-analytic.json");
 const ODD_NAME: &str = "spin, down \"fast\"";

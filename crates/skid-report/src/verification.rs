@@ -26,10 +26,10 @@ use super::format::{Checks, Counts, Sig, percent, show};
 use super::hertz::{self, HertzMeasure, HertzScene};
 use super::plot::{HERTZ_SVG, plot_hertz_pressure};
 use super::{ReportError, read};
-use crate::csv_out::CsvTable;
-use crate::model_file::contact_nodes::CONTACT_NODES_CSV;
-use crate::model_spec::ModelSpec;
-use crate::runner::MODEL_JSON;
+use skid_cases::csv_out::CsvTable;
+use skid_cases::model_file::contact_nodes::CONTACT_NODES_CSV;
+use skid_cases::model_spec::ModelSpec;
+use skid_cases::runner::MODEL_JSON;
 
 /// Largest relative error of the finest Hertz level's peak pressure.
 pub const PEAK_TOLERANCE: f64 = 0.03;

@@ -22,11 +22,11 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::atomic::write_atomic;
-use crate::report::{ReportError, e_slide, load_run};
-use crate::runner::run_case_with;
-use crate::schema::{AdaptiveSpec, Case, ContactSolveSpec, StepSpec};
-use crate::validate::CaseError;
+use crate::{ReportError, e_slide, load_run};
+use skid_cases::atomic::write_atomic;
+use skid_cases::runner::run_case_with;
+use skid_cases::schema::{AdaptiveSpec, Case, ContactSolveSpec, StepSpec};
+use skid_cases::validate::CaseError;
 
 /// Runs shorter than this (s) are repeated and their median taken.
 pub const REPEAT_BELOW_S: f64 = 2.0;
@@ -246,7 +246,7 @@ pub fn median(values: &[f64]) -> f64 {
 
 /// The smallest dynamic time step of a case (the one the ladder's factors apply to).
 fn base_dt(case: &Case) -> Option<f64> {
-    crate::report::convergence::time_steps(case)
+    crate::convergence::time_steps(case)
         .into_iter()
         .reduce(f64::min)
 }
@@ -400,7 +400,7 @@ pub const BENCH_MD: &str = "bench.md";
 /// # Errors
 /// [`BenchError`] if a file cannot be written.
 pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), BenchError> {
-    use crate::report::format::{percent, show};
+    use crate::format::{percent, show};
     use std::fmt::Write as _;
     let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
     for r in records.iter().filter(|r| !r.reference) {
@@ -416,14 +416,14 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
             }
         }
     }
-    crate::report::plot::plot_log_log(
+    crate::plot::plot_log_log(
         "Work-precision",
         &series,
         (
             "median wall time [s]",
             "error against the finest level (deceleration: relative; e_slide)",
         ),
-        &out.join(crate::report::plot::WORK_PRECISION_SVG),
+        &out.join(crate::plot::WORK_PRECISION_SVG),
     )?;
     let mut md = String::from("# Work against error (`skid bench`)\n\n");
     md.push_str(
@@ -443,7 +443,7 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
     let _ = writeln!(
         md,
         "![deceleration error and e_slide against wall time]({})\n",
-        crate::report::plot::WORK_PRECISION_SVG
+        crate::plot::WORK_PRECISION_SVG
     );
     md.push_str(
         "| case | method | dt [s] | status | wall [s] | runs | assembly / linear / contact [s] | increments | Newton iterations | fallbacks | deceleration [rad/s^2] | deceleration error [%] | e_slide [%] | t_stop [s] | t_stop difference [%] |\n\
@@ -481,7 +481,7 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
 /// What the quasi-static pad changes in the answer: for every case with both, the quasi-static
 /// reference against the dynamic one (the `reduced` reference, else the `global` one).
 fn model_change(records: &[BenchRecord]) -> String {
-    use crate::report::format::percent;
+    use crate::format::percent;
     use std::fmt::Write as _;
     let reference = |case: &str, method: BenchMethod| {
         records
@@ -540,7 +540,7 @@ mod tests {
         let text = include_str!("../../../cases/drum/2d-analytic.json");
         let overrides = ["steps[1].duration=0.01".to_string()];
         let file = PathBuf::from("2d-analytic.json");
-        let case = crate::validate::parse_case(text, &file, &overrides).expect("case");
+        let case = skid_cases::validate::parse_case(text, &file, &overrides).expect("case");
         let dir = tempfile::tempdir().expect("tempdir");
         let settings = BenchSettings {
             levels: 2,
@@ -571,11 +571,7 @@ mod tests {
                 .count(),
             2
         );
-        assert!(
-            dir.path()
-                .join(crate::report::plot::WORK_PRECISION_SVG)
-                .is_file()
-        );
+        assert!(dir.path().join(crate::plot::WORK_PRECISION_SVG).is_file());
         let written: Vec<BenchRecord> = serde_json::from_str(
             &std::fs::read_to_string(dir.path().join(BENCH_JSON)).expect("bench.json"),
         )

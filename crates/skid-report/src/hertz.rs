@@ -27,10 +27,10 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 use super::ReportError;
-use crate::csv_out::CsvTable;
-use crate::model_spec::ModelSpec;
-use crate::model_spec::{LoadSpec, RigidSurfaceSpec};
-use crate::schema::MaterialSpec;
+use skid_cases::csv_out::CsvTable;
+use skid_cases::model_spec::ModelSpec;
+use skid_cases::model_spec::{LoadSpec, RigidSurfaceSpec};
+use skid_cases::schema::MaterialSpec;
 
 /// A Hertz scene: what its analytic answer needs.
 #[derive(Clone, Debug, PartialEq)]
@@ -71,7 +71,7 @@ impl HertzScene {
         else {
             return None;
         };
-        let [crate::model_spec::ModelStepSpec::Static { .. }] = spec.steps.as_slice() else {
+        let [skid_cases::model_spec::ModelStepSpec::Static { .. }] = spec.steps.as_slice() else {
             return None;
         };
         let MaterialSpec::PolynomialN1 { c10, c01, d1 } = spec.part.section.material;

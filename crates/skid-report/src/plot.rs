@@ -6,7 +6,7 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::{ReportError, Run, omega_difference};
-use crate::atomic::write_atomic;
+use skid_cases::atomic::write_atomic;
 
 /// File name of the omega(t) plot.
 pub const OMEGA_SVG: &str = "omega.svg";

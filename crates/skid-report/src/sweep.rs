@@ -14,8 +14,8 @@ use serde_json::Value;
 
 use super::ReportError;
 use super::format::show;
-use crate::atomic::write_atomic;
-use crate::sweep::SweepRun;
+use skid_cases::atomic::write_atomic;
+use skid_cases::sweep::SweepRun;
 
 /// What the sweep report found.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -219,7 +219,7 @@ fn render(text: &mut String, name: &str, runs: &BTreeMap<usize, Run>, outcome: &
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sweep::ParameterValue;
+    use skid_cases::sweep::ParameterValue;
 
     fn entry(index: usize, status: &str, t_stop: Option<f64>) -> Value {
         let run = SweepRun {

@@ -6,10 +6,10 @@
 
 use std::path::{Path, PathBuf};
 
-use skid_cases::report::hertz::{self, HertzScene};
-use skid_cases::report::verification;
 use skid_cases::restart::DEFAULT_RESTART_EVERY;
 use skid_cases::{RunSummary, run_file};
+use skid_report::hertz::{self, HertzScene};
+use skid_report::verification;
 
 fn repo(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

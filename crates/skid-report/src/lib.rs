@@ -1,4 +1,8 @@
-//! The validation report: reads runs (`<dir>/*/summary.json`, `history.csv`, `case.json`) and
+//! skid's reports: the validation report, the sweep report and the bench of cost against
+//! error, made from the outputs that runs wrote (this crate reads them; it runs nothing but the
+//! bench's own ladder of runs).
+//!
+//! The validation report reads runs (`<dir>/*/summary.json`, `history.csv`, `case.json`) and
 //! writes a markdown report with SVG plots next to it. Its sections, each from its own
 //! directory of runs:
 //!
@@ -13,11 +17,13 @@
 //!   analytic answers (Hertz contact, [`hertz`]; Coulomb friction).
 //!
 //! The sweep report ([`sweep`]) is a report of its own: the runs of parameter sweeps, merged
-//! from the batch directories of their shards.
+//! from the batch directories of their shards. [`mod@bench`] runs each case at a ladder of
+//! time steps and methods and reports its cost beside its error.
 //!
 //! This module: reading runs, and the comparison math (interpolation, `e_slide`); [`mod@format`]:
 //! number formatting and check lists shared by the sections.
 
+pub mod bench;
 pub mod convergence;
 pub mod format;
 pub mod hard;
@@ -36,10 +42,10 @@ use serde::Deserialize;
 
 use format::Counts;
 
-use crate::atomic::write_atomic;
-use crate::csv_out::{CsvError, CsvTable};
-use crate::runner::CASE_JSON;
-use crate::schema::Case;
+use skid_cases::atomic::write_atomic;
+use skid_cases::csv_out::{CsvError, CsvTable};
+use skid_cases::runner::CASE_JSON;
+use skid_cases::schema::Case;
 
 /// The run used as reference when none is requested.
 pub const DEFAULT_REFERENCE: &str = "3d-analytic-fine";

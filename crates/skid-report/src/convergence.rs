@@ -22,9 +22,9 @@ use serde_json::Value;
 use super::format::{Sig, percent, show};
 use super::plot::{NEWTON_SVG, plot_newton};
 use super::{ReportError, Run, e_slide, load_runs};
-use crate::csv_out::CsvTable;
-use crate::newton::NEWTON_CSV;
-use crate::schema::{Case, StepSpec};
+use skid_cases::csv_out::CsvTable;
+use skid_cases::newton::NEWTON_CSV;
+use skid_cases::schema::{Case, StepSpec};
 
 /// What the levels of a series refine.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -649,9 +649,9 @@ mod tests {
     }
 
     fn case(overrides: &[&str]) -> Case {
-        let text = include_str!("../../../../cases/drum/2d-analytic.json");
+        let text = include_str!("../../../cases/drum/2d-analytic.json");
         let overrides: Vec<String> = overrides.iter().map(|o| o.to_string()).collect();
-        crate::validate::parse_case(text, Path::new("2d-analytic.json"), &overrides)
+        skid_cases::validate::parse_case(text, Path::new("2d-analytic.json"), &overrides)
             .expect("valid case")
     }
 
