@@ -311,6 +311,15 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     }
 }
 
+/// How the series of a log-log plot are drawn.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Marks {
+    /// Points joined by lines (a curve per series).
+    Lines,
+    /// Points alone (a cloud per series).
+    Points,
+}
+
 /// A plot titled `title` on log scales in both axes, one curve of points per `(label,
 /// [(x, y)])` (points with a non-positive value are left out): `work-precision.svg` (error
 /// against wall time), `scaling.svg` (cost against equations).
@@ -320,40 +329,10 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 pub fn plot_log_log(
     title: &str,
     series: &[(String, Vec<(f64, f64)>)],
-    (x_label, y_label): (&str, &str),
+    labels: (&str, &str),
     path: &Path,
 ) -> Result<(), ReportError> {
-    let positive = |p: &&(f64, f64)| p.0 > 0.0 && p.1 > 0.0 && p.0.is_finite() && p.1.is_finite();
-    let all = || series.iter().flat_map(|(_, p)| p.iter()).filter(positive);
-    let x = log_range(all().map(|p| p.0));
-    let y = log_range(all().map(|p| p.1));
-    write_svg(path, |root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(title, ("sans-serif", 22))
-            .margin(16)
-            .x_label_area_size(48)
-            .y_label_area_size(72)
-            .build_cartesian_2d(x.log_scale(), y.log_scale())
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc(x_label)
-            .y_desc(y_label)
-            .x_label_formatter(&|v| format!("{v:.0e}"))
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        for (k, (label, points)) in series.iter().enumerate() {
-            let color = Palette99::pick(k).to_rgba();
-            let points: Vec<(f64, f64)> = points.iter().filter(positive).copied().collect();
-            chart
-                .draw_series(LineSeries::new(points, color.stroke_width(2)).point_size(4))
-                .map_err(|e| e.to_string())?
-                .label(label.as_str())
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color));
-        }
-        draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)
-    })
+    log_log(title, series, labels, Marks::Lines, None, path)
 }
 
 /// A scatter plot titled `title` on log scales in both axes: one set of points per `(label,
@@ -366,7 +345,19 @@ pub fn plot_log_log(
 pub fn plot_scatter_log_log(
     title: &str,
     series: &[(String, Vec<(f64, f64)>)],
+    labels: (&str, &str),
+    limit: Option<(String, f64)>,
+    path: &Path,
+) -> Result<(), ReportError> {
+    log_log(title, series, labels, Marks::Points, limit, path)
+}
+
+/// The log-log plot of [`plot_log_log`] and [`plot_scatter_log_log`].
+fn log_log(
+    title: &str,
+    series: &[(String, Vec<(f64, f64)>)],
     (x_label, y_label): (&str, &str),
+    marks: Marks,
     limit: Option<(String, f64)>,
     path: &Path,
 ) -> Result<(), ReportError> {
@@ -393,15 +384,22 @@ pub fn plot_scatter_log_log(
         for (k, (label, points)) in series.iter().enumerate() {
             let color = Palette99::pick(k).to_rgba();
             let points: Vec<(f64, f64)> = points.iter().filter(positive).copied().collect();
-            chart
-                .draw_series(
-                    points
-                        .into_iter()
-                        .map(|p| Circle::new(p, 3, color.filled())),
-                )
-                .map_err(|e| e.to_string())?
-                .label(label.as_str())
-                .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
+            match marks {
+                Marks::Lines => chart
+                    .draw_series(LineSeries::new(points, color.stroke_width(2)).point_size(4))
+                    .map_err(|e| e.to_string())?
+                    .label(label.as_str())
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color)),
+                Marks::Points => chart
+                    .draw_series(
+                        points
+                            .into_iter()
+                            .map(|p| Circle::new(p, 3, color.filled())),
+                    )
+                    .map_err(|e| e.to_string())?
+                    .label(label.as_str())
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled())),
+            };
         }
         if let Some((label, value)) = &limit {
             let style = BLACK.stroke_width(2);
@@ -416,7 +414,11 @@ pub fn plot_scatter_log_log(
                 .label(label.as_str())
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
         }
-        draw_legend(&mut chart, SeriesLabelPosition::LowerRight)
+        let legend = match marks {
+            Marks::Lines => SeriesLabelPosition::LowerLeft,
+            Marks::Points => SeriesLabelPosition::LowerRight,
+        };
+        draw_legend(&mut chart, legend)
     })
 }
 
