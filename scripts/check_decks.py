@@ -53,4 +53,4 @@ def main(decks, cases):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out/inp", sys.argv[2] if len(sys.argv) > 2 else "out/drum"))
+    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out/inp", sys.argv[2] if len(sys.argv) > 2 else "out/drum/runs"))

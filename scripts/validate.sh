@@ -8,7 +8,8 @@
 # and checks the 2D benchmark's convergence in time step, its insensitivity to the pad density,
 # that the conic (clarabel) Coulomb solve gives the run of the default Newton-first one, and
 # that the 2D and 3D spin-downs do not depend on the hourglass stabilisation's stiffness.
-# Results go to out/. Exit status 0 only if every run completed and every check passed.
+# Results go to out/ (the drum runs to out/drum/runs, where scripts/drum.sh puts them too).
+# Exit status 0 only if every run completed and every check passed.
 #
 # HARD_CASES: the hard case files or directories to run instead of cases/hard (words, globs
 # allowed), e.g. HARD_CASES='cases/hard/2d-*.json'.
@@ -18,7 +19,7 @@ cargo build --release -p skid-cli
 skid=${CARGO_TARGET_DIR:-target}/release/skid
 
 status=0
-"$skid" batch cases/drum --out out/drum || status=1
+"$skid" batch cases/drum --out out/drum/runs || status=1
 # shellcheck disable=SC2206 # split into words and expand globs on purpose
 hard=(${HARD_CASES:-cases/hard})
 rm -rf out/hard # runs of cases left out must not stay in the report
@@ -32,7 +33,7 @@ rm -rf out/verification
 measured=()
 [ -f validation/scaling.json ] && measured+=(--scaling validation/scaling.json)
 [ -f validation/stress.json ] && measured+=(--stress validation/stress.json)
-"$skid" report --runs out/drum --hard out/hard --convergence out/convergence \
+"$skid" report --runs out/drum/runs --hard out/hard --convergence out/convergence \
     --verification out/verification "${measured[@]}" --out validation/report.md || status=1
 
 out=out/validation
@@ -57,5 +58,5 @@ python3 scripts/check_drum.py "$out" || status=1
 # the input decks of cases/inp against the case files' runs
 rm -rf out/inp
 "$skid" batch cases/inp --out out/inp >/dev/null || status=1
-python3 scripts/check_decks.py out/inp out/drum || status=1
+python3 scripts/check_decks.py out/inp out/drum/runs || status=1
 exit $status

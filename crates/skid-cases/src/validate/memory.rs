@@ -42,7 +42,7 @@ pub const SPARSE_ENTRY_BYTES: f64 = 16.0;
 /// [`SPARSE_ENTRY_BYTES`], the largest round coefficient that keeps the estimate below the peak
 /// resident memory measured at every level of `scripts/scaling.py` (tightest at 19,034
 /// equations on the reduced path, 1.06 times the estimate; at 101,810 equations the measured
-/// 5.4 GB is 1.6 times it). The preconditioner's nested-dissection factor alone holds about
+/// 5.25 GB is 1.5 times it). The preconditioner's nested-dissection factor alone holds about
 /// 18 `n^(4/3)` entries at 1e5 equations.
 pub const FACTOR_BYTES_3D: f64 = 40.0 * SPARSE_ENTRY_BYTES;
 /// Memory assumed available where the system does not say (no `/proc/meminfo`), bytes.
