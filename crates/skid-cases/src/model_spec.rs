@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::schema::{
     AdaptiveSpec, MaterialSpec, OutputSpec, SolverSpec, default_alpha, default_regularization_time,
+    one,
 };
 
 /// Format version a model file must declare in `skid_model`.
@@ -152,10 +153,6 @@ pub struct SectionSpec {
     /// each increment; rigid bodies tied to it must then be massless.
     #[serde(default)]
     pub quasi_static: bool,
-}
-
-fn one() -> f64 {
-    1.0
 }
 
 /// A rigid body: a reference node with a point mass and a rotary inertia, and optionally a

@@ -145,7 +145,8 @@ pub struct PadSpec {
     pub quasi_static: bool,
 }
 
-fn one() -> f64 {
+/// The serde default of factors and thicknesses: 1.
+pub(crate) fn one() -> f64 {
     1.0
 }
 
