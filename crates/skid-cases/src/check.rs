@@ -144,7 +144,7 @@ fn check_case(case: &Case, source: &Path) -> Result<CheckReport, CaseError> {
         d => return Err(bad_dimension(source, d)),
     };
     Ok(CheckReport {
-        memory_bytes: Some(memory::estimate(case).iter().map(|t| t.bytes).sum()),
+        memory_bytes: Some(memory::needed(case)),
         ..report("case file", &case.name, case.dimension, n)
     })
 }

@@ -10,6 +10,7 @@
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
+use skid_integrator::settings::ContactSolve;
 
 /// Index of the drum among the rigid bodies of a drum case's model.
 pub const DRUM: usize = 0;
@@ -305,6 +306,19 @@ pub struct SolverSpec {
     pub cutback_factor: f64,
     /// Consecutive cutbacks before the run stops.
     pub max_cutbacks: usize,
+}
+
+impl SolverSpec {
+    /// The contact solve these settings ask for, where `auto` takes `preferred` (the model's,
+    /// [`ContactSolve::preferred_for`]); the conic Coulomb method works on the reduced operator
+    /// only.
+    pub fn contact_solve_with(&self, preferred: ContactSolve) -> ContactSolve {
+        match (self.contact_solve, self.coulomb_method) {
+            (_, CoulombMethodSpec::Conic) | (ContactSolveSpec::Reduced, _) => ContactSolve::Reduced,
+            (ContactSolveSpec::Auto, _) => preferred,
+            (ContactSolveSpec::Global, _) => ContactSolve::Global,
+        }
+    }
 }
 
 impl Default for SolverSpec {

@@ -462,7 +462,7 @@ fn check_case_error(error: &CaseError, path: &Path) -> Result<(), TestCaseError>
 fn check_case_text(text: &str, path: &Path, overrides: &[String]) -> Result<(), TestCaseError> {
     match parse_case(text, path, overrides) {
         Ok(case) => {
-            let bytes: f64 = memory::estimate(&case).iter().map(|t| t.bytes).sum();
+            let bytes = memory::needed(&case);
             prop_assert!(
                 bytes.is_finite() && bytes <= memory::available() as f64,
                 "accepted a case of {bytes} B"

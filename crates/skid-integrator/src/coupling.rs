@@ -305,44 +305,6 @@ mod tests {
     use crate::model::Model;
     use crate::test_support::block_on_drum;
 
-    /// `H dx` predicts the change of gaps and slips for a small motion of nodes and drum.
-    fn rows_are_the_derivative_of_the_kinematics<const D: usize>() {
-        let model = block_on_drum::<D>();
-        let n = model.dofs().len();
-        let held = vec![false; n];
-        let x = DVector::from_fn(n, |i, _| 1e-3 * (i as f64 * 0.9).sin());
-        let start: Vec<Vector2<f64>> = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
-        let previous = rows.coords.clone();
-        let dx = DVector::from_fn(n, |i, _| 1e-7 * (i as f64 * 2.3).cos());
-        let plus = contact_rows(&model, &(&x + &dx), None, &previous, &held).expect("rows");
-        let minus = contact_rows(&model, &(&x - &dx), None, &previous, &held).expect("rows");
-        let predicted = rows.times(&dx);
-        let measured = (&plus.u - &minus.u) / 2.0;
-        assert!(
-            (&predicted - &measured).amax() < 1e-6 * predicted.amax(),
-            "{D}D: {predicted} vs {measured}"
-        );
-        // The drum's rotation and translation both enter the rows.
-        let drum_eqs = model.dofs().body_equations(0);
-        assert!(
-            rows.rows
-                .iter()
-                .any(|r| r.iter().any(|(eq, _)| drum_eqs.contains(eq)))
-        );
-        // Held equations are dropped.
-        let mut held = held;
-        for &eq in &drum_eqs {
-            held[eq] = true;
-        }
-        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
-        assert!(
-            rows.rows
-                .iter()
-                .all(|r| r.iter().all(|(eq, _)| !drum_eqs.contains(eq)))
-        );
-    }
-
     /// Screening open candidates out of the conic solve gives the full problem's solution,
     /// including for a candidate that only closes because a neighbour's force pulls it in.
     #[test]
@@ -569,15 +531,5 @@ mod tests {
     #[test]
     fn delassus_is_h_k_inverse_h_transpose_3d() {
         delassus_is_h_k_inverse_h_transpose::<3>();
-    }
-
-    #[test]
-    fn rows_are_the_derivative_of_the_kinematics_2d() {
-        rows_are_the_derivative_of_the_kinematics::<2>();
-    }
-
-    #[test]
-    fn rows_are_the_derivative_of_the_kinematics_3d() {
-        rows_are_the_derivative_of_the_kinematics::<3>();
     }
 }

@@ -52,8 +52,16 @@ impl ContactSolve {
     /// spin-down took 16.2 s against 27.6 s); [`ContactSolve::Reduced`] otherwise.
     pub fn preferred_for<const D: usize>(model: &Model<D>) -> Self {
         let candidates: usize = model.contacts().iter().map(|p| p.nodes.len()).sum();
-        let unknowns = model.dofs().len() + D * candidates;
-        if model.part().quasi_static || unknowns >= QUASI_DEFINITE_FROM {
+        Self::preferred(
+            model.part().quasi_static,
+            model.dofs().len() + D * candidates,
+        )
+    }
+
+    /// [`ContactSolve::preferred_for`] a model with a quasi-static solid or not and `unknowns`
+    /// unknowns of its global system (equations and contact rows), known before it is built.
+    pub fn preferred(quasi_static: bool, unknowns: usize) -> Self {
+        if quasi_static || unknowns >= QUASI_DEFINITE_FROM {
             Self::Global
         } else {
             Self::Reduced

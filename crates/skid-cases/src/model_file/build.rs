@@ -23,7 +23,7 @@ use crate::model_spec::{
     BoundarySpec, Dof, MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, RigidSurfaceSpec, SlaveSpec,
     StepBoundarySpec,
 };
-use crate::schema::{AdaptiveSpec, ContactSolveSpec, CoulombMethodSpec, MaterialSpec, SolverSpec};
+use crate::schema::{AdaptiveSpec, MaterialSpec, SolverSpec};
 
 /// A built scene: model, steps and solver settings.
 #[derive(Debug)]
@@ -709,8 +709,7 @@ fn held_motions<const D: usize>(
 }
 
 /// Solver settings; `auto` takes the contact solve `preferred` for the model
-/// ([`ContactSolve::preferred_for`]); the conic Coulomb method works on the reduced operator
-/// only.
+/// ([`SolverSpec::contact_solve_with`]).
 fn solver_settings(s: &SolverSpec, preferred: ContactSolve) -> Result<Settings, SpecError> {
     if s.max_newton_iterations == 0 {
         return fail("solver.max_newton_iterations", "expected at least 1");
@@ -739,11 +738,7 @@ fn solver_settings(s: &SolverSpec, preferred: ContactSolve) -> Result<Settings, 
             method: s.coulomb_method.into(),
             ..Default::default()
         },
-        contact_solve: match (s.contact_solve, s.coulomb_method) {
-            (_, CoulombMethodSpec::Conic) | (ContactSolveSpec::Reduced, _) => ContactSolve::Reduced,
-            (ContactSolveSpec::Auto, _) => preferred,
-            (ContactSolveSpec::Global, _) => ContactSolve::Global,
-        },
+        contact_solve: s.contact_solve_with(preferred),
         cutback: CutbackSettings {
             factor: s.cutback_factor,
             max_cutbacks: s.max_cutbacks,

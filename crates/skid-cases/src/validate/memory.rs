@@ -11,8 +11,9 @@
 //!   [`SPARSE_ENTRY_BYTES`], and its factorization: at least the matrix's entries, and in 3D
 //!   [`FACTOR_BYTES_3D`] `n^(4/3)` for `n` equations, the growth of a nested-dissection
 //!   factor's fill on a 3D mesh (2D fill, `n log n`, is not counted);
-//! - on the reduced contact path (`solver.contact_solve` `reduced`, or `auto` on a model it
-//!   gives that path: a pad that is not quasi-static, under [`QUASI_DEFINITE_FROM`] unknowns)
+//! - on the reduced contact path (the one the run takes,
+//!   [`crate::schema::SolverSpec::contact_solve_with`]: `reduced`, or `auto` on a pad that is
+//!   not quasi-static, under `skid_integrator::global_contact::QUASI_DEFINITE_FROM` unknowns)
 //!   the dense contact block: the inverse of the stiffness on the contact equations, its
 //!   product with the contact rows and the Delassus operator, three dense squares of `D`
 //!   equations per front-face node;
@@ -27,10 +28,10 @@
 //! 14 MB). A case whose estimate exceeds the available memory is refused
 //! before the run, naming the field whose term is the largest.
 
-use skid_integrator::global_contact::QUASI_DEFINITE_FROM;
+use skid_integrator::settings::ContactSolve;
 
 use crate::history::Sample;
-use crate::schema::{Case, ContactSolveSpec, CoulombMethodSpec, DrumSurfaceSpec, StepSpec};
+use crate::schema::{Case, DrumSurfaceSpec, StepSpec};
 
 /// Bytes per degree of freedom of the pad: eight vectors of one `f64` each.
 pub const NODE_BYTES_PER_DOF: f64 = 64.0;
@@ -100,14 +101,10 @@ pub fn estimate(case: &Case) -> Vec<Term> {
             bytes: entries * SPARSE_ENTRY_BYTES + factor,
         },
     ];
-    let reduced = match (case.solver.contact_solve, case.solver.coulomb_method) {
-        (ContactSolveSpec::Reduced, _) | (_, CoulombMethodSpec::Conic) => true,
-        (ContactSolveSpec::Global, _) => false,
-        (ContactSolveSpec::Auto, _) => {
-            !case.pad.quasi_static && dofs + contact_equations < QUASI_DEFINITE_FROM as f64
-        }
-    };
-    if reduced {
+    // the unknowns as the model will count them (`as` saturates on absurd counts)
+    let unknowns = (dofs + contact_equations) as usize;
+    let preferred = ContactSolve::preferred(case.pad.quasi_static, unknowns);
+    if case.solver.contact_solve_with(preferred) == ContactSolve::Reduced {
         terms.push(Term {
             field: "pad.elements",
             what: format!(
@@ -151,6 +148,11 @@ pub fn estimate(case: &Case) -> Vec<Term> {
         bytes: increments * std::mem::size_of::<Sample>() as f64,
     });
     terms
+}
+
+/// The total of [`estimate`], bytes.
+pub fn needed(case: &Case) -> f64 {
+    estimate(case).iter().map(|t| t.bytes).sum()
 }
 
 /// The memory available to a new process, bytes: `MemAvailable` of `/proc/meminfo`, or
@@ -248,10 +250,6 @@ mod tests {
             .any(|t| t.what.starts_with("the dense contact block"))
     }
 
-    fn total(case: &Case) -> f64 {
-        estimate(case).iter().map(|t| t.bytes).sum()
-    }
-
     /// The dense contact block is counted where the run forms it: on the reduced path, chosen
     /// or taken by `auto` on a small pad that is not quasi-static.
     #[test]
@@ -276,8 +274,8 @@ mod tests {
     /// to the power 4/3, to within 10 % (the mesh and the matrix grow linearly).
     #[test]
     fn a_large_3d_pad_costs_its_fill() {
-        let small = total(&drum_3d([50, 8, 10], &[]));
-        let large = total(&drum_3d([100, 16, 20], &[]));
+        let small = needed(&drum_3d([50, 8, 10], &[]));
+        let large = needed(&drum_3d([100, 16, 20], &[]));
         let nodes = (101.0 * 17.0 * 21.0) / (51.0 * 9.0 * 11.0);
         let ratio = (large / small) / f64::powf(nodes, 4.0 / 3.0);
         assert!((0.9..=1.0).contains(&ratio), "{ratio}");
