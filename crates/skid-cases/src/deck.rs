@@ -24,10 +24,13 @@
 //! - model-data boundary conditions hold throughout; in a step, zero-valued conditions on a
 //!   reference node hold that degree of freedom for the step (at its value at the step's start;
 //!   `OP=NEW` drops those of earlier steps);
-//! - the loads of the first step are those of the model: without amplitude, ramped over it
-//!   when it is static (applied at once when dynamic) and held after; with one, its value at
-//!   the step time (a static step's runs from 0 to 1); later steps must keep them (see
-//!   [`loads`] for gravity's direction and `OP=NEW`);
+//! - a load given in a step stays in force in later steps until a line at its place changes it
+//!   (`OP=MOD`) or `OP=NEW` removes it; without amplitude it goes linearly over a static step
+//!   from its value at the end of the previous step to the new one (from 0 in the first step;
+//!   a removed load to 0), and takes the new value at once in a dynamic step; with one, it is
+//!   its value in the step times the amplitude at the step time (a static step's runs from 0
+//!   to 1). The model's loads carry their factor in each step (see [`assemble`] and [`loads`]
+//!   for gravity's direction and `OP=NEW`);
 //! - `*DYNAMIC` without `ALPHA` takes the keyword's default `-0.05`;
 //! - `*ELASTIC` is the compressible neo-Hookean solid with the same small-strain moduli;
 //! - rigid membranes and shells are contacted on their mid-surface (zero thickness), rigid

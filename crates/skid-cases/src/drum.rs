@@ -231,6 +231,7 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
             surface: "ymax".into(),
             pressure: case.back_plate.pressure,
             amplitude: None,
+            step_factors: None,
         }],
         amplitudes: Vec::new(),
         contact: vec![ContactPairSpec {

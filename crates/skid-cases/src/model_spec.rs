@@ -49,12 +49,16 @@ pub struct ModelSpec {
     /// Node sets tied to rigid bodies.
     #[serde(default)]
     pub ties: Vec<TieSpec>,
-    /// Loads; each acts in every step. A load with an `amplitude` is that amplitude's value
-    /// at the step time times its full value: the time since the step began in a dynamic step,
-    /// and in a static step (which takes no physical time) the completed fraction of the step,
-    /// 0 to 1 (a static step's time period is 1). A load without amplitude is ramped from 0 to
-    /// full value over the first step if it is static and held at full value after (from the
-    /// start if the first step is dynamic).
+    /// Loads. A load acts in every step at its value times its factor in the step
+    /// (`step_factors`, 1 in every step if absent). A load with an `amplitude` is that
+    /// amplitude's value at the step time times the step's factor and its value: the time since
+    /// the step began in a dynamic step, and in a static step (which takes no physical time) the
+    /// completed fraction of the step, 0 to 1 (a static step's time period is 1). A load without
+    /// amplitude goes linearly over a static step from its factor at the end of the previous
+    /// step (0 before the first step) to the step's factor, and takes the step's factor at once
+    /// in a dynamic step: without `step_factors` it is ramped from 0 to full value over the
+    /// first step if that is static and held at full value after (from the start if the first
+    /// step is dynamic).
     #[serde(default)]
     pub loads: Vec<LoadSpec>,
     /// Named amplitudes: piecewise-linear factors of the step time that loads may name.
@@ -319,6 +323,9 @@ pub enum LoadSpec {
         /// Amplitude name.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         amplitude: Option<String>,
+        /// Factor on the load in each step, one per step (absent: 1 in every step).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        step_factors: Option<Vec<f64>>,
     },
     /// A force fixed in direction and size on every node of a node set (each node receives
     /// the whole force), or a force and a moment on a rigid body's reference node.
@@ -339,6 +346,9 @@ pub enum LoadSpec {
         /// Amplitude name.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         amplitude: Option<String>,
+        /// Factor on the load in each step, one per step (absent: 1 in every step).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        step_factors: Option<Vec<f64>>,
     },
     /// A uniform body-force acceleration: the force `m g` on every lumped node mass of the
     /// loaded elements (`rho V / 2^D` per element corner, `V` counting the thickness in 2D),
@@ -352,6 +362,9 @@ pub enum LoadSpec {
         /// Amplitude name.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         amplitude: Option<String>,
+        /// Factor on the load in each step, one per step (absent: 1 in every step).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        step_factors: Option<Vec<f64>>,
     },
 }
 
@@ -362,6 +375,15 @@ impl LoadSpec {
             Self::Pressure { amplitude, .. }
             | Self::Concentrated { amplitude, .. }
             | Self::Gravity { amplitude, .. } => amplitude.as_deref(),
+        }
+    }
+
+    /// The load's factor in each step, if given.
+    pub fn step_factors(&self) -> Option<&[f64]> {
+        match self {
+            Self::Pressure { step_factors, .. }
+            | Self::Concentrated { step_factors, .. }
+            | Self::Gravity { step_factors, .. } => step_factors.as_deref(),
         }
     }
 }

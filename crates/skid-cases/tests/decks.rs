@@ -545,16 +545,19 @@ fn concentrated_loads_gravity_and_amplitudes_map_onto_the_model() {
                 force: Some(vec![3.0, 0.0]),
                 moment: None,
                 amplitude: None,
+                step_factors: None,
             },
             LoadSpec::Gravity {
                 acceleration: vec![0.0, -2.0],
                 element_set: Some("left".into()),
                 amplitude: None,
+                step_factors: None,
             },
             LoadSpec::Gravity {
                 acceleration: vec![0.0, -9.81],
                 element_set: None,
                 amplitude: ramp,
+                step_factors: None,
             },
         ]
     );

@@ -333,7 +333,7 @@ fn loads_whose_amplitudes_restart_with_a_step_jump_there_without_work() {
 /// Each problem in a load or an amplitude is reported with its field path.
 #[test]
 fn every_load_error_names_its_field() {
-    let cases: [(&str, &str, &str); 14] = [
+    let cases: [(&str, &str, &str); 15] = [
         (
             r#"loads[1].amplitude="ramp""#,
             "loads[1].amplitude",
@@ -400,6 +400,11 @@ fn every_load_error_names_its_field() {
             "loads[0].surface",
             "no surface named 'top'",
         ),
+        (
+            r#"loads[1].step_factors=[1.0, 2.0]"#,
+            "loads[1].step_factors",
+            "expected one factor per step (1 steps), got 2",
+        ),
     ];
     for (set, field, fragment) in cases {
         let spec = scene_spec("2d-block-pushed-on-flat", &[set.to_string()]);
@@ -407,4 +412,94 @@ fn every_load_error_names_its_field() {
         assert_eq!(error.field, field, "{set}: {error:?}");
         assert!(error.message.contains(fragment), "{set}: {}", error.message);
     }
+}
+
+/// Loads that change between steps, from a deck (`2d-block-stick-then-slide-deck.inp`): the
+/// block of the pushed scene pressed by N = 20 N in a static step, pushed sideways by
+/// F = 3 N = 0.5 mu N in a second static step (`*CLOAD` adding a component), then by
+/// F = 9 N = 1.5 mu N in a dynamic step (`*CLOAD` changing it).
+///
+/// The deck's loads become two loads of the model: the press, and the push with its factor in
+/// each step (0, 1, 3). In the static steps the block is in equilibrium: no contact slides,
+/// the friction resultant is -F at every increment of the push's ramp (F/4, F/2, 3F/4, F) and
+/// the normal one N (during the press, its share of N), to the force tolerance (1e-6 of the
+/// largest force; measured: 9e-8 of N for the normal resultant, 4e-10 for the friction one). Once the push is raised
+/// every contact slides and the friction resultant is exactly -mu times the normal one (to
+/// 1e-6, as in the pushed scene), and the block accelerates at `(F - mu N) / m = 3000 m/s^2`
+/// (the plate's velocity after the 10 ms of the step, to 1e-3: the jump of the push sets the
+/// block vibrating on its contacts).
+#[test]
+fn a_block_sticks_then_slides_as_the_loads_of_a_deck_change_between_steps() {
+    let deck = skid_cases::deck::read_model(&repo(
+        "cases/verification/2d-block-stick-then-slide-deck.inp",
+    ))
+    .expect("deck reads")
+    .model;
+    let expected_loads: Vec<(Vec<f64>, Option<Vec<f64>>)> = vec![
+        (vec![0.0, -20.0], None),
+        (vec![3.0, 0.0], Some(vec![0.0, 1.0, 3.0])),
+    ];
+    let loads: Vec<(Vec<f64>, Option<Vec<f64>>)> = deck
+        .loads
+        .iter()
+        .map(|l| match l {
+            LoadSpec::Concentrated {
+                force: Some(force),
+                step_factors,
+                ..
+            } => (force.clone(), step_factors.clone()),
+            other => panic!("expected concentrated loads, got {other:?}"),
+        })
+        .collect();
+    assert_eq!(loads, expected_loads);
+
+    let scene = model_file::build::<2>(&deck).expect("scene builds");
+    struct Steps(Vec<(String, State)>);
+    impl Observer<2> for Steps {
+        fn on_increment(&mut self, _: &Model<2>, r: &IncrementReport<'_>) -> std::io::Result<()> {
+            self.0.push((r.step.to_string(), r.state.clone()));
+            Ok(())
+        }
+    }
+    let mut record = Steps(Vec::new());
+    let (_, result) = run(&scene.model, &scene.steps, &scene.settings, &mut record);
+    let last = result.expect("run completes");
+    let in_step = |name: &str| -> Vec<&State> {
+        record
+            .0
+            .iter()
+            .filter(|(step, _)| step == name)
+            .map(|(_, s)| s)
+            .collect()
+    };
+    let (n, f) = (20.0, 3.0);
+    let ramp = [0.25, 0.5, 0.75, 1.0];
+    for (step, presses, pushes) in [("press", ramp, [0.0; 4]), ("stick", [1.0; 4], ramp)] {
+        let states = in_step(step);
+        assert_eq!(states.len(), 4, "{step}: increments");
+        for ((state, press), push) in states.iter().zip(presses).zip(pushes) {
+            let (t, normal) = resultants(state);
+            assert!((normal - press * n).abs() <= 1e-6 * n, "{step}: N = {normal}");
+            assert!((t + push * f).abs() <= 1e-6 * n, "{step}: T = {t}");
+            let slipping = state
+                .contacts
+                .iter()
+                .filter(|c| c.tangential_force.norm() >= MU * c.normal_force * (1.0 - 1e-9))
+                .count();
+            assert_eq!(slipping, 0, "{step}: contacts at the cone's edge, T = {t}");
+        }
+    }
+    let sliding = in_step("slide");
+    assert!(!sliding.is_empty());
+    for state in &sliding {
+        let (t, normal) = resultants(state);
+        assert!(
+            (t + MU * normal).abs() <= 1e-6 * MU * normal,
+            "T = {t}, mu N = {}",
+            MU * normal
+        );
+    }
+    let v = last.v[plate_x(&scene.model)];
+    let expected = (3.0 * f - MU * n) / MASS * 0.01;
+    assert!((v - expected).abs() <= 1e-3 * expected, "v = {v}, expected {expected}");
 }

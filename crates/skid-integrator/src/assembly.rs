@@ -343,7 +343,7 @@ pub fn external_forces<const D: usize>(
     let mut f = DVector::zeros(model.dofs().len());
     let mesh = &model.part().mesh;
     for load in model.pressures() {
-        let pressure = instant.factor(load.amplitude.as_ref()) * load.pressure;
+        let pressure = instant.factor(&load.variation) * load.pressure;
         for face in &load.faces {
             let xf: Vec<SVector<f64, D>> = face
                 .iter()
@@ -363,7 +363,7 @@ pub fn external_forces<const D: usize>(
         }
     }
     for load in model.dead_loads() {
-        f.axpy(instant.factor(load.amplitude.as_ref()), &load.force, 1.0);
+        f.axpy(instant.factor(&load.variation), &load.force, 1.0);
     }
     Ok(f)
 }

@@ -62,6 +62,8 @@ pub enum IncrementKind {
         regularization: f64,
         /// Step time at the end of the increment (the completed fraction of the step).
         step_time: f64,
+        /// Index of the step in the run.
+        step: usize,
     },
     /// HHT increment of size `h`.
     Dynamic {
@@ -71,25 +73,39 @@ pub enum IncrementKind {
         h: f64,
         /// Step time at the end of the increment, s.
         step_time: f64,
+        /// Index of the step in the run.
+        step: usize,
+        /// Completed fraction of the step at the end of the increment.
+        fraction: f64,
     },
 }
 
 impl IncrementKind {
     /// Where the loads stand at the end of the increment: the ramp of a static increment's load
-    /// factor (1 in a dynamic one) and the step time.
+    /// factor (1 in a dynamic one), the step time, the step and its completed fraction.
     pub fn loads(&self) -> LoadInstant {
         match *self {
             Self::Static {
                 load_factor,
                 step_time,
+                step,
                 ..
             } => LoadInstant {
                 ramp: load_factor,
                 step_time,
+                step,
+                fraction: step_time,
             },
-            Self::Dynamic { step_time, .. } => LoadInstant {
+            Self::Dynamic {
+                step_time,
+                step,
+                fraction,
+                ..
+            } => LoadInstant {
                 ramp: 1.0,
                 step_time,
+                step,
+                fraction,
             },
         }
     }
@@ -316,7 +332,13 @@ fn solve_increment_with<const D: usize>(
             let (force_residual, force_worst) = scaled_force_residual(
                 model,
                 &full,
-                &[&internal.force, &f_ext, &inertia, &contact_force],
+                &[
+                    &internal.force,
+                    &f_ext,
+                    &start.external_force,
+                    &inertia,
+                    &contact_force,
+                ],
                 length,
             );
             let d = rows.components;
@@ -539,7 +561,9 @@ const MAX_STEP_HALVINGS: usize = 4;
 
 /// `max_i |R_i| / s` with `s` the largest magnitude among the given force vectors, and the
 /// equation `i` where it is reached (`None` without equations); moments are divided by the
-/// model size so that both compare as forces.
+/// model size so that both compare as forces. The forces include the loads at the start of
+/// the increment, so that an increment that removes every load is judged against the loads it
+/// removes rather than against forces that vanish with them.
 fn scaled_force_residual<const D: usize>(
     model: &Model<D>,
     residual: &DVector<f64>,

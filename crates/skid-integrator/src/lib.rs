@@ -50,6 +50,7 @@ mod test_support;
 pub use error::{IncrementFailure, LinearFailure, ModelError, RunError, WorstResidual};
 pub use loads::{
     Amplitude, ConcentratedLoad, GravityLoad, LoadInstant, LoadTarget, Loads, PressureLoad,
+    StepVariation, Variation,
 };
 pub use model::{ContactPair, Model, SolidPart, Tie};
 pub use settings::Settings;

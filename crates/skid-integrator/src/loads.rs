@@ -1,13 +1,15 @@
 //! Loads and how they vary over a run: follower pressures, concentrated forces and moments, and
 //! gravity, each scaled by its amplitude or by the default ramp.
 //!
-//! A load's factor at an instant of a step is `A(t_s)` if it has an [`Amplitude`] `A`, read
-//! against the step time `t_s` (the time since the step began in a dynamic step; in a static
-//! step, which takes no physical time, the completed fraction of the step, 0 to 1, as a static
-//! step of unit time period), and otherwise the ramp: in a first step that is static, the
-//! fraction of it completed, and 1 from then on (and throughout when the first step is
-//! dynamic). The nodal forces at an instant are `f = sum_l factor_l f_l`, the pressures'
-//! `f_l` on the current geometry, the others fixed in direction and size (dead loads).
+//! A load's factor at an instant of a step follows its [`Variation`]: `A(t_s)` if it has an
+//! [`Amplitude`] `A`, read against the step time `t_s` (the time since the step began in a
+//! dynamic step; in a static step, which takes no physical time, the completed fraction of the
+//! step, 0 to 1, as a static step of unit time period); by default the ramp: in a first step
+//! that is static, the fraction of it completed, and 1 from then on (and throughout when the
+//! first step is dynamic); or, for a load that changes between steps, its own variation in
+//! each step ([`StepVariation`]). The nodal forces at an instant are `f = sum_l factor_l f_l`,
+//! the pressures' `f_l` on the current geometry, the others fixed in direction and size (dead
+//! loads).
 
 use nalgebra::{DVector, SVector, Vector3};
 
@@ -94,20 +96,67 @@ impl std::fmt::Display for AmplitudeError {
     }
 }
 
-/// Where the loads stand at the end of an increment (see the module documentation).
+/// How a load's factor varies over one step.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StepVariation {
+    /// Linear in the completed fraction `s` of the step: `from + (to - from) s`.
+    Ramp {
+        /// Factor at the start of the step.
+        from: f64,
+        /// Factor at its end.
+        to: f64,
+    },
+    /// `scale A(t_s)`, with `A` read against the step time.
+    Amplitude {
+        /// The amplitude `A`.
+        amplitude: Amplitude,
+        /// Factor on it.
+        scale: f64,
+    },
+}
+
+/// How a load's factor varies over the run (see the module documentation).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Variation {
+    /// The default ramp.
+    #[default]
+    Ramp,
+    /// `A(t_s)` in every step.
+    Amplitude(Amplitude),
+    /// One variation per step of the run, in order (the run checks that there is one for every
+    /// step).
+    PerStep(Vec<StepVariation>),
+}
+
+/// Where the loads stand at an instant of a step (see the module documentation).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LoadInstant {
-    /// Factor of the loads without amplitude.
+    /// Factor of the loads that follow the default ramp.
     pub ramp: f64,
     /// Step time the amplitudes are read against (s in a dynamic step, the completed fraction
     /// of a static step).
     pub step_time: f64,
+    /// Index of the step in the run.
+    pub step: usize,
+    /// Completed fraction of the step, 0 to 1.
+    pub fraction: f64,
 }
 
 impl LoadInstant {
-    /// The factor of a load with `amplitude` (`None`: the ramp).
-    pub fn factor(&self, amplitude: Option<&Amplitude>) -> f64 {
-        amplitude.map_or(self.ramp, |a| a.at(self.step_time))
+    /// The factor of a load that varies as `variation`. A per-step variation missing for this
+    /// step (which a run's check of its steps excludes) gives 0.
+    pub fn factor(&self, variation: &Variation) -> f64 {
+        match variation {
+            Variation::Ramp => self.ramp,
+            Variation::Amplitude(a) => a.at(self.step_time),
+            Variation::PerStep(steps) => match steps.get(self.step) {
+                Some(StepVariation::Ramp { from, to }) => from + (to - from) * self.fraction,
+                Some(StepVariation::Amplitude { amplitude, scale }) => {
+                    scale * amplitude.at(self.step_time)
+                }
+                None => 0.0,
+            },
+        }
     }
 }
 
@@ -130,8 +179,8 @@ pub struct ConcentratedLoad<const D: usize> {
     /// Moment on a rigid body, N m (zero on nodes); it must lie along the body's free rotation
     /// axis.
     pub moment: Vector3<f64>,
-    /// Time variation (`None`: the ramp).
-    pub amplitude: Option<Amplitude>,
+    /// Time variation.
+    pub variation: Variation,
 }
 
 /// A uniform body-force acceleration at factor 1: the force `m_i g` on every lumped mass
@@ -143,8 +192,8 @@ pub struct GravityLoad<const D: usize> {
     pub acceleration: SVector<f64, D>,
     /// Elements loaded (`None`: every element and every rigid body).
     pub elements: Option<Vec<usize>>,
-    /// Time variation (`None`: the ramp).
-    pub amplitude: Option<Amplitude>,
+    /// Time variation.
+    pub variation: Variation,
 }
 
 /// A uniform follower pressure on a set of faces (positive pushes into the solid).
@@ -158,8 +207,8 @@ pub struct PressureLoad {
     pub faces: Vec<Vec<usize>>,
     /// Pressure at load factor 1, Pa.
     pub pressure: f64,
-    /// Time variation (`None`: the ramp, see [`crate::loads`]).
-    pub amplitude: Option<Amplitude>,
+    /// Time variation (see [`crate::loads`]).
+    pub variation: Variation,
 }
 
 /// Every load of a model.
@@ -187,8 +236,8 @@ impl<const D: usize> From<Vec<PressureLoad>> for Loads<D> {
 pub struct DeadLoad {
     /// Forces (and moments) per equation at factor 1.
     pub force: DVector<f64>,
-    /// Time variation (`None`: the ramp).
-    pub amplitude: Option<Amplitude>,
+    /// Time variation.
+    pub variation: Variation,
 }
 
 /// What the nodal forces of dead loads are assembled from.
@@ -272,7 +321,7 @@ impl<const D: usize> ConcentratedLoad<D> {
         }
         Ok(DeadLoad {
             force: f,
-            amplitude: self.amplitude.clone(),
+            variation: self.variation.clone(),
         })
     }
 }
@@ -322,7 +371,7 @@ impl<const D: usize> GravityLoad<D> {
         }
         Ok(DeadLoad {
             force: f,
-            amplitude: self.amplitude.clone(),
+            variation: self.variation.clone(),
         })
     }
 }
@@ -370,13 +419,26 @@ mod tests {
     }
 
     #[test]
-    fn a_load_without_amplitude_follows_the_ramp() {
+    fn a_load_follows_the_ramp_its_amplitude_or_its_variation_in_the_step() {
         let instant = LoadInstant {
             ramp: 0.25,
             step_time: 0.5,
+            step: 1,
+            fraction: 0.75,
         };
         let a = Amplitude::new(vec![(0.0, 0.0), (1.0, 4.0)]).expect("amplitude");
-        assert_eq!(instant.factor(None), 0.25);
-        assert_eq!(instant.factor(Some(&a)), 2.0);
+        assert_eq!(instant.factor(&Variation::Ramp), 0.25);
+        assert_eq!(instant.factor(&Variation::Amplitude(a.clone())), 2.0);
+        let ramp = |from, to| StepVariation::Ramp { from, to };
+        let per_step = |second| Variation::PerStep(vec![ramp(0.0, 1.0), second]);
+        // from 1 to 3 over the step, three quarters done
+        assert_eq!(instant.factor(&per_step(ramp(1.0, 3.0))), 2.5);
+        let scaled = StepVariation::Amplitude {
+            amplitude: a,
+            scale: -0.5,
+        };
+        assert_eq!(instant.factor(&per_step(scaled)), -1.0);
+        let beyond = LoadInstant { step: 2, ..instant };
+        assert_eq!(beyond.factor(&per_step(ramp(1.0, 3.0))), 0.0);
     }
 }

@@ -34,7 +34,7 @@ use crate::error::{IncrementFailure, RunError};
 use crate::global_contact::{GlobalContactSolver, GlobalSolverMemory};
 use crate::hht::Hht;
 use crate::increment::{IncrementCounters, IncrementKind, Workspace, solve_increment};
-use crate::loads::LoadInstant;
+use crate::loads::{LoadInstant, Variation};
 use crate::model::Model;
 use crate::settings::Settings;
 use crate::state::{ContactPointState, EnergyLedger, State};
@@ -574,6 +574,8 @@ pub fn initial_state<const D: usize>(
         LoadInstant {
             ramp: load_factor,
             step_time: 0.0,
+            step: 0,
+            fraction: 0.0,
         },
     )?;
     let energy = EnergyLedger {
@@ -596,13 +598,13 @@ pub fn initial_state<const D: usize>(
 }
 
 /// The loads at the start of `step` (step time 0, the ramp where the last step left it, 1 in a
-/// dynamic step): an amplitude that restarts with the step may change them from the end of the
-/// last step. The state's external force and `f_int - f_ext` take the new loads, so that the
+/// dynamic step): an amplitude that restarts with the step, or a load's own variation in the
+/// step, may change them from the end of the last step. The state's external force and `f_int - f_ext` take the new loads, so that the
 /// step's first increment starts from them (its work by the trapezoidal rule, the HHT history
 /// term); a load that does not change leaves the state untouched.
 fn start_loads<const D: usize>(
     model: &Model<D>,
-    step: &Step,
+    (index, step): (usize, &Step),
     state: &mut State,
 ) -> Result<(), IncrementFailure> {
     let ramp = match step.kind {
@@ -612,6 +614,8 @@ fn start_loads<const D: usize>(
     let instant = LoadInstant {
         ramp,
         step_time: 0.0,
+        step: index,
+        fraction: 0.0,
     };
     let f_ext = external_forces(model, &state.x, instant)?;
     if f_ext != state.external_force {
@@ -638,6 +642,22 @@ fn consistent_acceleration<const D: usize>(
 
 fn validate_steps<const D: usize>(model: &Model<D>, steps: &[Step]) -> Result<(), RunError> {
     let bad = |s: &Step, msg: String| Err(RunError::Invalid(format!("step '{}': {msg}", s.name)));
+    let pressures = model.pressures().iter().map(|l| &l.variation).enumerate();
+    let dead = model.dead_loads().iter().map(|l| &l.variation).enumerate();
+    let variations = pressures
+        .map(|(i, v)| (format!("pressure load {i}"), v))
+        .chain(dead.map(|(i, v)| (format!("concentrated or gravity load {i}"), v)));
+    for (what, variation) in variations {
+        if let Variation::PerStep(per_step) = variation
+            && per_step.len() != steps.len()
+        {
+            return Err(RunError::Invalid(format!(
+                "{what}: it varies in {} steps, the run has {}",
+                per_step.len(),
+                steps.len()
+            )));
+        }
+    }
     for s in steps {
         for hold in &s.held {
             if hold.body >= model.bodies().len() {
@@ -895,7 +915,7 @@ impl<const D: usize> Run<'_, D> {
             } => (dt / duration, duration, adaptive),
         };
         if position.is_none() {
-            start_loads(model, step, &mut state).map_err(|cause| RunError::StepFailed {
+            start_loads(model, (index, step), &mut state).map_err(|cause| RunError::StepFailed {
                 step: step.name.clone(),
                 increment: 0,
                 time: state.time,
@@ -943,11 +963,14 @@ impl<const D: usize> Run<'_, D> {
                     load_factor: lambda0 + (1.0 - lambda0) * (progress + dp),
                     regularization: 1.0 / (regularization_time * regularization_time),
                     step_time: progress + dp,
+                    step: index,
                 },
                 StepKind::Dynamic { alpha, .. } => IncrementKind::Dynamic {
                     hht: Hht::new(alpha).map_err(RunError::Invalid)?,
                     h: dp * span,
                     step_time: (progress + dp) * span,
+                    step: index,
+                    fraction: progress + dp,
                 },
             };
             let before = workspace.counts();

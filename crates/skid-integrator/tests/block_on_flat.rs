@@ -11,7 +11,7 @@ use skid_integrator::settings::Settings;
 use skid_integrator::stepper::{
     Adaptive, Checkpoint, IncrementReport, Observer, RunStatistics, Step, StepKind, resume, run,
 };
-use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie};
+use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie, Variation};
 
 const MU: f64 = 0.3;
 const WIDTH: f64 = 0.02;
@@ -58,12 +58,12 @@ fn block(side_force: f64) -> (Model<2>, f64) {
             PressureLoad {
                 faces: top_faces,
                 pressure: P_TOP,
-                amplitude: None,
+                variation: Variation::Ramp,
             },
             PressureLoad {
                 faces: left_faces,
                 pressure: side_force / (HEIGHT * THICKNESS),
-                amplitude: None,
+                variation: Variation::Ramp,
             },
         ]
         .into(),

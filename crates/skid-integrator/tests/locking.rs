@@ -7,7 +7,7 @@ use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 use skid_integrator::settings::Settings;
 use skid_integrator::stepper::{IncrementReport, Observer, Step, StepKind, run};
-use skid_integrator::{Model, PressureLoad, SolidPart, State, Tie};
+use skid_integrator::{Model, PressureLoad, SolidPart, State, Tie, Variation};
 
 const LENGTH: f64 = 0.1;
 const HEIGHT: f64 = 0.01;
@@ -66,7 +66,7 @@ fn tip_deflection(k_over_mu: f64) -> f64 {
         vec![PressureLoad {
             faces: top,
             pressure: PRESSURE,
-            amplitude: None,
+            variation: Variation::Ramp,
         }]
         .into(),
         vec![],

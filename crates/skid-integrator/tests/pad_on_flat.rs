@@ -11,7 +11,7 @@ use nalgebra::Vector3;
 use skid_contact::plane::RigidPlane;
 use skid_integrator::settings::Settings;
 use skid_integrator::stepper::{IncrementReport, Observer, Step, StepKind, run};
-use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie};
+use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie, Variation};
 
 const LENGTH: f64 = 0.1;
 const THICKNESS: f64 = 0.05;
@@ -59,7 +59,7 @@ fn pad(pressure: f64, d1: f64) -> Model<2> {
         vec![PressureLoad {
             faces: back_faces,
             pressure,
-            amplitude: None,
+            variation: Variation::Ramp,
         }]
         .into(),
         vec![ContactPair {

@@ -17,7 +17,7 @@ use skid_fem::rigid::RigidBody;
 use skid_integrator::settings::ContactSolve;
 use skid_integrator::settings::Settings;
 use skid_integrator::stepper::{HeldMotion, IncrementReport, Observer, Step, StepKind, run};
-use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie};
+use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie, Variation};
 
 const MU: f64 = 0.3;
 const WIDTH: f64 = 0.02;
@@ -69,7 +69,7 @@ fn scene(quasi_static: bool, plate_mass: f64) -> Result<Model<2>, skid_integrato
         vec![PressureLoad {
             faces: top_faces,
             pressure: P_TOP,
-            amplitude: None,
+            variation: Variation::Ramp,
         }]
         .into(),
         vec![ContactPair {

@@ -9,7 +9,9 @@
 //! - `GRAV` takes the direction components as a direction: the acceleration is the magnitude
 //!   times the unit vector; without an element set it acts on the whole model (the part and
 //!   every rigid body's point mass);
-//! - `OP=NEW` on a keyword removes the loads of earlier steps given with the same keyword.
+//! - `OP=NEW` on a keyword removes the loads of earlier steps given with the same keyword;
+//!   the loads in force in each step become the model's loads with a factor per step (see
+//!   `assemble::loads::model_loads`).
 
 use super::fields::{allow_parameters, at_most, field, key, label, line_error, real, valued};
 use super::keywords::{Block, DeckError, Location};

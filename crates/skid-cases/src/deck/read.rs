@@ -914,9 +914,9 @@ fn start_step(defs: &Definitions, block: &Block) -> Result<StepDef, DeckError> {
     allow_parameters(block, &["NAME", "NLGEOM", "INC", "AMPLITUDE"])?;
     if let Some(amplitude) = valued(block, "AMPLITUDE")? {
         return Err(block.error(format!(
-            "AMPLITUDE={amplitude}: skid ramps the loads without amplitude over the first step if \
-             it is static and holds them after; remove the parameter, or give the loads an \
-             AMPLITUDE"
+            "AMPLITUDE={amplitude}: skid ramps the loads without amplitude over a static step \
+             and applies them at once in a dynamic one; remove the parameter, or give the loads \
+             an AMPLITUDE"
         )));
     }
     if let Some(inc) = valued(block, "INC")?

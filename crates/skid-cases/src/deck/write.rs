@@ -5,7 +5,8 @@
 //! the steps. Numbers are written so that they read back to the same bits.
 //!
 //! Two settings have no keyword and are refused: a static step's regularisation time other
-//! than the default, and adaptive increments. General contact is written as `*CONTACT` with
+//! than the default, and adaptive increments; loads that change between steps are refused
+//! too. General contact is written as `*CONTACT` with
 //! all exterior faces, so its search distance is not kept (every exterior node becomes a
 //! candidate).
 
@@ -341,6 +342,12 @@ pub fn write_deck(
 /// its norm as the magnitude, which reads back to the same bits.
 fn write_loads(out: &mut String, spec: &ModelSpec) -> Result<(), String> {
     for (k, load) in spec.loads.iter().enumerate() {
+        if load.step_factors().is_some() {
+            return Err(format!(
+                "loads[{k}].step_factors: a load that changes between steps is not written as a \
+                 deck (its value in each step would not read back to the same bits)"
+            ));
+        }
         let keyword = match load {
             LoadSpec::Pressure { .. } => "DSLOAD",
             LoadSpec::Concentrated { .. } => "CLOAD",

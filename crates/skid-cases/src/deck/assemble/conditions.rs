@@ -114,9 +114,10 @@ pub(super) struct StepsAndLoads {
     pub amplitudes: Vec<AmplitudeSpec>,
 }
 
-/// Steps and the loads they apply: boundary conditions with `OP=MOD` accumulate and `OP=NEW`
-/// replaces those of earlier steps (model-data conditions hold throughout); the loads of the
-/// first step are the model's (with the amplitudes they name), and later steps must keep them.
+/// Steps and the loads they apply: boundary conditions and loads with `OP=MOD` accumulate and
+/// `OP=NEW` replaces those of earlier steps (model-data conditions hold throughout); the loads
+/// in force in each step become the model's loads with their factors in each step (see
+/// [`model_loads`]).
 pub(super) fn steps(
     defs: &Definitions,
     part: &Part,
@@ -130,7 +131,7 @@ pub(super) fn steps(
     }
     let mut held: BTreeMap<usize, BTreeSet<usize>> = BTreeMap::new();
     let mut loads_in_force: Vec<InForce> = Vec::new();
-    let mut first_loads = None;
+    let mut per_step = Vec::new();
     let mut out = Vec::new();
     for (i, step) in defs.steps.iter().enumerate() {
         if step.nlgeom == Some(false) || (i == 0 && step.nlgeom.is_none()) {
@@ -145,21 +146,7 @@ pub(super) fn steps(
         for change in &step.loads {
             apply_loads(defs, part, bodies, part_spec, change, &mut loads_in_force)?;
         }
-        match &first_loads {
-            None => first_loads = Some(loads_in_force.clone()),
-            Some(first) if *first != loads_in_force => {
-                return Err(error(
-                    &step.location,
-                    format!(
-                        "*STEP {}: the loads differ from the first step's; skid applies the first \
-                         step's loads (ramped over it if static) and holds them (loads that change \
-                         between steps are not supported yet)",
-                        step.name
-                    ),
-                ));
-            }
-            Some(_) => {}
-        }
+        per_step.push(loads_in_force.clone());
         let boundary = held
             .iter()
             .filter_map(|(&b, dofs)| {
@@ -183,7 +170,7 @@ pub(super) fn steps(
             .collect::<Result<Vec<_>, DeckError>>()?;
         out.push(step_spec(step, boundary)?);
     }
-    let (loads, amplitudes) = model_loads(defs, part, bodies, &first_loads.unwrap_or_default());
+    let (loads, amplitudes) = model_loads(defs, part, bodies, &per_step);
     Ok(StepsAndLoads {
         steps: out,
         loads,

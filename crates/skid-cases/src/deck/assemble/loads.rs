@@ -281,76 +281,164 @@ fn pressure_surface(
     })
 }
 
-/// The model's loads and the amplitudes they name (in the order first named): the
-/// concentrated components on one target with one amplitude make one load (forces from DOFs
-/// 1-3, the moment from 4-6; in 2D DOF 6 is the moment about z).
-pub(super) fn model_loads(
-    defs: &Definitions,
-    part: &Part,
-    bodies: &[Body],
-    in_force: &[InForce],
-) -> (Vec<LoadSpec>, Vec<AmplitudeSpec>) {
-    let dim = part.dimension;
-    let mut loads = Vec::new();
-    // concentrated loads: (target, amplitude) -> index in `loads`
-    let mut grouped: Vec<(CloadTarget, Option<String>, usize)> = Vec::new();
-    for load in in_force {
-        match load {
-            InForce::Pressure {
+/// Where a load of the model acts and the amplitude it follows: the loads in force that share
+/// these make one load of the model.
+#[derive(Clone, Debug, PartialEq)]
+enum Place {
+    Pressure {
+        keyword: &'static str,
+        surface: String,
+        amplitude: Option<String>,
+    },
+    /// Components 0-2 force, 3-5 moment.
+    Concentrated {
+        target: CloadTarget,
+        amplitude: Option<String>,
+    },
+    Gravity {
+        element_set: Option<String>,
+        amplitude: Option<String>,
+    },
+}
+
+impl InForce {
+    /// The load of the model it is part of, its component there and its value.
+    fn component(&self) -> (Place, Vec<(usize, f64)>) {
+        match self {
+            Self::Pressure {
+                keyword,
                 surface,
                 pressure,
                 amplitude,
-                ..
-            } => loads.push(LoadSpec::Pressure {
-                surface: surface.clone(),
-                pressure: *pressure,
-                amplitude: amplitude.clone(),
-            }),
-            InForce::Gravity {
-                element_set,
-                acceleration,
-                amplitude,
-            } => loads.push(LoadSpec::Gravity {
-                acceleration: acceleration[..dim].to_vec(),
-                element_set: element_set.clone(),
-                amplitude: amplitude.clone(),
-            }),
-            InForce::Concentrated {
+            } => (
+                Place::Pressure {
+                    keyword,
+                    surface: surface.clone(),
+                    amplitude: amplitude.clone(),
+                },
+                vec![(0, *pressure)],
+            ),
+            Self::Concentrated {
                 target,
                 dof,
                 magnitude,
                 amplitude,
-            } => {
-                let index = match grouped
-                    .iter()
-                    .find(|(t, a, _)| t == target && a == amplitude)
-                {
-                    Some(&(_, _, index)) => index,
-                    None => {
-                        let (node_set, body) = match target {
-                            CloadTarget::Nodes(name) => (Some(name.clone()), None),
-                            CloadTarget::Body(b) => (None, Some(bodies[*b].def.name.clone())),
-                        };
-                        loads.push(LoadSpec::Concentrated {
-                            node_set,
-                            body,
-                            force: None,
-                            moment: None,
-                            amplitude: amplitude.clone(),
-                        });
-                        grouped.push((target.clone(), amplitude.clone(), loads.len() - 1));
-                        loads.len() - 1
-                    }
-                };
-                let LoadSpec::Concentrated { force, moment, .. } = &mut loads[index] else {
-                    continue;
-                };
-                if *dof <= 3 {
-                    force.get_or_insert_with(|| vec![0.0; dim])[dof - 1] = *magnitude;
-                } else {
-                    moment.get_or_insert([0.0; 3])[dof - 4] = *magnitude;
+            } => (
+                Place::Concentrated {
+                    target: target.clone(),
+                    amplitude: amplitude.clone(),
+                },
+                vec![(dof - 1, *magnitude)],
+            ),
+            Self::Gravity {
+                element_set,
+                acceleration,
+                amplitude,
+            } => (
+                Place::Gravity {
+                    element_set: element_set.clone(),
+                    amplitude: amplitude.clone(),
+                },
+                acceleration.iter().copied().enumerate().collect(),
+            ),
+        }
+    }
+}
+
+/// A load of the model over the steps: the value of each of its components in each step
+/// (`None` where no line gives it), and which components some line gives.
+struct History {
+    place: Place,
+    values: Vec<[f64; 6]>,
+    given: [bool; 6],
+}
+
+/// The loads of the model from the loads in force in each step, and the amplitudes they name
+/// (in the order first named).
+///
+/// The loads in force that act at one place with one amplitude make one load of the model
+/// (a concentrated load on one target gathers its force components from DOFs 1-3 and its moment
+/// from 4-6; in 2D DOF 6 is the moment about z). Its value is that of the first step where it
+/// acts, and its factor in each step the ratio of its value there to that one (0 where it is
+/// removed). Components that change in different ratios become loads of their own, one per
+/// ratio sequence; a load whose factors are all 1 has none.
+pub(super) fn model_loads(
+    defs: &Definitions,
+    part: &Part,
+    bodies: &[Body],
+    per_step: &[Vec<InForce>],
+) -> (Vec<LoadSpec>, Vec<AmplitudeSpec>) {
+    let dim = part.dimension;
+    let steps = per_step.len();
+    let mut histories: Vec<History> = Vec::new();
+    for (step, in_force) in per_step.iter().enumerate() {
+        for load in in_force {
+            let (place, components) = load.component();
+            let index = match histories.iter().position(|h| h.place == place) {
+                Some(index) => index,
+                None => {
+                    histories.push(History {
+                        place,
+                        values: vec![[0.0; 6]; steps],
+                        given: [false; 6],
+                    });
+                    histories.len() - 1
                 }
+            };
+            let history = &mut histories[index];
+            for (component, value) in components {
+                history.values[step][component] = value;
+                history.given[component] = true;
             }
+        }
+    }
+    let mut loads = Vec::new();
+    for history in &histories {
+        for Part6 {
+            value,
+            holds,
+            factors,
+        } in proportional_parts(history)
+        {
+            let given = |c: usize| holds[c];
+            let step_factors = factors.filter(|f| f.iter().any(|&c| c != 1.0));
+            loads.push(match &history.place {
+                Place::Pressure {
+                    surface, amplitude, ..
+                } => LoadSpec::Pressure {
+                    surface: surface.clone(),
+                    pressure: value[0],
+                    amplitude: amplitude.clone(),
+                    step_factors,
+                },
+                Place::Gravity {
+                    element_set,
+                    amplitude,
+                } => LoadSpec::Gravity {
+                    acceleration: value[..dim].to_vec(),
+                    element_set: element_set.clone(),
+                    amplitude: amplitude.clone(),
+                    step_factors,
+                },
+                Place::Concentrated { target, amplitude } => {
+                    let (node_set, body) = match target {
+                        CloadTarget::Nodes(name) => (Some(name.clone()), None),
+                        CloadTarget::Body(b) => (None, Some(bodies[*b].def.name.clone())),
+                    };
+                    LoadSpec::Concentrated {
+                        node_set,
+                        body,
+                        force: (0..3)
+                            .any(given)
+                            .then(|| value[..dim].to_vec()),
+                        moment: (3..6)
+                            .any(given)
+                            .then(|| [value[3], value[4], value[5]]),
+                        amplitude: amplitude.clone(),
+                        step_factors,
+                    }
+                }
+            });
         }
     }
     let mut amplitudes: Vec<AmplitudeSpec> = Vec::new();
@@ -369,4 +457,58 @@ pub(super) fn model_loads(
         });
     }
     (loads, amplitudes)
+}
+
+/// A load's history split into parts that change in one ratio: each part's value (that of the
+/// first step where it is not zero), the components it holds and its factor in each step.
+/// Parts come in the order they start to act; components given but zero in every step go with
+/// the first; a load zero throughout is one part without factors.
+fn proportional_parts(history: &History) -> Vec<Part6> {
+    let mut parts: Vec<Part6> = Vec::new();
+    let mut zero = [false; 6];
+    for c in 0..6 {
+        let series: Vec<f64> = history.values.iter().map(|v| v[c]).collect();
+        let Some(&reference) = series.iter().find(|&&v| v != 0.0) else {
+            zero[c] = history.given[c];
+            continue;
+        };
+        let factors: Vec<f64> = series.iter().map(|v| v / reference).collect();
+        let index = match parts.iter().position(|p| p.factors.as_ref() == Some(&factors)) {
+            Some(index) => index,
+            None => {
+                parts.push(Part6 {
+                    value: [0.0; 6],
+                    holds: [false; 6],
+                    factors: Some(factors),
+                });
+                parts.len() - 1
+            }
+        };
+        parts[index].value[c] = reference;
+        parts[index].holds[c] = true;
+    }
+    // the parts in the order they start to act
+    parts.sort_by_key(|p| {
+        p.factors
+            .as_ref()
+            .and_then(|f| f.iter().position(|&c| c != 0.0))
+    });
+    if parts.is_empty() {
+        parts.push(Part6 {
+            value: [0.0; 6],
+            holds: [false; 6],
+            factors: None,
+        });
+    }
+    for (holds, zero) in parts[0].holds.iter_mut().zip(zero) {
+        *holds |= zero;
+    }
+    parts
+}
+
+/// One part of a load's history (see [`proportional_parts`]).
+struct Part6 {
+    value: [f64; 6],
+    holds: [bool; 6],
+    factors: Option<Vec<f64>>,
 }

@@ -6,10 +6,13 @@ use std::collections::BTreeMap;
 use nalgebra::{SVector, Vector3};
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
-use skid_integrator::{Amplitude, ConcentratedLoad, GravityLoad, LoadTarget, Loads, PressureLoad};
+use skid_integrator::{
+    Amplitude, ConcentratedLoad, GravityLoad, LoadTarget, Loads, PressureLoad, StepVariation,
+    Variation,
+};
 
 use super::{SpecError, fail, finite_point, vector3};
-use crate::model_spec::{AmplitudeSpec, Dof, LoadSpec, ModelSpec};
+use crate::model_spec::{AmplitudeSpec, Dof, LoadSpec, ModelSpec, ModelStepSpec};
 
 /// The amplitudes by name, each checked: a unique non-empty name, at least one point, finite
 /// times >= 0 that increase strictly, finite factors.
@@ -43,6 +46,57 @@ fn amplitudes(specs: &[AmplitudeSpec]) -> Result<BTreeMap<&str, Amplitude>, Spec
         named.insert(a.name.as_str(), amplitude);
     }
     Ok(named)
+}
+
+/// How a load with `amplitude` and `step_factors` (`field`) varies over `steps` (see
+/// [`ModelSpec::loads`]): with factors `c_k`, `c_k A(t_s)` with an amplitude `A`; without one
+/// the ramp from `c_{k-1}` (`c_{-1} = 0`) to `c_k` over a static step and `c_k` throughout a
+/// dynamic one. Without factors, the amplitude in every step, or the default ramp.
+fn variation(
+    amplitude: Option<Amplitude>,
+    step_factors: Option<&[f64]>,
+    steps: &[ModelStepSpec],
+    field: &str,
+) -> Result<Variation, SpecError> {
+    let Some(factors) = step_factors else {
+        return Ok(amplitude.map_or(Variation::Ramp, Variation::Amplitude));
+    };
+    if factors.len() != steps.len() {
+        return fail(
+            field,
+            format!(
+                "expected one factor per step ({} steps), got {}",
+                steps.len(),
+                factors.len()
+            ),
+        );
+    }
+    if let Some(k) = factors.iter().position(|c| !c.is_finite()) {
+        return fail(
+            format!("{field}[{k}]"),
+            format!("expected a finite number, got {}", factors[k]),
+        );
+    }
+    let mut previous = 0.0;
+    let per_step = factors
+        .iter()
+        .zip(steps)
+        .map(|(&c, step)| {
+            let from = match step {
+                ModelStepSpec::Static { .. } => previous,
+                ModelStepSpec::Dynamic { .. } => c,
+            };
+            previous = c;
+            match &amplitude {
+                Some(a) => StepVariation::Amplitude {
+                    amplitude: a.clone(),
+                    scale: c,
+                },
+                None => StepVariation::Ramp { from, to: c },
+            }
+        })
+        .collect();
+    Ok(Variation::PerStep(per_step))
 }
 
 /// Checks that every element of every element set exists (`elements` of them).
@@ -112,6 +166,7 @@ pub(super) fn loads<const D: usize>(
                 })
             })
             .transpose()?;
+        let variation = variation(amplitude, load.step_factors(), &spec.steps, &f("step_factors"))?;
         match load {
             LoadSpec::Pressure {
                 surface, pressure, ..
@@ -129,7 +184,7 @@ pub(super) fn loads<const D: usize>(
                 loads.pressures.push(PressureLoad {
                     faces: faces.clone(),
                     pressure: *pressure,
-                    amplitude,
+                    variation,
                 });
             }
             LoadSpec::Concentrated {
@@ -179,7 +234,7 @@ pub(super) fn loads<const D: usize>(
                     target,
                     force,
                     moment,
-                    amplitude,
+                    variation,
                 });
             }
             LoadSpec::Gravity {
@@ -207,7 +262,7 @@ pub(super) fn loads<const D: usize>(
                 loads.gravity.push(GravityLoad {
                     acceleration,
                     elements,
-                    amplitude,
+                    variation,
                 });
             }
         }
