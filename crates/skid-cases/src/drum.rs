@@ -227,6 +227,7 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
             node_set: "ymax".into(),
             body: BODY_NAMES[BACK_PLATE].into(),
         }],
+        initial_velocities: Vec::new(),
         loads: vec![LoadSpec::Pressure {
             surface: "ymax".into(),
             pressure: case.back_plate.pressure,

@@ -49,6 +49,10 @@ pub struct ModelSpec {
     /// Node sets tied to rigid bodies.
     #[serde(default)]
     pub ties: Vec<TieSpec>,
+    /// Initial velocities of the part's nodes (rigid bodies give theirs in
+    /// `rigid_bodies`); nodes not listed start at rest.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub initial_velocities: Vec<NodeVelocitySpec>,
     /// Loads. A load acts in every step at its value times its factor in the step
     /// (`step_factors`, 1 in every step if absent). A load with an `amplitude` is that
     /// amplitude's value at the step time times the step's factor and its value: the time since
@@ -297,6 +301,17 @@ pub struct BoundarySpec {
     pub node_set: Option<String>,
     /// The degrees of freedom held.
     pub dofs: Vec<Dof>,
+}
+
+/// The initial velocity of the nodes of a node set.
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct NodeVelocitySpec {
+    /// Node set of the part (its nodes must be free along every nonzero component and not tied
+    /// to a rigid body).
+    pub node_set: String,
+    /// Velocity, `dimension` components, m/s.
+    pub velocity: Vec<f64>,
 }
 
 /// Nodes that translate with a rigid body's reference node.

@@ -75,6 +75,8 @@ pub struct Model<const D: usize> {
     regularization_mass: DVector<f64>,
     quasi_static: Vec<bool>,
     length_scale: f64,
+    /// Initial velocities of the solid's nodes, `(node, velocity)`.
+    node_velocities: Vec<(usize, SVector<f64, D>)>,
 }
 
 fn invalid<T>(msg: String) -> Result<T, ModelError> {
@@ -311,7 +313,59 @@ impl<const D: usize> Model<D> {
             regularization_mass,
             quasi_static,
             length_scale,
+            node_velocities: Vec::new(),
         })
+    }
+
+    /// The model with these initial velocities of the solid's nodes, `(node, velocity)`, added
+    /// to those it has (a node given twice takes its last velocity).
+    ///
+    /// # Errors
+    /// [`ModelError::Invalid`] for a node that does not exist, a velocity that is not finite, a
+    /// node tied to a rigid body (it moves with the body: give the body the velocity), a
+    /// velocity along a fixed component, or a quasi-static solid (its nodes have no inertia).
+    pub fn with_node_velocities(
+        mut self,
+        velocities: Vec<(usize, SVector<f64, D>)>,
+    ) -> Result<Self, ModelError> {
+        if self.part.quasi_static && !velocities.is_empty() {
+            return invalid(
+                "initial velocities of a quasi-static solid's nodes: its nodes have no inertia"
+                    .into(),
+            );
+        }
+        let n_nodes = self.part.mesh.nodes.len();
+        for &(node, v) in &velocities {
+            if node >= n_nodes {
+                return invalid(format!(
+                    "initial velocity: node {node} does not exist ({n_nodes} nodes)"
+                ));
+            }
+            if !v.iter().all(|c| c.is_finite()) {
+                return invalid(format!(
+                    "initial velocity of node {node}: expected finite components, got {:?}",
+                    v.as_slice()
+                ));
+            }
+            if let Some(tie) = self.ties.iter().find(|t| t.nodes.contains(&node)) {
+                return invalid(format!(
+                    "initial velocity of node {node}: it is tied to rigid body '{}' and moves \
+                     with it; give the body the velocity",
+                    self.bodies[tie.body].name
+                ));
+            }
+            for (axis, eq) in self.dofs.node(node).iter().enumerate() {
+                if eq.is_none() && v[axis] != 0.0 {
+                    return invalid(format!(
+                        "initial velocity of node {node}: component {axis} is fixed, expected 0 \
+                         there, got {}",
+                        v[axis]
+                    ));
+                }
+            }
+        }
+        self.node_velocities.extend(velocities);
+        Ok(self)
     }
 
     /// The deformable solid.
@@ -381,9 +435,17 @@ impl<const D: usize> Model<D> {
         embed(&(self.part.mesh.nodes[node] + self.dofs.node_displacement(x, node)))
     }
 
-    /// Initial velocity vector: rigid-body initial velocities, zero for the solid's nodes.
+    /// Initial velocity vector: rigid-body initial velocities, and those given to the solid's
+    /// nodes (zero elsewhere).
     pub fn initial_velocity(&self) -> DVector<f64> {
         let mut v = DVector::zeros(self.dofs.len());
+        for (node, velocity) in &self.node_velocities {
+            for (eq, c) in self.dofs.node(*node).iter().zip(velocity.iter()) {
+                if let Some(eq) = eq {
+                    v[*eq] = *c;
+                }
+            }
+        }
         for (b, body) in self.bodies.iter().enumerate() {
             for (i, eq) in self.dofs.body_translation(b).iter().enumerate() {
                 if let Some(eq) = eq {

@@ -231,6 +231,7 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
         rigid_bodies: rigid_specs,
         boundary: spec_boundary,
         ties,
+        initial_velocities: Vec::new(),
         loads,
         amplitudes,
         contact,

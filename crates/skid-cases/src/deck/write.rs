@@ -5,8 +5,8 @@
 //! the steps. Numbers are written so that they read back to the same bits.
 //!
 //! Two settings have no keyword and are refused: a static step's regularisation time other
-//! than the default, and adaptive increments; loads that change between steps are refused
-//! too. General contact is written as `*CONTACT` with
+//! than the default, and adaptive increments; loads that change between steps and initial
+//! velocities of the part's nodes are refused too. General contact is written as `*CONTACT` with
 //! all exterior faces, so its search distance is not kept (every exterior node becomes a
 //! candidate).
 
@@ -67,6 +67,13 @@ pub fn write_deck(
 ) -> Result<String, String> {
     let dim = spec.dimension;
     let part = &spec.part;
+    if !spec.initial_velocities.is_empty() {
+        return Err(
+            "initial_velocities: the deck reader takes initial velocities of rigid-body \
+             reference nodes only, so those of the part's nodes are not written"
+                .into(),
+        );
+    }
     let mut out = String::new();
     let _ = writeln!(out, "*HEADING");
     for line in spec.description.lines().filter(|l| !l.trim().is_empty()) {

@@ -263,10 +263,33 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         quasi_static: section.quasi_static,
         fixed: fixed_nodes,
     };
-    let model = Model::new(part, bodies, ties, loads, contacts).map_err(|e| SpecError {
+    let mut model = Model::new(part, bodies, ties, loads, contacts).map_err(|e| SpecError {
         field: "(model)".into(),
         message: e.to_string(),
     })?;
+    for (i, initial) in spec.initial_velocities.iter().enumerate() {
+        let field = |name: &str| format!("initial_velocities[{i}].{name}");
+        let velocity = finite_point::<D>(&field("velocity"), &initial.velocity)?;
+        let nodes = model
+            .part()
+            .mesh
+            .node_sets
+            .get(&initial.node_set)
+            .ok_or_else(|| SpecError {
+                field: field("node_set"),
+                message: format!(
+                    "no node set named '{}' in part '{}'",
+                    initial.node_set, spec.part.name
+                ),
+            })?;
+        let velocities = nodes.iter().map(|&n| (n, velocity)).collect();
+        model = model
+            .with_node_velocities(velocities)
+            .map_err(|e| SpecError {
+                field: format!("initial_velocities[{i}]"),
+                message: e.to_string(),
+            })?;
+    }
     let settings = solver_settings(&spec.solver, ContactSolve::preferred_for(&model))?;
     Ok(Scene {
         model,
