@@ -130,6 +130,7 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
         }],
         node_sets: mesh.node_sets,
         element_sets: BTreeMap::new(),
+        materials: Vec::new(),
         surfaces: mesh.surfaces,
         section: SectionSpec {
             material: pad.material.clone(),

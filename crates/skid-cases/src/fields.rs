@@ -424,7 +424,7 @@ fn pad_grid<const D: usize>(model: &Model<D>, state: &State) -> io::Result<Grid>
     for (e, (element, nodes)) in model.elements().iter().zip(&mesh.elements).enumerate() {
         let u_e: Vec<_> = nodes.iter().map(|&n| u[n]).collect();
         let response = element
-            .evaluate(part.material.as_ref(), &u_e, false)
+            .evaluate(part.material(e), &u_e, false)
             .map_err(|err| invalid_data(format!("pad element {e}: {err}")))?;
         let s = response.cauchy_stress;
         stress.extend(STRESS_COMPONENTS.map(|(i, j)| s[(i, j)]));

@@ -99,11 +99,28 @@ pub struct PartSpec {
     /// clockwise; 3D: counter-clockwise seen from outside).
     #[serde(default)]
     pub surfaces: BTreeMap<String, Vec<Vec<usize>>>,
-    /// Named element sets (element numbers, counted across blocks), for gravity.
+    /// Named element sets (element numbers, counted across blocks), for gravity and materials.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub element_sets: BTreeMap<String, Vec<usize>>,
-    /// Material and section of every element.
+    /// Material and section of every element (but those of `materials`).
     pub section: SectionSpec,
+    /// Materials of element sets: their elements take this material and density instead of
+    /// the section's (the section's thickness, hourglass scale and quasi-static setting hold
+    /// for every element); an element in two of these sets is refused.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub materials: Vec<SetMaterialSpec>,
+}
+
+/// The material and density of an element set of the part.
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SetMaterialSpec {
+    /// Element set (`part.element_sets`).
+    pub element_set: String,
+    /// Hyperelastic material.
+    pub material: MaterialSpec,
+    /// Mass density, kg/m^3.
+    pub density: f64,
 }
 
 /// Element types of a deformable part.

@@ -140,7 +140,7 @@ impl Assembler {
                 Tangent::None
             };
             model.elements()[e]
-                .respond(part.material.as_ref(), &u, tangent)
+                .respond(part.material(e), &u, tangent)
                 .map_err(|err| match err {
                     FemError::InvertedElement { det_f, corner } => {
                         IncrementFailure::InvertedElement {

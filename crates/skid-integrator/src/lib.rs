@@ -52,7 +52,7 @@ pub use loads::{
     Amplitude, ConcentratedLoad, GravityLoad, LoadInstant, LoadTarget, Loads, PressureLoad,
     StepVariation, Variation,
 };
-pub use model::{ContactPair, Model, SolidPart, Tie};
+pub use model::{ContactPair, Model, Section, SolidPart, Tie};
 pub use settings::Settings;
 pub use state::State;
 pub use stepper::{

@@ -246,7 +246,8 @@ pub(crate) struct Scene<'a, const D: usize> {
     pub bodies: &'a [RigidBody<D>],
     pub elements: &'a [OnePointSolid<D>],
     pub connectivity: &'a [Vec<usize>],
-    pub density: f64,
+    /// Mass density of each element, kg/m^3.
+    pub densities: &'a [f64],
     pub nodes: usize,
 }
 
@@ -359,7 +360,7 @@ impl<const D: usize> GravityLoad<D> {
                     scene.elements.len()
                 ));
             };
-            let m = element.lumped_node_mass(scene.density);
+            let m = element.lumped_node_mass(scene.densities[e]);
             for &n in &scene.connectivity[e] {
                 add(scene.dofs.node(n), m);
             }

@@ -74,11 +74,13 @@ impl MixedPressures {
         x: &DVector<f64>,
         responses: &[ElementResponse],
     ) {
-        let material = model.part().material.as_ref();
+        let part = model.part();
         self.recorded_at = Some(x.clone());
         self.at = responses
             .iter()
-            .map(|r| {
+            .enumerate()
+            .map(|(e, r)| {
+                let material = part.material(e);
                 Some(Linearisation {
                     pressure: material.volumetric_pressure(r.volume_ratio),
                     stiffness: material.volumetric_stiffness(r.volume_ratio),

@@ -14,26 +14,55 @@ use crate::dof::DofMap;
 use crate::error::ModelError;
 use crate::loads::{DeadLoad, Loads, PressureLoad, Scene};
 
-/// The deformable solid: mesh, material and section data.
+/// A material and its mass density, shared by a group of elements.
+#[derive(Debug)]
+pub struct Section {
+    /// Hyperelastic material.
+    pub material: Box<dyn Hyperelastic>,
+    /// Mass density, kg/m^3.
+    pub density: f64,
+}
+
+/// The deformable solid: mesh, materials and section data.
 #[derive(Debug)]
 pub struct SolidPart<const D: usize> {
     /// Mesh of one-point elements (quads in 2D, hexahedra in 3D).
     pub mesh: SolidMesh<D>,
-    /// Hyperelastic material of every element.
-    pub material: Box<dyn Hyperelastic>,
-    /// Mass density, kg/m^3.
-    pub density: f64,
+    /// Sections (at least one).
+    pub sections: Vec<Section>,
+    /// Section of each element, an index into `sections`; empty when every element has the
+    /// first.
+    pub element_sections: Vec<usize>,
     /// Out-of-plane thickness in 2D (plane strain), m; 1 in 3D.
     pub thickness: f64,
     /// Factor on the hourglass stabilisation stiffness (1 = default).
     pub hourglass_scale: f64,
     /// Whether the solid is quasi-static: its nodes carry no inertia, so in a dynamic step they
     /// are in equilibrium with the mean contact forces of each increment (see
-    /// [`crate::increment`]). `density` then serves only the regularisation of static Newton
-    /// steps.
+    /// [`crate::increment`]). The densities then serve only the regularisation of static
+    /// Newton steps.
     pub quasi_static: bool,
     /// Node components held at zero displacement throughout, as `(node, axis)` pairs.
     pub fixed: Vec<(usize, usize)>,
+}
+
+impl<const D: usize> SolidPart<D> {
+    /// The section of element `e` (the first for an element beyond `element_sections`, which
+    /// [`Model::new`] refuses unless that list is empty).
+    pub fn section(&self, e: usize) -> &Section {
+        let k = self.element_sections.get(e).copied().unwrap_or(0);
+        &self.sections[k.min(self.sections.len() - 1)]
+    }
+
+    /// The material of element `e`.
+    pub fn material(&self, e: usize) -> &dyn Hyperelastic {
+        self.section(e).material.as_ref()
+    }
+
+    /// The mass density of element `e`, kg/m^3.
+    pub fn density(&self, e: usize) -> f64 {
+        self.section(e).density
+    }
 }
 
 /// Nodes tied to a rigid body: they translate with its reference node.
@@ -107,8 +136,34 @@ impl<const D: usize> Model<D> {
             return invalid(format!("dimension must be 2 or 3, got {D}"));
         }
         part.mesh.validate()?;
-        if !(part.density.is_finite() && part.density > 0.0) {
-            return invalid(format!("density must be > 0, got {}", part.density));
+        if part.sections.is_empty() {
+            return invalid("the solid needs at least one section".into());
+        }
+        for (k, section) in part.sections.iter().enumerate() {
+            if !(section.density.is_finite() && section.density > 0.0) {
+                return invalid(format!(
+                    "section {k}: density must be > 0, got {}",
+                    section.density
+                ));
+            }
+        }
+        let n_elements = part.mesh.elements.len();
+        if !part.element_sections.is_empty() && part.element_sections.len() != n_elements {
+            return invalid(format!(
+                "{} element sections for {n_elements} elements",
+                part.element_sections.len()
+            ));
+        }
+        if let Some((e, k)) = part
+            .element_sections
+            .iter()
+            .enumerate()
+            .find(|&(_, &k)| k >= part.sections.len())
+        {
+            return invalid(format!(
+                "element {e}: section {k} does not exist ({} sections)",
+                part.sections.len()
+            ));
         }
         if !(part.thickness.is_finite() && part.thickness > 0.0) {
             return invalid(format!("thickness must be > 0, got {}", part.thickness));
@@ -200,9 +255,9 @@ impl<const D: usize> Model<D> {
             }
         }
 
-        let mu0 = part.material.initial_shear_modulus();
         let mut elements = Vec::with_capacity(part.mesh.elements.len());
         for (e, conn) in part.mesh.elements.iter().enumerate() {
+            let mu0 = part.material(e).initial_shear_modulus();
             let x: Vec<SVector<f64, D>> = conn.iter().map(|&n| part.mesh.nodes[n]).collect();
             let element = OnePointSolid::new(&x, part.thickness, mu0, part.hourglass_scale)
                 .map_err(|err| ModelError::Invalid(format!("element {e}: {err}")))?;
@@ -221,8 +276,8 @@ impl<const D: usize> Model<D> {
         );
 
         let mut solid_mass = DVector::zeros(dofs.len());
-        for (element, conn) in elements.iter().zip(&part.mesh.elements) {
-            let m = element.lumped_node_mass(part.density);
+        for (e, (element, conn)) in elements.iter().zip(&part.mesh.elements).enumerate() {
+            let m = element.lumped_node_mass(part.density(e));
             for &n in conn {
                 for eq in dofs.node(n).iter().flatten() {
                     solid_mass[*eq] += m;
@@ -284,12 +339,13 @@ impl<const D: usize> Model<D> {
         }
         let length_scale = (hi - lo).norm().max(f64::MIN_POSITIVE);
 
+        let densities: Vec<f64> = (0..elements.len()).map(|e| part.density(e)).collect();
         let scene = Scene {
             dofs: &dofs,
             bodies: &bodies,
             elements: &elements,
             connectivity: &part.mesh.elements,
-            density: part.density,
+            densities: &densities,
             nodes: n_nodes,
         };
         let mut dead_loads = Vec::with_capacity(concentrated.len() + gravity.len());

@@ -2,6 +2,7 @@
 
 use nalgebra::{SVector, Vector3};
 use skid_fem::material::PolynomialN1;
+use crate::model::Section;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 
@@ -24,8 +25,11 @@ pub(crate) fn pad_block<const D: usize>(
     .expect("mesh");
     SolidPart {
         mesh,
-        material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6).expect("material")),
-        density: 1000.0,
+        sections: vec![Section {
+            material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6).expect("material")),
+            density: 1000.0,
+        }],
+        element_sections: Vec::new(),
         thickness: 0.1,
         hourglass_scale: 1.0,
         quasi_static: false,

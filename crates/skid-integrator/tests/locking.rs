@@ -3,6 +3,7 @@
 
 use nalgebra::SVector;
 use skid_fem::material::PolynomialN1;
+use skid_integrator::Section;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 use skid_integrator::settings::Settings;
@@ -39,8 +40,11 @@ fn tip_deflection(k_over_mu: f64) -> f64 {
     let material = PolynomialN1::new(MU / 2.0, 0.0, 2.0 / (k_over_mu * MU)).expect("material");
     let part = SolidPart {
         mesh,
-        material: Box::new(material),
-        density: 1000.0,
+        sections: vec![Section {
+            material: Box::new(material),
+            density: 1000.0,
+        }],
+        element_sections: Vec::new(),
         thickness: THICKNESS,
         hourglass_scale: 1.0,
         quasi_static: false,

@@ -6,6 +6,7 @@
 
 use nalgebra::SVector;
 use skid_fem::material::PolynomialN1;
+use skid_integrator::Section;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 use skid_integrator::settings::Settings;
@@ -43,8 +44,11 @@ fn cantilever(variation: Variation) -> (Model<2>, Vec<usize>) {
     let tip = mesh.node_sets["xmax"].clone();
     let part = SolidPart {
         mesh,
-        material: Box::new(PolynomialN1::new(5e5, 0.0, 1e-6).expect("material")),
-        density: 1000.0,
+        sections: vec![Section {
+            material: Box::new(PolynomialN1::new(5e5, 0.0, 1e-6).expect("material")),
+            density: 1000.0,
+        }],
+        element_sections: Vec::new(),
         thickness: 0.01,
         hourglass_scale: 1.0,
         quasi_static: false,

@@ -9,13 +9,13 @@ use skid_contact::plane::RigidPlane;
 use skid_contact::surface::{AnalyticCylinder, RigidSurface};
 use skid_contact::triangles::{CylinderChart, TriangulatedSurface};
 use skid_fem::cell::{embed, face_corners};
-use skid_fem::material::PolynomialN1;
+use skid_fem::material::{Hyperelastic, PolynomialN1};
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 use skid_integrator::settings::{ContactSolve, NewtonSettings};
 use skid_integrator::settings::{CutbackSettings, Settings};
 use skid_integrator::stepper::{Adaptive, BodyMotion, HeldMotion, Step, StepKind};
-use skid_integrator::{ContactPair, Model, SolidPart, Tie};
+use skid_integrator::{ContactPair, Model, Section, SolidPart, Tie};
 
 mod loads;
 
@@ -111,15 +111,7 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
     let mesh = part_mesh::<D>(spec)?;
     loads::check_element_sets(spec, mesh.elements.len())?;
     let section = &spec.part.section;
-    let material = match section.material {
-        MaterialSpec::PolynomialN1 { c10, c01, d1 } => {
-            PolynomialN1::new(c10, c01, d1).map_err(|e| SpecError {
-                field: "part.section.material".into(),
-                message: e.to_string(),
-            })?
-        }
-    };
-    positive("part.section.density", section.density)?;
+    let (sections, element_sections) = sections(spec, mesh.elements.len())?;
     positive("part.section.thickness", section.thickness)?;
     if D == 3 && section.thickness != 1.0 {
         return fail(
@@ -256,8 +248,8 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
 
     let part = SolidPart {
         mesh,
-        material: Box::new(material),
-        density: section.density,
+        sections,
+        element_sections,
         thickness: section.thickness,
         hourglass_scale: section.hourglass_scale,
         quasi_static: section.quasi_static,
@@ -296,6 +288,62 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         steps,
         settings,
     })
+}
+
+/// A material of the format, checked, as the solver's (`field` names it in errors).
+fn material(field: &str, spec: &MaterialSpec) -> Result<Box<dyn Hyperelastic>, SpecError> {
+    match *spec {
+        MaterialSpec::PolynomialN1 { c10, c01, d1 } => PolynomialN1::new(c10, c01, d1)
+            .map(|m| Box::new(m) as Box<dyn Hyperelastic>)
+            .map_err(|e| SpecError {
+                field: field.into(),
+                message: e.to_string(),
+            }),
+    }
+}
+
+/// The part's sections: the part's own first, then one per entry of `part.materials`, and the
+/// section of each of the `elements` (empty when there is one section).
+fn sections(spec: &ModelSpec, elements: usize) -> Result<(Vec<Section>, Vec<usize>), SpecError> {
+    let part = &spec.part;
+    positive("part.section.density", part.section.density)?;
+    let mut sections = vec![Section {
+        material: material("part.section.material", &part.section.material)?,
+        density: part.section.density,
+    }];
+    let mut of_element = vec![0; elements];
+    for (i, set) in part.materials.iter().enumerate() {
+        let f = |name: &str| format!("part.materials[{i}].{name}");
+        let members = part.element_sets.get(&set.element_set).ok_or_else(|| SpecError {
+            field: f("element_set"),
+            message: format!(
+                "no element set named '{}' in part '{}'",
+                set.element_set, part.name
+            ),
+        })?;
+        positive(&f("density"), set.density)?;
+        sections.push(Section {
+            material: material(&f("material"), &set.material)?,
+            density: set.density,
+        });
+        for &e in members {
+            if of_element[e] != 0 {
+                return fail(
+                    f("element_set"),
+                    format!(
+                        "element {e} is also in element set '{}' of part.materials[{}]",
+                        part.materials[of_element[e] - 1].element_set,
+                        of_element[e] - 1
+                    ),
+                );
+            }
+            of_element[e] = i + 1;
+        }
+    }
+    if sections.len() == 1 {
+        of_element.clear();
+    }
+    Ok((sections, of_element))
 }
 
 /// The part's mesh: nodes, elements of every block, sorted node sets, checked surfaces.

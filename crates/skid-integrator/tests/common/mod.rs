@@ -2,6 +2,7 @@
 
 use nalgebra::SVector;
 use skid_fem::material::PolynomialN1;
+use skid_integrator::Section;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 use skid_integrator::SolidPart;
@@ -39,8 +40,11 @@ pub fn block_part(
     .expect("mesh");
     SolidPart {
         mesh,
-        material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, d1).expect("material")),
-        density: 1000.0,
+        sections: vec![Section {
+            material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, d1).expect("material")),
+            density: 1000.0,
+        }],
+        element_sections: Vec::new(),
         thickness,
         hourglass_scale: 1.0,
         quasi_static,

@@ -167,6 +167,7 @@ pub(super) fn part_spec(
         }],
         node_sets,
         surfaces,
+        materials: Vec::new(),
         element_sets: BTreeMap::new(),
         section: SectionSpec {
             material: law,

@@ -1,0 +1,114 @@
+//! Materials per element set (`part.materials` of a model file): a column of two plane-strain
+//! elements, the upper four times stiffer than the lower, compressed by a small pressure on top.
+//! With Poisson's ratio 0 each layer is in uniaxial stress `p` and shortens by `p h / E`
+//! (`E = 2 mu = 4 C10`), so the middle nodes move down by `p h / E_1` and the top by
+//! `p h (1 / E_1 + 1 / E_2)`, to the strain's order (2.5e-4) for the finite strain.
+
+use std::path::Path;
+
+use skid_cases::model_file::{self, parse_model};
+use skid_integrator::stepper::{IncrementReport, Observer, run};
+use skid_integrator::{Model, State};
+
+const H: f64 = 0.01;
+const PRESSURE: f64 = 100.0;
+const C10_LOWER: f64 = 1e5;
+const C10_UPPER: f64 = 4e5;
+
+/// The column as a model file, with `materials` the text of `part.materials`.
+fn column(materials: &str) -> String {
+    let material = |c10: f64| {
+        format!(r#"{{"type": "polynomial_n1", "c10": {c10}, "c01": 0.0, "d1": {}}}"#, 1.5 / c10)
+    };
+    format!(
+        r#"{{
+  "skid_model": 1, "name": "column", "dimension": 2,
+  "part": {{
+    "name": "column",
+    "nodes": [[0.0, 0.0], [0.01, 0.0], [0.0, 0.01], [0.01, 0.01], [0.0, 0.02], [0.01, 0.02]],
+    "elements": [{{"type": "CPE4R", "connectivity": [[0, 1, 3, 2], [2, 3, 5, 4]]}}],
+    "node_sets": {{"bottom": [0, 1], "corner": [0]}},
+    "surfaces": {{"top": [[5, 4]]}},
+    "element_sets": {{"upper": [1], "lower": [0]}},
+    "section": {{"material": {lower}, "density": 1000.0, "thickness": 0.01}},
+    "materials": {materials}
+  }},
+  "boundary": [{{"node_set": "bottom", "dofs": ["y"]}}, {{"node_set": "corner", "dofs": ["x"]}}],
+  "loads": [{{"type": "pressure", "surface": "top", "pressure": {PRESSURE}}}],
+  "steps": [{{"type": "static", "name": "press", "increments": 2}}]
+}}"#,
+        lower = material(C10_LOWER),
+    )
+    .replace("UPPER", &material(C10_UPPER))
+}
+
+struct Last(Option<State>);
+
+impl<const D: usize> Observer<D> for Last {
+    fn on_increment(&mut self, _: &Model<D>, r: &IncrementReport<'_>) -> std::io::Result<()> {
+        self.0 = Some(r.state.clone());
+        Ok(())
+    }
+}
+
+fn spec(materials: &str) -> skid_cases::model_spec::ModelSpec {
+    parse_model(&column(materials), Path::new("column.json"), &[]).expect("model parses")
+}
+
+#[test]
+fn each_layer_of_a_column_shortens_as_its_own_material_says() {
+    let spec = spec(r#"[{"element_set": "upper", "material": UPPER, "density": 3000.0}]"#);
+    let scene = model_file::build::<2>(&spec).expect("scene builds");
+    let model = &scene.model;
+    // the lumped masses follow each element's density: a quarter of 1e-3 kg (lower) and of
+    // 3e-3 kg (upper) at each corner
+    let mass = |n: usize| model.mass()[model.dofs().node(n)[0].expect("free in x")];
+    for (n, expected) in [(1, 0.25e-3), (2, 1e-3), (5, 0.75e-3)] {
+        assert!((mass(n) - expected).abs() < 1e-15, "node {n}: mass {}", mass(n));
+    }
+    let mut last = Last(None);
+    let (_, result) = run(model, &scene.steps, &scene.settings, &mut last);
+    let state = result.expect("run completes");
+    let down = |n: usize| -model.dofs().node_displacement(&state.x, n)[1];
+    let (e1, e2) = (4.0 * C10_LOWER, 4.0 * C10_UPPER);
+    let middle = PRESSURE * H / e1;
+    let top = PRESSURE * H * (1.0 / e1 + 1.0 / e2);
+    for (n, expected) in [(2, middle), (3, middle), (4, top), (5, top)] {
+        let got = down(n);
+        assert!(
+            (got - expected).abs() <= 1e-3 * expected,
+            "node {n}: down {got:e}, expected {expected:e}"
+        );
+    }
+}
+
+#[test]
+fn materials_of_element_sets_are_checked_with_their_field() {
+    for (materials, field, fragment) in [
+        (
+            r#"[{"element_set": "nowhere", "material": UPPER, "density": 1000.0}]"#,
+            "part.materials[0].element_set",
+            "no element set named 'nowhere'",
+        ),
+        (
+            r#"[{"element_set": "upper", "material": UPPER, "density": 0.0}]"#,
+            "part.materials[0].density",
+            "",
+        ),
+        (
+            r#"[{"element_set": "upper", "material": UPPER, "density": 1000.0},
+                {"element_set": "upper", "material": UPPER, "density": 1000.0}]"#,
+            "part.materials[1].element_set",
+            "element 1 is also in element set 'upper' of part.materials[0]",
+        ),
+        (
+            r#"[{"element_set": "upper", "material": {"type": "polynomial_n1", "c10": -1.0, "c01": 0.0, "d1": 1e-6}, "density": 1000.0}]"#,
+            "part.materials[0].material",
+            "",
+        ),
+    ] {
+        let error = model_file::build::<2>(&spec(materials)).expect_err(materials);
+        assert_eq!(error.field, field, "{materials}: {error:?}");
+        assert!(error.message.contains(fragment), "{}", error.message);
+    }
+}
