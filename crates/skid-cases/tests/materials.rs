@@ -29,7 +29,7 @@ fn column(materials: &str) -> String {
     "elements": [{{"type": "CPE4R", "connectivity": [[0, 1, 3, 2], [2, 3, 5, 4]]}}],
     "node_sets": {{"bottom": [0, 1], "corner": [0]}},
     "surfaces": {{"top": [[5, 4]]}},
-    "element_sets": {{"upper": [1], "lower": [0]}},
+    "element_sets": {{"upper": [1]}},
     "section": {{"material": {lower}, "density": 1000.0, "thickness": 0.01}},
     "materials": {materials}
   }},
@@ -111,4 +111,90 @@ fn materials_of_element_sets_are_checked_with_their_field() {
         assert_eq!(error.field, field, "{materials}: {error:?}");
         assert!(error.message.contains(fragment), "{}", error.message);
     }
+}
+
+/// The column as a deck: one `*SOLID SECTION` per layer, each with its `*MATERIAL`.
+const COLUMN_DECK: &str = "\
+*HEADING
+two-material column
+*NODE
+1, 0.0, 0.0
+2, 0.01, 0.0
+3, 0.0, 0.01
+4, 0.01, 0.01
+5, 0.0, 0.02
+6, 0.01, 0.02
+*ELEMENT, TYPE=CPE4R
+1, 1, 2, 4, 3
+2, 3, 4, 6, 5
+*ELSET, ELSET=lower
+1
+*ELSET, ELSET=upper
+2
+*NSET, NSET=bottom
+1, 2
+*NSET, NSET=corner
+1
+*SURFACE, NAME=top, TYPE=ELEMENT
+upper, S3
+*SOLID SECTION, ELSET=lower, MATERIAL=soft
+0.01
+*SOLID SECTION, ELSET=upper, MATERIAL=stiff
+0.01
+*MATERIAL, NAME=soft
+*HYPERELASTIC, POLYNOMIAL, N=1
+100000.0, 0.0, 1.5e-5
+*DENSITY
+1000.0
+*MATERIAL, NAME=stiff
+*HYPERELASTIC, POLYNOMIAL, N=1
+400000.0, 0.0, 3.75e-6
+*DENSITY
+3000.0
+*BOUNDARY
+bottom, 2, 2
+corner, 1, 1
+*STEP, NAME=press, NLGEOM=YES
+*STATIC, DIRECT
+0.5, 1.0
+*DSLOAD
+top, P, 100.0
+*END STEP
+";
+
+#[test]
+fn a_deck_with_a_section_per_layer_runs_as_the_model_file_with_materials() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("column.inp");
+    std::fs::write(&path, COLUMN_DECK).expect("write deck");
+    let deck = skid_cases::deck::read_model(&path).expect("deck reads").model;
+    assert_eq!(deck.part.element_sets["upper"], vec![1]);
+    assert_eq!(deck.part.materials.len(), 1);
+    assert_eq!(deck.part.materials[0].element_set, "upper");
+    assert_eq!(deck.part.materials[0].density, 3000.0);
+    let file = spec(r#"[{"element_set": "upper", "material": UPPER, "density": 3000.0}]"#);
+    assert_eq!(deck.part.materials[0].material, file.part.materials[0].material);
+    let final_state = |spec: &skid_cases::model_spec::ModelSpec| {
+        let scene = model_file::build::<2>(spec).expect("scene builds");
+        let (_, result) = run(&scene.model, &scene.steps, &scene.settings, &mut Last(None));
+        result.expect("run completes").x
+    };
+    let (a, b) = (final_state(&deck), final_state(&file));
+    assert!((&a - &b).amax() <= 1e-12 * b.amax(), "{a} against {b}");
+
+    // the model file written as a deck reads back to the same part
+    let written = skid_cases::deck::write::write_deck(&file, &Default::default())
+        .expect("the column writes as a deck");
+    std::fs::write(&path, written).expect("write deck");
+    let back = skid_cases::deck::read_model(&path).expect("written deck reads").model;
+    assert_eq!(back.part, file.part);
+
+    // every deformable element needs exactly one section
+    let twice = COLUMN_DECK.replace("*ELSET, ELSET=upper\n2\n", "*ELSET, ELSET=upper\n1, 2\n");
+    std::fs::write(&path, twice).expect("write deck");
+    let message = skid_cases::deck::read_model(&path).expect_err("two sections").to_string();
+    assert!(
+        message.contains("element 1 already has the section of ELSET=lower"),
+        "{message}"
+    );
 }

@@ -93,10 +93,15 @@ pub fn write_deck(
         let _ = writeln!(out, "{}, {}", i + 1, list(x.iter().map(|v| num(*v))));
     }
     let kind = if dim == 2 { "CPE4R" } else { "C3D8R" };
-    let _ = writeln!(out, "*ELEMENT, TYPE={kind}, ELSET={}", part.name);
     let mut elements = Vec::new();
     for block in &part.elements {
         elements.extend(block.connectivity.iter().cloned());
+    }
+    // With materials by element set, the part's own section holds the other elements only.
+    if part.materials.is_empty() {
+        let _ = writeln!(out, "*ELEMENT, TYPE={kind}, ELSET={}", part.name);
+    } else {
+        let _ = writeln!(out, "*ELEMENT, TYPE={kind}");
     }
     for (e, nodes) in elements.iter().enumerate() {
         let _ = writeln!(
@@ -140,28 +145,57 @@ pub fn write_deck(
             let _ = writeln!(out, "{e}, S{k}");
         }
     }
-    let material = format!("{}-material", part.name);
-    let _ = writeln!(
-        out,
-        "*SOLID SECTION, ELSET={}, MATERIAL={material}",
-        part.name
-    );
-    if dim == 2 {
-        let _ = writeln!(out, "{}", num(part.section.thickness));
-    }
-    let _ = writeln!(out, "*MATERIAL, NAME={material}");
-    match &part.section.material {
-        MaterialSpec::PolynomialN1 { c10, c01, d1 } => {
-            let _ = writeln!(
-                out,
-                "*HYPERELASTIC, POLYNOMIAL, N=1\n{}, {}, {}",
-                num(*c10),
-                num(*c01),
-                num(*d1)
-            );
+    if !part.materials.is_empty() {
+        let mut own = vec![true; elements.len()];
+        for set in &part.materials {
+            let members = part.element_sets.get(&set.element_set).ok_or(format!(
+                "part.materials: no element set named '{}'",
+                set.element_set
+            ))?;
+            for &e in members {
+                if let Some(slot) = own.get_mut(e) {
+                    *slot = false;
+                }
+            }
         }
+        if part.element_sets.contains_key(&part.name) {
+            return Err(format!(
+                "part.element_sets.{}: the part's name is the element set of its own section",
+                part.name
+            ));
+        }
+        let _ = writeln!(out, "*ELSET, ELSET={}", part.name);
+        label_lines(
+            &mut out,
+            (0..elements.len()).filter(|&e| own[e]).map(|e| e + 1),
+        );
     }
-    let _ = writeln!(out, "*DENSITY\n{}", num(part.section.density));
+    let thickness = part.section.thickness;
+    let own = [(part.name.as_str(), &part.section.material, part.section.density)];
+    let others = part
+        .materials
+        .iter()
+        .map(|m| (m.element_set.as_str(), &m.material, m.density));
+    for (elset, law, density) in own.into_iter().chain(others) {
+        let material = format!("{elset}-material");
+        let _ = writeln!(out, "*SOLID SECTION, ELSET={elset}, MATERIAL={material}");
+        if dim == 2 {
+            let _ = writeln!(out, "{}", num(thickness));
+        }
+        let _ = writeln!(out, "*MATERIAL, NAME={material}");
+        match law {
+            MaterialSpec::PolynomialN1 { c10, c01, d1 } => {
+                let _ = writeln!(
+                    out,
+                    "*HYPERELASTIC, POLYNOMIAL, N=1\n{}, {}, {}",
+                    num(*c10),
+                    num(*c01),
+                    num(*d1)
+                );
+            }
+        }
+        let _ = writeln!(out, "*DENSITY\n{}", num(density));
+    }
 
     // rigid bodies
     let mut next_node = part.nodes.len() + 1;

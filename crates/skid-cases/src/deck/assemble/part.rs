@@ -1,7 +1,13 @@
 //! The deformable part of a deck: its numbering from 0 in the order of `*NODE`, its element
-//! block, node sets and surfaces of element faces, and the node sets of slave surfaces.
+//! block, node sets and surfaces of element faces, and the node sets of slave surfaces. Every
+//! deformable element has one `*SOLID SECTION`: the first section listed is the part's, and each
+//! other one's elements become an element set of its ELSET's name with its material
+//! (`part.materials`); all share one thickness.
 
 use super::*;
+use crate::deck::read::SectionDef;
+use crate::model_spec::SetMaterialSpec;
+use crate::schema::MaterialSpec;
 
 pub(super) fn part_numbering(defs: &Definitions, deck: &Location) -> Result<Part, DeckError> {
     let elements: Vec<u64> = defs
@@ -65,62 +71,68 @@ pub(super) fn part_spec(
                     .is_some_and(|es| es.iter().any(|e| defs.mesh.elements[e].kind.is_solid()))
         })
         .collect();
-    let [section] = solid_sections.as_slice() else {
+    let Some(first) = solid_sections.first() else {
         return Err(error(
-            solid_sections.get(1).map_or(deck, |s| &s.location),
-            format!(
-                "expected one *SOLID SECTION for the deformable elements, found {} (one \
-                 material per part so far)",
-                solid_sections.len()
-            ),
+            deck,
+            "expected a *SOLID SECTION for the deformable elements, found none",
         ));
     };
-    let members: BTreeSet<u64> = defs
-        .mesh
-        .elements_named(&section.elset)
-        .unwrap_or_default()
-        .into_iter()
-        .collect();
-    if let Some(e) = part.elements.iter().find(|e| !members.contains(e)) {
+    // the section of every deformable element, by its position in the part
+    let position: BTreeMap<u64, usize> =
+        part.elements.iter().enumerate().map(|(i, e)| (*e, i)).collect();
+    let mut section_of: Vec<Option<usize>> = vec![None; part.elements.len()];
+    let mut read = Vec::new();
+    for (k, section) in solid_sections.iter().enumerate() {
+        for e in defs.mesh.elements_named(&section.elset).unwrap_or_default() {
+            let Some(&i) = position.get(&e) else {
+                continue;
+            };
+            if let Some(other) = section_of[i].replace(k) {
+                return Err(error(
+                    &section.location,
+                    format!(
+                        "*SOLID SECTION, ELSET={}: element {e} already has the section of \
+                         ELSET={}",
+                        section.elset, solid_sections[other].elset
+                    ),
+                ));
+            }
+        }
+        read.push(section_properties(defs, dim, section)?);
+    }
+    if let Some(i) = section_of.iter().position(Option::is_none) {
+        let e = part.elements[i];
         return Err(error(
-            &defs.mesh.elements[e].location,
-            format!(
-                "element {e} has no section: the *SOLID SECTION's ELSET={} does not hold it",
-                section.elset
-            ),
+            &defs.mesh.elements[&e].location,
+            format!("element {e} has no section: no *SOLID SECTION's ELSET holds it"),
         ));
     }
-    let material = defs.materials.get(&key(&section.material)).ok_or_else(|| {
-        error(
-            &section.location,
-            format!("*SOLID SECTION: no *MATERIAL named {}", section.material),
-        )
-    })?;
-    let law = material.value.law.clone().ok_or_else(|| {
-        error(
-            &material.location,
-            format!(
-                "*MATERIAL {}: give *HYPERELASTIC or *ELASTIC",
-                material.name
-            ),
-        )
-    })?;
-    let density = material.value.density.ok_or_else(|| {
-        error(
-            &material.location,
-            format!("*MATERIAL {}: give *DENSITY", material.name),
-        )
-    })?;
-    let thickness = match (dim, section.thickness) {
-        (2, t) => t.unwrap_or(1.0),
-        (_, Some(t)) if t != 1.0 => {
+    let (law, density, thickness) = read[0].clone();
+    let mut element_sets = BTreeMap::new();
+    let mut materials = Vec::new();
+    for (k, (section, (law_k, density_k, thickness_k))) in
+        solid_sections.iter().zip(&read).enumerate().skip(1)
+    {
+        if *thickness_k != thickness {
             return Err(error(
                 &section.location,
-                format!("*SOLID SECTION: a 3D solid takes no thickness (got {t})"),
+                format!(
+                    "*SOLID SECTION, ELSET={}: thickness {thickness_k} differs from ELSET={}'s \
+                     {thickness} (one thickness per part)",
+                    section.elset, first.elset
+                ),
             ));
         }
-        _ => 1.0,
-    };
+        let members: Vec<usize> = (0..part.elements.len())
+            .filter(|&i| section_of[i] == Some(k))
+            .collect();
+        element_sets.insert(section.elset.clone(), members);
+        materials.push(SetMaterialSpec {
+            element_set: section.elset.clone(),
+            material: law_k.clone(),
+            density: *density_k,
+        });
+    }
     let mut nodes = vec![Vec::new(); part.number.len()];
     for (label, &i) in &part.number {
         nodes[i] = defs.mesh.nodes[label][..dim].to_vec();
@@ -159,7 +171,7 @@ pub(super) fn part_spec(
         }
     }
     Ok(PartSpec {
-        name: section.elset.clone(),
+        name: first.elset.clone(),
         nodes,
         elements: vec![ElementBlockSpec {
             kind: ElementType::solid(dim),
@@ -167,8 +179,8 @@ pub(super) fn part_spec(
         }],
         node_sets,
         surfaces,
-        materials: Vec::new(),
-        element_sets: BTreeMap::new(),
+        materials,
+        element_sets,
         section: SectionSpec {
             material: law,
             density,
@@ -177,6 +189,46 @@ pub(super) fn part_spec(
             quasi_static: false,
         },
     })
+}
+
+/// The material law, density and thickness of a `*SOLID SECTION` of a part of dimension `dim`.
+fn section_properties(
+    defs: &Definitions,
+    dim: usize,
+    section: &SectionDef,
+) -> Result<(MaterialSpec, f64, f64), DeckError> {
+    let material = defs.materials.get(&key(&section.material)).ok_or_else(|| {
+        error(
+            &section.location,
+            format!("*SOLID SECTION: no *MATERIAL named {}", section.material),
+        )
+    })?;
+    let law = material.value.law.clone().ok_or_else(|| {
+        error(
+            &material.location,
+            format!(
+                "*MATERIAL {}: give *HYPERELASTIC or *ELASTIC",
+                material.name
+            ),
+        )
+    })?;
+    let density = material.value.density.ok_or_else(|| {
+        error(
+            &material.location,
+            format!("*MATERIAL {}: give *DENSITY", material.name),
+        )
+    })?;
+    let thickness = match (dim, section.thickness) {
+        (2, t) => t.unwrap_or(1.0),
+        (_, Some(t)) if t != 1.0 => {
+            return Err(error(
+                &section.location,
+                format!("*SOLID SECTION: a 3D solid takes no thickness (got {t})"),
+            ));
+        }
+        _ => 1.0,
+    };
+    Ok((law, density, thickness))
 }
 
 /// Faces of solid elements as part node numbers, outward.
