@@ -84,7 +84,10 @@ fn a_block_launched_along_a_flat_slides_to_a_stop_under_coulomb_friction() {
     result.expect("run completes");
 
     let p0 = momentum(model, &record.0[0].1);
-    assert!((p0 - MASS * V0).abs() < 1e-9 * MASS * V0, "initial momentum {p0}");
+    assert!(
+        (p0 - MASS * V0).abs() < 1e-9 * MASS * V0,
+        "initial momentum {p0}"
+    );
     let mut stop = None;
     let mut time = 0.0;
     let slide = &record.0[record.0.len() - 100 - 1..];

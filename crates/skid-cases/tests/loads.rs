@@ -479,7 +479,10 @@ fn a_block_sticks_then_slides_as_the_loads_of_a_deck_change_between_steps() {
         assert_eq!(states.len(), 4, "{step}: increments");
         for ((state, press), push) in states.iter().zip(presses).zip(pushes) {
             let (t, normal) = resultants(state);
-            assert!((normal - press * n).abs() <= 1e-6 * n, "{step}: N = {normal}");
+            assert!(
+                (normal - press * n).abs() <= 1e-6 * n,
+                "{step}: N = {normal}"
+            );
             assert!((t + push * f).abs() <= 1e-6 * n, "{step}: T = {t}");
             let slipping = state
                 .contacts
@@ -501,5 +504,8 @@ fn a_block_sticks_then_slides_as_the_loads_of_a_deck_change_between_steps() {
     }
     let v = last.v[plate_x(&scene.model)];
     let expected = (3.0 * f - MU * n) / MASS * 0.01;
-    assert!((v - expected).abs() <= 1e-3 * expected, "v = {v}, expected {expected}");
+    assert!(
+        (v - expected).abs() <= 1e-3 * expected,
+        "v = {v}, expected {expected}"
+    );
 }

@@ -18,7 +18,10 @@ const C10_UPPER: f64 = 4e5;
 /// The column as a model file, with `materials` the text of `part.materials`.
 fn column(materials: &str) -> String {
     let material = |c10: f64| {
-        format!(r#"{{"type": "polynomial_n1", "c10": {c10}, "c01": 0.0, "d1": {}}}"#, 1.5 / c10)
+        format!(
+            r#"{{"type": "polynomial_n1", "c10": {c10}, "c01": 0.0, "d1": {}}}"#,
+            1.5 / c10
+        )
     };
     format!(
         r#"{{
@@ -64,7 +67,11 @@ fn each_layer_of_a_column_shortens_as_its_own_material_says() {
     // 3e-3 kg (upper) at each corner
     let mass = |n: usize| model.mass()[model.dofs().node(n)[0].expect("free in x")];
     for (n, expected) in [(1, 0.25e-3), (2, 1e-3), (5, 0.75e-3)] {
-        assert!((mass(n) - expected).abs() < 1e-15, "node {n}: mass {}", mass(n));
+        assert!(
+            (mass(n) - expected).abs() < 1e-15,
+            "node {n}: mass {}",
+            mass(n)
+        );
     }
     let mut last = Last(None);
     let (_, result) = run(model, &scene.steps, &scene.settings, &mut last);
@@ -167,13 +174,18 @@ fn a_deck_with_a_section_per_layer_runs_as_the_model_file_with_materials() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("column.inp");
     std::fs::write(&path, COLUMN_DECK).expect("write deck");
-    let deck = skid_cases::deck::read_model(&path).expect("deck reads").model;
+    let deck = skid_cases::deck::read_model(&path)
+        .expect("deck reads")
+        .model;
     assert_eq!(deck.part.element_sets["upper"], vec![1]);
     assert_eq!(deck.part.materials.len(), 1);
     assert_eq!(deck.part.materials[0].element_set, "upper");
     assert_eq!(deck.part.materials[0].density, 3000.0);
     let file = spec(r#"[{"element_set": "upper", "material": UPPER, "density": 3000.0}]"#);
-    assert_eq!(deck.part.materials[0].material, file.part.materials[0].material);
+    assert_eq!(
+        deck.part.materials[0].material,
+        file.part.materials[0].material
+    );
     let final_state = |spec: &skid_cases::model_spec::ModelSpec| {
         let scene = model_file::build::<2>(spec).expect("scene builds");
         let (_, result) = run(&scene.model, &scene.steps, &scene.settings, &mut Last(None));
@@ -186,13 +198,17 @@ fn a_deck_with_a_section_per_layer_runs_as_the_model_file_with_materials() {
     let written = skid_cases::deck::write::write_deck(&file, &Default::default())
         .expect("the column writes as a deck");
     std::fs::write(&path, written).expect("write deck");
-    let back = skid_cases::deck::read_model(&path).expect("written deck reads").model;
+    let back = skid_cases::deck::read_model(&path)
+        .expect("written deck reads")
+        .model;
     assert_eq!(back.part, file.part);
 
     // every deformable element needs exactly one section
     let twice = COLUMN_DECK.replace("*ELSET, ELSET=upper\n2\n", "*ELSET, ELSET=upper\n1, 2\n");
     std::fs::write(&path, twice).expect("write deck");
-    let message = skid_cases::deck::read_model(&path).expect_err("two sections").to_string();
+    let message = skid_cases::deck::read_model(&path)
+        .expect_err("two sections")
+        .to_string();
     assert!(
         message.contains("element 1 already has the section of ELSET=lower"),
         "{message}"

@@ -915,13 +915,15 @@ impl<const D: usize> Run<'_, D> {
             } => (dt / duration, duration, adaptive),
         };
         if position.is_none() {
-            start_loads(model, (index, step), &mut state).map_err(|cause| RunError::StepFailed {
-                step: step.name.clone(),
-                increment: 0,
-                time: state.time,
-                size: 0.0,
-                cutbacks: 0,
-                cause,
+            start_loads(model, (index, step), &mut state).map_err(|cause| {
+                RunError::StepFailed {
+                    step: step.name.clone(),
+                    increment: 0,
+                    time: state.time,
+                    size: 0.0,
+                    cutbacks: 0,
+                    cause,
+                }
             })?;
             if matches!(step.kind, StepKind::Dynamic { .. }) {
                 state.a = consistent_acceleration(model, &state, &held);

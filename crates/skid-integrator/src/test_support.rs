@@ -1,8 +1,8 @@
 //! Small scenes shared by the unit tests.
 
+use crate::model::Section;
 use nalgebra::{SVector, Vector3};
 use skid_fem::material::PolynomialN1;
-use crate::model::Section;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 

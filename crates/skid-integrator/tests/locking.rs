@@ -3,9 +3,9 @@
 
 use nalgebra::SVector;
 use skid_fem::material::PolynomialN1;
-use skid_integrator::Section;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
+use skid_integrator::Section;
 use skid_integrator::settings::Settings;
 use skid_integrator::stepper::{IncrementReport, Observer, Step, StepKind, run};
 use skid_integrator::{Model, PressureLoad, SolidPart, State, Tie, Variation};

@@ -6,9 +6,9 @@
 
 use nalgebra::SVector;
 use skid_fem::material::PolynomialN1;
-use skid_integrator::Section;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
+use skid_integrator::Section;
 use skid_integrator::settings::Settings;
 use skid_integrator::stepper::{IncrementReport, Observer, Step, StepKind, run};
 use skid_integrator::{
@@ -169,14 +169,21 @@ fn a_load_follows_its_variation_in_every_step() {
             );
         }
     }
-    assert!(increments.next().is_none(), "more increments than steps ask");
+    assert!(
+        increments.next().is_none(),
+        "more increments than steps ask"
+    );
 
     // the doubled load reaches the equilibrium of one step at twice the load
     let doubled = &taken[5].1;
-    let (single, single_tip) =
-        cantilever(Variation::PerStep(vec![ramp(0.0, 2.0)]));
+    let (single, single_tip) = cantilever(Variation::PerStep(vec![ramp(0.0, 2.0)]));
     let mut once = Record::default();
-    let (_, result) = run(&single, &[static_step("at once", 6)], &Settings::default(), &mut once);
+    let (_, result) = run(
+        &single,
+        &[static_step("at once", 6)],
+        &Settings::default(),
+        &mut once,
+    );
     let at_once = result.expect("single step converges");
     let (a, b) = (
         deflection(&model, &tip, doubled),
@@ -188,7 +195,10 @@ fn a_load_follows_its_variation_in_every_step() {
     // without load the elastic beam is back in its reference shape
     let removed = &taken[7].1;
     let back = removed.x.amax();
-    assert!(back < 1e-7 * a.abs(), "displacement {back} left after removal");
+    assert!(
+        back < 1e-7 * a.abs(),
+        "displacement {back} left after removal"
+    );
 }
 
 #[test]

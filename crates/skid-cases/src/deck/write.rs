@@ -171,7 +171,11 @@ pub fn write_deck(
         );
     }
     let thickness = part.section.thickness;
-    let own = [(part.name.as_str(), &part.section.material, part.section.density)];
+    let own = [(
+        part.name.as_str(),
+        &part.section.material,
+        part.section.density,
+    )];
     let others = part
         .materials
         .iter()

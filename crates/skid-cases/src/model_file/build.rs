@@ -314,13 +314,16 @@ fn sections(spec: &ModelSpec, elements: usize) -> Result<(Vec<Section>, Vec<usiz
     let mut of_element = vec![0; elements];
     for (i, set) in part.materials.iter().enumerate() {
         let f = |name: &str| format!("part.materials[{i}].{name}");
-        let members = part.element_sets.get(&set.element_set).ok_or_else(|| SpecError {
-            field: f("element_set"),
-            message: format!(
-                "no element set named '{}' in part '{}'",
-                set.element_set, part.name
-            ),
-        })?;
+        let members = part
+            .element_sets
+            .get(&set.element_set)
+            .ok_or_else(|| SpecError {
+                field: f("element_set"),
+                message: format!(
+                    "no element set named '{}' in part '{}'",
+                    set.element_set, part.name
+                ),
+            })?;
         positive(&f("density"), set.density)?;
         sections.push(Section {
             material: material(&f("material"), &set.material)?,

@@ -2,9 +2,9 @@
 
 use nalgebra::SVector;
 use skid_fem::material::PolynomialN1;
-use skid_integrator::Section;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
+use skid_integrator::Section;
 use skid_integrator::SolidPart;
 
 /// A massless 2D rigid body at `(0, y)` that may translate along the axes marked in `free` and

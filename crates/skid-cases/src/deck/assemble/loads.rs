@@ -428,12 +428,8 @@ pub(super) fn model_loads(
                     LoadSpec::Concentrated {
                         node_set,
                         body,
-                        force: (0..3)
-                            .any(given)
-                            .then(|| value[..dim].to_vec()),
-                        moment: (3..6)
-                            .any(given)
-                            .then(|| [value[3], value[4], value[5]]),
+                        force: (0..3).any(given).then(|| value[..dim].to_vec()),
+                        moment: (3..6).any(given).then(|| [value[3], value[4], value[5]]),
                         amplitude: amplitude.clone(),
                         step_factors,
                     }
@@ -473,7 +469,10 @@ fn proportional_parts(history: &History) -> Vec<Part6> {
             continue;
         };
         let factors: Vec<f64> = series.iter().map(|v| v / reference).collect();
-        let index = match parts.iter().position(|p| p.factors.as_ref() == Some(&factors)) {
+        let index = match parts
+            .iter()
+            .position(|p| p.factors.as_ref() == Some(&factors))
+        {
             Some(index) => index,
             None => {
                 parts.push(Part6 {

@@ -78,8 +78,12 @@ pub(super) fn part_spec(
         ));
     };
     // the section of every deformable element, by its position in the part
-    let position: BTreeMap<u64, usize> =
-        part.elements.iter().enumerate().map(|(i, e)| (*e, i)).collect();
+    let position: BTreeMap<u64, usize> = part
+        .elements
+        .iter()
+        .enumerate()
+        .map(|(i, e)| (*e, i))
+        .collect();
     let mut section_of: Vec<Option<usize>> = vec![None; part.elements.len()];
     let mut read = Vec::new();
     for (k, section) in solid_sections.iter().enumerate() {

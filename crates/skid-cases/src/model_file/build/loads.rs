@@ -166,7 +166,12 @@ pub(super) fn loads<const D: usize>(
                 })
             })
             .transpose()?;
-        let variation = variation(amplitude, load.step_factors(), &spec.steps, &f("step_factors"))?;
+        let variation = variation(
+            amplitude,
+            load.step_factors(),
+            &spec.steps,
+            &f("step_factors"),
+        )?;
         match load {
             LoadSpec::Pressure {
                 surface, pressure, ..
