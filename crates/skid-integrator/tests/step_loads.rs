@@ -4,16 +4,14 @@
 //! the equilibrium of a single step at twice the load, and removing it brings the elastic beam
 //! back to its reference shape.
 
+mod common;
+
 use nalgebra::SVector;
-use skid_fem::material::PolynomialN1;
-use skid_fem::mesh::SolidMesh;
-use skid_fem::rigid::RigidBody;
-use skid_integrator::Section;
 use skid_integrator::settings::Settings;
 use skid_integrator::stepper::{IncrementReport, Observer, Step, StepKind, run};
 use skid_integrator::{
-    Amplitude, ConcentratedLoad, LoadTarget, Loads, Model, RunError, SolidPart, State,
-    StepVariation, Tie, Variation,
+    Amplitude, ConcentratedLoad, LoadTarget, Loads, Model, RunError, State, StepVariation, Tie,
+    Variation,
 };
 
 /// Force on each tip node at factor 1, N (downwards).
@@ -32,38 +30,13 @@ impl<const D: usize> Observer<D> for Record {
     }
 }
 
-/// A 40 x 4 cantilever, clamped at x = 0, with the tip load varying as `variation`.
+/// A 20 x 2 cantilever 0.1 m long and 0.01 m high (the pad material, nearly incompressible),
+/// clamped at x = 0 to a held wall, with the tip load varying as `variation`.
 fn cantilever(variation: Variation) -> (Model<2>, Vec<usize>) {
-    let mesh = SolidMesh::<2>::structured_block(
-        SVector::<f64, 2>::zeros(),
-        SVector::<f64, 2>::new(0.1, 0.01),
-        [20, 2],
-    )
-    .expect("mesh");
-    let clamped = mesh.node_sets["xmin"].clone();
-    let tip = mesh.node_sets["xmax"].clone();
-    let part = SolidPart {
-        mesh,
-        sections: vec![Section {
-            material: Box::new(PolynomialN1::new(5e5, 0.0, 1e-6).expect("material")),
-            density: 1000.0,
-        }],
-        element_sections: Vec::new(),
-        thickness: 0.01,
-        hourglass_scale: 1.0,
-        quasi_static: false,
-        fixed: vec![],
-    };
-    let wall = RigidBody::<2> {
-        name: "wall".into(),
-        reference_point: SVector::zeros(),
-        mass: 0.0,
-        rotary_inertia: 0.0,
-        free_translations: [false, false],
-        rotation_axis: None,
-        initial_velocity: SVector::zeros(),
-        initial_angular_velocity: 0.0,
-    };
+    let part = common::block_part([0.0, 0.0], [0.1, 0.01], [20, 2], 0.01, 1.45e-7, false);
+    let clamped = part.mesh.node_sets["xmin"].clone();
+    let tip = part.mesh.node_sets["xmax"].clone();
+    let wall = common::translating_body("wall", [false, false], 0.0);
     let loads = Loads {
         concentrated: vec![ConcentratedLoad {
             target: LoadTarget::Nodes(tip.clone()),

@@ -345,8 +345,8 @@ impl InForce {
     }
 }
 
-/// A load of the model over the steps: the value of each of its components in each step
-/// (`None` where no line gives it), and which components some line gives.
+/// A load of the model over the steps: the value of each of its components in each step (0
+/// where no line gives it), and which components some line gives.
 struct History {
     place: Place,
     values: Vec<[f64; 6]>,
@@ -394,13 +394,12 @@ pub(super) fn model_loads(
     }
     let mut loads = Vec::new();
     for history in &histories {
-        for Part6 {
+        for ProportionalPart {
             value,
             holds,
             factors,
         } in proportional_parts(history)
         {
-            let given = |c: usize| holds[c];
             let step_factors = factors.filter(|f| f.iter().any(|&c| c != 1.0));
             loads.push(match &history.place {
                 Place::Pressure {
@@ -428,8 +427,10 @@ pub(super) fn model_loads(
                     LoadSpec::Concentrated {
                         node_set,
                         body,
-                        force: (0..3).any(given).then(|| value[..dim].to_vec()),
-                        moment: (3..6).any(given).then(|| [value[3], value[4], value[5]]),
+                        force: (0..3).any(|c| holds[c]).then(|| value[..dim].to_vec()),
+                        moment: (3..6)
+                            .any(|c| holds[c])
+                            .then(|| [value[3], value[4], value[5]]),
                         amplitude: amplitude.clone(),
                         step_factors,
                     }
@@ -459,8 +460,8 @@ pub(super) fn model_loads(
 /// first step where it is not zero), the components it holds and its factor in each step.
 /// Parts come in the order they start to act; components given but zero in every step go with
 /// the first; a load zero throughout is one part without factors.
-fn proportional_parts(history: &History) -> Vec<Part6> {
-    let mut parts: Vec<Part6> = Vec::new();
+fn proportional_parts(history: &History) -> Vec<ProportionalPart> {
+    let mut parts: Vec<ProportionalPart> = Vec::new();
     let mut zero = [false; 6];
     for c in 0..6 {
         let series: Vec<f64> = history.values.iter().map(|v| v[c]).collect();
@@ -475,7 +476,7 @@ fn proportional_parts(history: &History) -> Vec<Part6> {
         {
             Some(index) => index,
             None => {
-                parts.push(Part6 {
+                parts.push(ProportionalPart {
                     value: [0.0; 6],
                     holds: [false; 6],
                     factors: Some(factors),
@@ -493,7 +494,7 @@ fn proportional_parts(history: &History) -> Vec<Part6> {
             .and_then(|f| f.iter().position(|&c| c != 0.0))
     });
     if parts.is_empty() {
-        parts.push(Part6 {
+        parts.push(ProportionalPart {
             value: [0.0; 6],
             holds: [false; 6],
             factors: None,
@@ -506,7 +507,7 @@ fn proportional_parts(history: &History) -> Vec<Part6> {
 }
 
 /// One part of a load's history (see [`proportional_parts`]).
-struct Part6 {
+struct ProportionalPart {
     value: [f64; 6],
     holds: [bool; 6],
     factors: Option<Vec<f64>>,
