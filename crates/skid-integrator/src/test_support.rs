@@ -23,6 +23,7 @@ pub(crate) fn pad_block<const D: usize>(
     )
     .expect("mesh");
     SolidPart {
+        name: "pad".into(),
         mesh,
         material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6).expect("material")),
         density: 1000.0,

@@ -255,6 +255,7 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
     }
 
     let part = SolidPart {
+        name: spec.part.name.clone(),
         mesh,
         material: Box::new(material),
         density: section.density,

@@ -38,6 +38,7 @@ pub fn block_part(
     )
     .expect("mesh");
     SolidPart {
+        name: "pad".into(),
         mesh,
         material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, d1).expect("material")),
         density: 1000.0,
