@@ -38,7 +38,11 @@
 //! - lines and quadrilaterals made rigid must form a regular prism (the faceted drum), which is
 //!   treated as axially unbounded, and the slave nodes are checked to lie within its ends;
 //! - a point rotary inertia counts about its body's one free rotation axis;
-//! - general contact makes every node of the part's exterior faces a candidate.
+//! - general contact makes every node of the part's exterior faces a candidate;
+//! - `*OUTPUT, FIELD` with `TIME INTERVAL=t` or `NUMBER INTERVAL=n` (the step's period over n)
+//!   turns on the field output ([`crate::fields`]) with one interval for the whole run, the
+//!   smallest of the dynamic steps' requests (of the static steps' if only they ask); a
+//!   request without either (`FREQUENCY`) writes none, with a note.
 
 pub mod assemble;
 pub mod fields;

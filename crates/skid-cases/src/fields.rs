@@ -1,30 +1,42 @@
-//! ParaView field output: the pad's fields and the drum's surface as VTK XML unstructured grids
-//! (ASCII `.vtu`), listed over time in the collection `skid.pvd`.
+//! ParaView field output: the deformable part's fields and the rigid bodies' contact surfaces
+//! as VTK XML unstructured grids (ASCII `.vtu`), listed over time in the collection `skid.pvd`.
+//! Drum case files, model files and decks write the same output (the drum case's part is
+//! `pad` and its drum body `drum`).
 //!
 //! Files in `<out>/fields/`, for frame number `NNNN`:
 //!
-//! - `pad_NNNN.vtu`: the pad mesh at its reference coordinates (z = 0 in 2D); cells `VTK_QUAD`
-//!   (9) in 2D and `VTK_HEXAHEDRON` (12) in 3D, in the mesh's corner order, which is VTK's
-//!   (counter-clockwise; in 3D the bottom face, then the top face). Point data:
-//!   - `displacement` (3 components, m): "Warp By Vector" shows the deformed pad;
-//!   - `contact_pressure` (Pa): the node's normal contact force over its tributary area, 0 at
-//!     nodes that carry no contact force;
+//! - `<part>_NNNN.vtu`, named after the part: its mesh at its reference coordinates (z = 0 in
+//!   2D); cells `VTK_QUAD` (9) in 2D and `VTK_HEXAHEDRON` (12) in 3D, in the mesh's corner
+//!   order, which is VTK's (counter-clockwise; in 3D the bottom face, then the top face). Point
+//!   data:
+//!   - `displacement` (3 components, m): "Warp By Vector" shows the deformed part;
+//!   - `contact_pressure` (Pa): the node's normal contact force, summed over the contact pairs
+//!     it is a candidate of, over its tributary area; 0 at nodes that carry no contact force;
 //!   - `contact_shear` (3 components, Pa, world frame): the tangential (friction) part of the
-//!     contact force on the pad node over the same area;
-//!   - `contact_status`: 0 open (or no candidate), 1 sticking, 2 sliding.
+//!     contact force on the node over the same area;
+//!   - `contact_status`: 0 open (or no candidate), 1 sticking, 2 sliding (the highest over
+//!     the node's pairs).
 //!
 //!   Cell data: `cauchy_stress` (6 components xx yy zz xy yz xz, Pa; zz is the plane-strain
 //!   stress in 2D), `volume_ratio` (J) and `mises` (von Mises stress, Pa).
-//! - `drum_NNNN.vtu`: the drum's lateral surface at radius R, whatever its idealization, rotated
-//!   by the current drum angle about +z through its reference point: in 2D a closed polyline of
-//!   [`DRUM_SEGMENTS`] `VTK_LINE` cells, in 3D a band of [`DRUM_SEGMENTS`] `VTK_QUAD` cells over
-//!   the drum width. Point data `velocity` (3 components, m/s) = omega e_z x r.
-//! - `skid.pvd`: the collection, one `DataSet` per part and frame (part 0 the pad, part 1 the
-//!   drum) with the frame's time as `timestep`.
+//! - `<body>_NNNN.vtu`, one per rigid body that carries a contact pair's master surface, named
+//!   after the body: the surface in the body's current pose (reference point plus translation,
+//!   rotation by its angle about its axis). Unbounded surfaces are drawn over the part: a
+//!   cylinder over the axial extent of the part's current nodes projected on its axis, a plane
+//!   over their projection on it, each extent widened by [`MARGIN`] of itself at both ends. A
+//!   cylinder is a band of [`CIRCLE_SEGMENTS`] quadrilaterals (2D: a closed polyline of as many
+//!   lines), a faceted cylinder one quadrilateral per facet (2D: its polygon), a plane one
+//!   quadrilateral (2D: a segment), triangles as they are (`VTK_TRIANGLE`); cells are ordered
+//!   with the surface's outward normal. Point data `velocity` (3 components, m/s): the rigid-body velocity
+//!   `v_c + omega e x (x - c)`.
+//! - `skid.pvd`: the collection, one `DataSet` per file and frame (part 0 the deformable
+//!   part, then the bodies in the model's order) with the frame's time as `timestep`.
 //!
-//! Tributary area: the current area of each face of the pad's front surface (in 2D the segment
-//! length times the plane-strain thickness), split equally among the face's nodes. A candidate
-//! off the front face (general contact) takes its shares of all exterior faces instead.
+//! Tributary area: the current area of each contact face (an exterior face of the part all of
+//! whose nodes are candidates of one contact pair; in 2D the segment length times the
+//! plane-strain thickness), split equally among the face's nodes. A candidate on no contact
+//! face takes its shares of all exterior faces instead. Summing pressure times area over the
+//! nodes gives the total normal contact force.
 //!
 //! Frames: the initial state; the end of every static step; in dynamic steps the first increment
 //! at or past each multiple of the field interval; and the end of the run (also of a run stopped
@@ -32,42 +44,25 @@
 //! replaces it, under the same number. Every file is written to a temporary name and renamed, and
 //! the collection is rewritten after the frame's files, so it lists only complete frames.
 
-use std::fmt::{self, Write as _};
+mod body;
+mod part;
+mod vtu;
+
 use std::io;
 use std::path::{Path, PathBuf};
 
-use nalgebra::{SVector, Vector3};
-use skid_contact::kinematics::{RotatingFrame, evaluate};
-use skid_fem::cell::embed;
+use skid_contact::surface::RigidSurface;
 use skid_integrator::stepper::{IncrementReport, Observer};
 use skid_integrator::{Model, State};
 
 use crate::atomic::write_atomic;
-use crate::schema::DRUM;
+
+pub use body::{CIRCLE_SEGMENTS, MARGIN};
 
 /// Subdirectory of a case's output directory that holds the field output.
 pub const FIELDS_DIR: &str = "fields";
 /// File name of the collection.
 pub const COLLECTION: &str = "skid.pvd";
-/// Segments of the drum outline around the circumference.
-pub const DRUM_SEGMENTS: usize = 144;
-/// Surface of the pad mesh that faces the drum (see [`crate::drum`]).
-const FRONT_SURFACE: &str = "ymin";
-
-const VTK_LINE: u8 = 3;
-const VTK_QUAD: u8 = 9;
-const VTK_HEXAHEDRON: u8 = 12;
-/// Tensor index pairs of the six stress components, in output order.
-const STRESS_COMPONENTS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2)];
-
-/// Drum dimensions used to draw its surface.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DrumOutline {
-    /// Radius R, m.
-    pub radius: f64,
-    /// Axial width (extent of the 3D band), m.
-    pub width: f64,
-}
 
 /// The last converged state seen, kept for the frame at the end of a static step or run.
 struct Last {
@@ -92,14 +87,14 @@ pub struct FieldMemory {
 pub struct FieldWriter {
     dir: PathBuf,
     interval: f64,
-    drum: DrumOutline,
     /// Times of the frames written so far (frame `i` at `times[i]`).
     times: Vec<f64>,
     last: Option<Last>,
 }
 
 /// Removes the field files of an earlier run from `<out>/fields/` (only the files this module
-/// writes), and the directory itself if that leaves it empty.
+/// writes: the collection and the frames `<name>_<digits>.vtu`, with their temporaries, whatever
+/// the names of that run's part and bodies), and the directory itself if that leaves it empty.
 ///
 /// # Errors
 /// I/O errors.
@@ -114,8 +109,10 @@ pub fn clear(out: &Path) -> io::Result<()> {
             .file_name()
             .and_then(|n| n.to_str())
             .unwrap_or_default();
-        let frame = (name.starts_with("pad_") || name.starts_with("drum_"))
-            && (name.ends_with(".vtu") || name.ends_with(".vtu.partial"));
+        let frame = name
+            .strip_suffix(".vtu")
+            .or_else(|| name.strip_suffix(".vtu.partial"))
+            .is_some_and(is_frame_stem);
         if frame || name == COLLECTION || name == format!("{COLLECTION}.partial") {
             std::fs::remove_file(&path)?;
         }
@@ -131,7 +128,7 @@ impl FieldWriter {
     ///
     /// # Errors
     /// An `InvalidInput` error unless `interval` is finite and > 0; I/O errors.
-    pub fn create(out: &Path, interval: f64, drum: DrumOutline) -> io::Result<Self> {
+    pub fn create(out: &Path, interval: f64) -> io::Result<Self> {
         if !(interval.is_finite() && interval > 0.0) {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidInput,
@@ -143,7 +140,6 @@ impl FieldWriter {
         Ok(Self {
             dir,
             interval,
-            drum,
             times: Vec::new(),
             last: None,
         })
@@ -158,11 +154,10 @@ impl FieldWriter {
     pub fn reopen(
         out: &Path,
         interval: f64,
-        drum: DrumOutline,
         memory: FieldMemory,
         state: State,
     ) -> io::Result<Self> {
-        let mut writer = Self::create(out, interval, drum)?;
+        let mut writer = Self::create(out, interval)?;
         writer.times = memory.times;
         writer.last = Some(Last {
             state,
@@ -221,15 +216,28 @@ impl FieldWriter {
             Some(&t) if state.time <= t => self.times.len() - 1,
             _ => self.times.len(),
         };
-        let pad = pad_grid(model, state)?;
-        let drum = drum_grid(model, state, self.drum)?;
-        for (grid, file) in [(pad, pad_file(index)), (drum, drum_file(index))] {
+        let current = part::current_positions(model, state);
+        let mut grids = vec![(
+            part::part_grid(model, state, &current)?,
+            model.part().name.as_str(),
+        )];
+        for (body, surface) in drawn_bodies(model) {
+            grids.push((
+                body::body_grid(model, state, body, surface, &current)?,
+                model.bodies()[body].name.as_str(),
+            ));
+        }
+        for (grid, name) in &grids {
             let text = grid.to_vtu().map_err(io::Error::other)?;
-            write_atomic(&self.dir.join(file), &text)?;
+            write_atomic(&self.dir.join(frame_file(name, index)), &text)?;
         }
         self.times.truncate(index);
         self.times.push(state.time);
-        let text = collection(&self.times).map_err(io::Error::other)?;
+        let names: Vec<&str> = grids.iter().map(|(_, name)| *name).collect();
+        let text = vtu::collection(&self.times, |i| {
+            names.iter().map(|name| frame_file(name, i)).collect()
+        })
+        .map_err(io::Error::other)?;
         write_atomic(&self.dir.join(COLLECTION), &text)
     }
 }
@@ -253,347 +261,29 @@ impl<const D: usize> Observer<D> for FieldWriter {
     }
 }
 
-fn pad_file(index: usize) -> String {
-    format!("pad_{index:04}.vtu")
+/// The rigid bodies drawn: each one that carries a contact pair's master surface, in the
+/// model's order, with the surface of its first pair.
+fn drawn_bodies<const D: usize>(model: &Model<D>) -> Vec<(usize, &dyn RigidSurface)> {
+    (0..model.bodies().len())
+        .filter_map(|body| {
+            let pair = model.contacts().iter().find(|pair| pair.body == body)?;
+            Some((body, pair.surface.as_ref()))
+        })
+        .collect()
 }
 
-fn drum_file(index: usize) -> String {
-    format!("drum_{index:04}.vtu")
+/// The file of frame `index` of the part or body `name`: `<name>_NNNN.vtu`.
+fn frame_file(name: &str, index: usize) -> String {
+    format!("{name}_{index:04}.vtu")
+}
+
+/// Whether a file stem is that of a frame file, `<name>_<digits>`.
+fn is_frame_stem(stem: &str) -> bool {
+    stem.rsplit_once('_').is_some_and(|(name, digits)| {
+        !name.is_empty() && !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
+    })
 }
 
 fn invalid_data(message: String) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidData, message)
-}
-
-/// The collection listing both parts of every frame.
-fn collection(times: &[f64]) -> Result<String, fmt::Error> {
-    let mut out = String::from(
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" \
-         byte_order=\"LittleEndian\">\n  <Collection>\n",
-    );
-    for (index, time) in times.iter().enumerate() {
-        for (part, file) in [(0, pad_file(index)), (1, drum_file(index))] {
-            writeln!(
-                out,
-                "    <DataSet timestep=\"{time:e}\" group=\"\" part=\"{part}\" file=\"{file}\"/>"
-            )?;
-        }
-    }
-    out.push_str("  </Collection>\n</VTKFile>\n");
-    Ok(out)
-}
-
-/// One named data array, its values already formatted.
-struct DataArray {
-    name: &'static str,
-    scalar: &'static str,
-    components: usize,
-    values: String,
-}
-
-impl DataArray {
-    /// `Float64` values, `components` per tuple (shortest round-trip representation).
-    fn floats(
-        name: &'static str,
-        components: usize,
-        values: impl IntoIterator<Item = f64>,
-    ) -> Self {
-        let values = values
-            .into_iter()
-            .map(|v| format!("{v:e}"))
-            .collect::<Vec<_>>()
-            .join(" ");
-        Self {
-            name,
-            scalar: "Float64",
-            components,
-            values,
-        }
-    }
-
-    /// Vectors of 3 `Float64` components.
-    fn vectors(name: &'static str, values: &[Vector3<f64>]) -> Self {
-        Self::floats(name, 3, values.iter().flat_map(|v| v.iter().copied()))
-    }
-
-    /// Integers of the given VTK type (one component).
-    fn integers<T: fmt::Display>(
-        name: &'static str,
-        scalar: &'static str,
-        values: impl IntoIterator<Item = T>,
-    ) -> Self {
-        let values = values
-            .into_iter()
-            .map(|v| v.to_string())
-            .collect::<Vec<_>>()
-            .join(" ");
-        Self {
-            name,
-            scalar,
-            components: 1,
-            values,
-        }
-    }
-
-    fn write(&self, out: &mut String) -> fmt::Result {
-        writeln!(
-            out,
-            "        <DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" \
-             format=\"ascii\">\n          {}\n        </DataArray>",
-            self.scalar, self.name, self.components, self.values
-        )
-    }
-}
-
-/// An unstructured grid with one cell type.
-struct Grid {
-    points: Vec<Vector3<f64>>,
-    cells: Vec<Vec<usize>>,
-    cell_type: u8,
-    point_data: Vec<DataArray>,
-    cell_data: Vec<DataArray>,
-}
-
-impl Grid {
-    /// The grid as an ASCII VTK XML `UnstructuredGrid` file.
-    fn to_vtu(&self) -> Result<String, fmt::Error> {
-        let mut out = String::new();
-        writeln!(
-            out,
-            "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" \
-             byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n    \
-             <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
-            self.points.len(),
-            self.cells.len()
-        )?;
-        for (tag, arrays) in [
-            ("PointData", &self.point_data),
-            ("CellData", &self.cell_data),
-        ] {
-            if arrays.is_empty() {
-                continue;
-            }
-            writeln!(out, "      <{tag}>")?;
-            for array in arrays {
-                array.write(&mut out)?;
-            }
-            writeln!(out, "      </{tag}>")?;
-        }
-        writeln!(out, "      <Points>")?;
-        DataArray::vectors("Points", &self.points).write(&mut out)?;
-        writeln!(out, "      </Points>\n      <Cells>")?;
-        let offsets = self.cells.iter().scan(0, |end, cell| {
-            *end += cell.len();
-            Some(*end)
-        });
-        for array in [
-            DataArray::integers("connectivity", "Int64", self.cells.iter().flatten()),
-            DataArray::integers("offsets", "Int64", offsets),
-            DataArray::integers("types", "UInt8", self.cells.iter().map(|_| self.cell_type)),
-        ] {
-            array.write(&mut out)?;
-        }
-        writeln!(
-            out,
-            "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>"
-        )?;
-        Ok(out)
-    }
-}
-
-/// The pad: reference mesh, displacements, contact tractions and element stresses.
-fn pad_grid<const D: usize>(model: &Model<D>, state: &State) -> io::Result<Grid> {
-    let part = model.part();
-    let mesh = &part.mesh;
-    let u: Vec<SVector<f64, D>> = (0..mesh.nodes.len())
-        .map(|n| model.dofs().node_displacement(&state.x, n))
-        .collect();
-    let current: Vec<Vector3<f64>> = mesh
-        .nodes
-        .iter()
-        .zip(&u)
-        .map(|(x, u)| embed(&(x + u)))
-        .collect();
-    let contact = contact_tractions(model, state, &current)?;
-    let cells = mesh.elements.len();
-    let (mut stress, mut ratio, mut mises) = (
-        Vec::with_capacity(6 * cells),
-        Vec::with_capacity(cells),
-        Vec::with_capacity(cells),
-    );
-    for (e, (element, nodes)) in model.elements().iter().zip(&mesh.elements).enumerate() {
-        let u_e: Vec<_> = nodes.iter().map(|&n| u[n]).collect();
-        let response = element
-            .evaluate(part.material(e), &u_e, false)
-            .map_err(|err| invalid_data(format!("pad element {e}: {err}")))?;
-        let s = response.cauchy_stress;
-        stress.extend(STRESS_COMPONENTS.map(|(i, j)| s[(i, j)]));
-        ratio.push(response.volume_ratio);
-        let deviator = s - nalgebra::Matrix3::identity() * (s.trace() / 3.0);
-        mises.push((1.5 * deviator.norm_squared()).sqrt());
-    }
-    Ok(Grid {
-        points: mesh.nodes.iter().map(embed).collect(),
-        cells: mesh.elements.clone(),
-        cell_type: if D == 2 { VTK_QUAD } else { VTK_HEXAHEDRON },
-        point_data: vec![
-            DataArray::vectors("displacement", &u.iter().map(embed).collect::<Vec<_>>()),
-            DataArray::floats("contact_pressure", 1, contact.pressure),
-            DataArray::vectors("contact_shear", &contact.shear),
-            DataArray::integers("contact_status", "Int32", contact.status),
-        ],
-        cell_data: vec![
-            DataArray::floats("cauchy_stress", 6, stress),
-            DataArray::floats("volume_ratio", 1, ratio),
-            DataArray::floats("mises", 1, mises),
-        ],
-    })
-}
-
-/// Contact tractions and status per node of the pad.
-struct ContactTractions {
-    pressure: Vec<f64>,
-    shear: Vec<Vector3<f64>>,
-    status: Vec<i32>,
-}
-
-/// Sums the contact forces of every candidate on its node and divides them by the node's
-/// tributary area. `current`: the nodes' current positions.
-fn contact_tractions<const D: usize>(
-    model: &Model<D>,
-    state: &State,
-    current: &[Vector3<f64>],
-) -> io::Result<ContactTractions> {
-    let n = current.len();
-    let mut normal = vec![0.0; n];
-    let mut shear = vec![Vector3::zeros(); n];
-    let mut status = vec![0; n];
-    let dofs = model.dofs();
-    for c in state.contacts.iter().filter(|c| c.is_closed()) {
-        let pair = model
-            .contacts()
-            .get(c.pair)
-            .ok_or_else(|| invalid_data(format!("contact pair {} does not exist", c.pair)))?;
-        let body = &model.bodies()[pair.body];
-        let frame = RotatingFrame {
-            center: embed(&(body.reference_point + dofs.body_displacement(&state.x, pair.body))),
-            axis: body.rotation_axis.unwrap_or_else(Vector3::z),
-            angle: dofs.body_angle(&state.x, pair.body),
-        };
-        let position = current
-            .get(c.node)
-            .ok_or_else(|| invalid_data(format!("contact node {} does not exist", c.node)))?;
-        let kinematics = evaluate(pair.surface.as_ref(), &frame, position).ok_or_else(|| {
-            invalid_data(format!(
-                "contact pair '{}': node {} has no projection",
-                pair.name, c.node
-            ))
-        })?;
-        normal[c.node] += c.normal_force;
-        // The tangential forces are conjugate to the convected coordinates: their force on
-        // the node is r_T,k d xi_k / dx.
-        for k in 0..D - 1 {
-            shear[c.node] += kinematics.d_dx[k + 1] * c.tangential_force[k];
-        }
-        let sliding =
-            pair.mu > 0.0 && c.tangential_force.norm() >= pair.mu * c.normal_force * (1.0 - 1e-6);
-        status[c.node] = status[c.node].max(if sliding { 2 } else { 1 });
-    }
-    let mesh = &model.part().mesh;
-    let thickness = if D == 2 { model.part().thickness } else { 1.0 };
-    let front = tributary_areas(
-        mesh.surfaces.get(FRONT_SURFACE).into_iter().flatten(),
-        current,
-        thickness,
-    );
-    let exterior = tributary_areas(mesh.surfaces.values().flatten(), current, thickness);
-    let area: Vec<f64> = front
-        .iter()
-        .zip(&exterior)
-        .map(|(&f, &e)| if f > 0.0 { f } else { e })
-        .collect();
-    let per_area = |force: f64, a: f64| if a > 0.0 { force / a } else { 0.0 };
-    Ok(ContactTractions {
-        pressure: normal
-            .iter()
-            .zip(&area)
-            .map(|(&f, &a)| per_area(f, a))
-            .collect(),
-        shear: shear
-            .iter()
-            .zip(&area)
-            .map(|(f, &a)| f.map(|c| per_area(c, a)))
-            .collect(),
-        status,
-    })
-}
-
-/// Current area of the faces split equally among their nodes (2D: segment length times
-/// `thickness`; 3D: quadrilateral area from its diagonals).
-fn tributary_areas<'a>(
-    faces: impl IntoIterator<Item = &'a Vec<usize>>,
-    x: &[Vector3<f64>],
-    thickness: f64,
-) -> Vec<f64> {
-    let mut area = vec![0.0; x.len()];
-    for face in faces {
-        let a = match *face.as_slice() {
-            [p, q] => (x[q] - x[p]).norm() * thickness,
-            [p, q, r, s] => 0.5 * (x[r] - x[p]).cross(&(x[s] - x[q])).norm(),
-            _ => continue,
-        };
-        for &node in face {
-            area[node] += a / face.len() as f64;
-        }
-    }
-    area
-}
-
-/// The drum's lateral surface at the current angle, with its velocity.
-fn drum_grid<const D: usize>(
-    model: &Model<D>,
-    state: &State,
-    outline: DrumOutline,
-) -> io::Result<Grid> {
-    let body = model
-        .bodies()
-        .get(DRUM)
-        .ok_or_else(|| invalid_data("the model has no drum".into()))?;
-    let dofs = model.dofs();
-    let center = embed(&(body.reference_point + dofs.body_displacement(&state.x, DRUM)));
-    let angle = dofs.body_angle(&state.x, DRUM);
-    let omega = dofs.body_rotation(DRUM).map_or(0.0, |eq| state.v[eq]);
-    let n = DRUM_SEGMENTS;
-    let rings: &[f64] = if D == 2 {
-        &[0.0]
-    } else {
-        &[-0.5 * outline.width, 0.5 * outline.width]
-    };
-    let points: Vec<Vector3<f64>> = rings
-        .iter()
-        .flat_map(|&z| {
-            (0..n).map(move |k| {
-                let phi = angle + std::f64::consts::TAU * k as f64 / n as f64;
-                center + Vector3::new(outline.radius * phi.cos(), outline.radius * phi.sin(), z)
-            })
-        })
-        .collect();
-    let velocity: Vec<Vector3<f64>> = points
-        .iter()
-        .map(|p| Vector3::z().cross(&(p - center)) * omega)
-        .collect();
-    let next = |k: usize| (k + 1) % n;
-    let (cells, cell_type) = if D == 2 {
-        ((0..n).map(|k| vec![k, next(k)]).collect(), VTK_LINE)
-    } else {
-        let cells = (0..n).map(|k| vec![k, next(k), n + next(k), n + k]);
-        (cells.collect(), VTK_QUAD)
-    };
-    Ok(Grid {
-        points,
-        cells,
-        cell_type,
-        point_data: vec![DataArray::vectors("velocity", &velocity)],
-        cell_data: Vec::new(),
-    })
 }

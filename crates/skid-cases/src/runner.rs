@@ -23,7 +23,7 @@ use serde::Serialize;
 use crate::atomic::write_atomic;
 use crate::csv_out::CsvMark;
 use crate::deck::is_deck;
-use crate::fields::{self, DrumOutline, FieldWriter};
+use crate::fields::{self, FieldMemory, FieldWriter};
 use crate::fingerprint::Fnv1a;
 use crate::history::DrumRecorder;
 use crate::model_file::contact_nodes;
@@ -349,22 +349,13 @@ fn run_in<const D: usize>(
 ) -> Result<Summary, CaseError> {
     let scene = case_scene::<D>(case, source)?;
     let fields_dir = dir.join(fields::FIELDS_DIR);
-    let drum = DrumOutline {
-        radius: case.drum.radius,
-        width: case.drum.width,
-    };
     let (mut recorder, mut newton, mut field_writer, input, checkpoint) = match start {
         Start::Fresh => {
             clear_outputs(dir)?;
             let input = write_input(dir, CASE_JSON, case_text(case))?;
             let recorder = DrumRecorder::create(dir).map_err(output(dir.join("history.csv")))?;
             let newton = NewtonRecorder::create(dir).map_err(output(dir.join(NEWTON_CSV)))?;
-            let fields = case
-                .output
-                .field_interval
-                .map(|interval| FieldWriter::create(dir, interval, drum))
-                .transpose()
-                .map_err(output(fields_dir.clone()))?;
+            let fields = field_writer(dir, case.output.field_interval, None)?;
             (recorder, newton, fields, input, None)
         }
         Start::Resume(restart) => {
@@ -384,14 +375,11 @@ fn run_in<const D: usize>(
                 .map_err(reopen_error(dir, dir.join("history.csv")))?;
             let newton = NewtonRecorder::reopen(dir, &newton)
                 .map_err(reopen_error(dir, dir.join(NEWTON_CSV)))?;
-            let fields = match (case.output.field_interval, fields) {
-                (Some(interval), Some(memory)) => Some(
-                    FieldWriter::reopen(dir, interval, drum, memory, checkpoint.state.clone())
-                        .map_err(reopen_error(dir, fields_dir.clone()))?,
-                ),
-                (None, None) => None,
-                _ => return Err(misfit(dir, "its field output does not fit the case's")),
-            };
+            let fields = field_writer(
+                dir,
+                case.output.field_interval,
+                Some((fields, &checkpoint.state)),
+            )?;
             (recorder, newton, fields, input, Some(checkpoint))
         }
     };
@@ -410,10 +398,8 @@ fn run_in<const D: usize>(
     );
     let samples = recorder.finish().map_err(output(dir.join("history.csv")))?;
     newton.finish().map_err(output(dir.join(NEWTON_CSV)))?;
-    if let Some(writer) = field_writer.take() {
-        writer
-            .finish(&scene.model)
-            .map_err(output(fields_dir.clone()))?;
+    if let Some(writer) = field_writer {
+        writer.finish(&scene.model).map_err(output(fields_dir))?;
     }
     let summary = summarize(case, &samples, &stats, result.err().as_ref());
     write_atomic(
@@ -422,6 +408,36 @@ fn run_in<const D: usize>(
     )
     .map_err(output(dir.join("summary.json")))?;
     Ok(summary)
+}
+
+/// The field writer of a run whose input asks for frames every `interval` (none without):
+/// created afresh, or, on resuming (`resumed`: the restart file's field memory and the restart
+/// point's state), reopened where the restart point left the output.
+///
+/// # Errors
+/// [`CaseError::Output`] if `<dir>/fields` cannot be written; [`CaseError::Resume`] if the
+/// restart file's field output does not fit the input's or is missing.
+fn field_writer(
+    dir: &Path,
+    interval: Option<f64>,
+    resumed: Option<(Option<FieldMemory>, &State)>,
+) -> Result<Option<FieldWriter>, CaseError> {
+    let fields_dir = dir.join(fields::FIELDS_DIR);
+    match (interval, resumed) {
+        (None, None | Some((None, _))) => Ok(None),
+        (Some(interval), None) => FieldWriter::create(dir, interval)
+            .map(Some)
+            .map_err(output(fields_dir)),
+        (Some(interval), Some((Some(memory), state))) => {
+            FieldWriter::reopen(dir, interval, memory, state.clone())
+                .map(Some)
+                .map_err(reopen_error(dir, fields_dir))
+        }
+        (None, Some((Some(_), _))) | (Some(_), Some((None, _))) => Err(misfit(
+            dir,
+            "its field output does not fit the input's field_interval",
+        )),
+    }
 }
 
 /// Writes the input as run, `text`, into `dir/file`, and returns its identity for the restart
@@ -511,14 +527,16 @@ fn run_model_in<const D: usize>(
 ) -> Result<ModelSummary, CaseError> {
     let scene = model_scene::<D>(spec, source)?;
     let history_path = dir.join(model_file::history::HISTORY_CSV);
-    let (mut history, mut newton, input, checkpoint) = match start {
+    let fields_dir = dir.join(fields::FIELDS_DIR);
+    let (mut history, mut newton, mut field_writer, input, checkpoint) = match start {
         Start::Fresh => {
             clear_outputs(dir)?;
             let input = write_input(dir, MODEL_JSON, model_file::to_json(spec))?;
             let history =
                 ModelRecorder::create(dir, &scene.model).map_err(output(history_path.clone()))?;
             let newton = NewtonRecorder::create(dir).map_err(output(dir.join(NEWTON_CSV)))?;
-            (history, newton, input, None)
+            let fields = field_writer(dir, spec.output.field_interval, None)?;
+            (history, newton, fields, input, None)
         }
         Start::Resume(restart) => {
             let RestartFile {
@@ -533,23 +551,22 @@ fn run_model_in<const D: usize>(
             let RecorderMemory::Model(record) = recorder else {
                 return Err(misfit(dir, "it holds a drum case's history, not a model's"));
             };
-            if fields.is_some() {
-                return Err(misfit(
-                    dir,
-                    "it holds field output, which model files do not write",
-                ));
-            }
             let history = ModelRecorder::reopen(dir, &history, *record)
                 .map_err(reopen_error(dir, history_path.clone()))?;
             let newton = NewtonRecorder::reopen(dir, &newton)
                 .map_err(reopen_error(dir, dir.join(NEWTON_CSV)))?;
-            (history, newton, input, Some(checkpoint))
+            let fields = field_writer(
+                dir,
+                spec.output.field_interval,
+                Some((fields, &checkpoint.state)),
+            )?;
+            (history, newton, fields, input, Some(checkpoint))
         }
     };
     let mut observers = Observers {
         history: &mut history,
         newton: &mut newton,
-        fields: None,
+        fields: field_writer.as_mut(),
         restart: RestartWriter::new(dir, restart_every, input, checkpoint.as_ref()),
     };
     let (stats, result) = integrate(
@@ -561,6 +578,9 @@ fn run_model_in<const D: usize>(
     );
     let record = history.finish().map_err(output(history_path))?;
     newton.finish().map_err(output(dir.join(NEWTON_CSV)))?;
+    if let Some(writer) = field_writer {
+        writer.finish(&scene.model).map_err(output(fields_dir))?;
+    }
     if let Ok(state) = &result {
         let path = dir.join(contact_nodes::CONTACT_NODES_CSV);
         contact_nodes::write(dir, &scene.model, state).map_err(output(path))?;

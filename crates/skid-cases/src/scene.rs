@@ -51,16 +51,9 @@ pub(crate) fn model_scene<const D: usize>(
     spec: &ModelSpec,
     source: &Path,
 ) -> Result<Scene<D>, CaseError> {
-    let invalid = |field: String, message: String| CaseError::Invalid {
+    model_file::build::<D>(spec).map_err(|e| CaseError::Invalid {
         path: source.to_path_buf(),
-        field,
-        message,
-    };
-    if spec.output.field_interval.is_some() {
-        return Err(invalid(
-            "output.field_interval".into(),
-            "ParaView field output is written for drum case files only so far; remove it".into(),
-        ));
-    }
-    model_file::build::<D>(spec).map_err(|e| invalid(e.field, e.message))
+        field: e.field,
+        message: e.message,
+    })
 }

@@ -272,6 +272,12 @@ pub(crate) const MAX_NAME: usize = 100;
 /// `.`, `_`, `+`, `-`, not starting with `.` (hidden, or the directory itself or its parent)
 /// or `-` (read as an option on a command line).
 pub(crate) fn check_case_name(name: &str) -> Result<(), Problem> {
+    check_file_name("name", name, "the name of the output directory")
+}
+
+/// A name that names a file or directory (`role` says which, for the message): 1 to
+/// [`MAX_NAME`] ASCII letters, digits and `.`, `_`, `+`, `-`, not starting with `.` or `-`.
+pub(crate) fn check_file_name(field: &str, name: &str, role: &str) -> Result<(), Problem> {
     let allowed = |c: char| c.is_ascii_alphanumeric() || "._+-".contains(c);
     if name.is_empty()
         || name.chars().count() > MAX_NAME
@@ -279,10 +285,10 @@ pub(crate) fn check_case_name(name: &str) -> Result<(), Problem> {
         || name.starts_with(['.', '-'])
     {
         return Err((
-            "name".into(),
+            field.into(),
             format!(
                 "expected 1 to {MAX_NAME} of the characters A-Z a-z 0-9 . _ + - not starting \
-                 with . or - (the name of the output directory), got {name:?}"
+                 with . or - ({role}), got {name:?}"
             ),
         ));
     }

@@ -563,3 +563,82 @@ fn concentrated_loads_gravity_and_amplitudes_map_onto_the_model() {
     );
     assert!(matches!(m.loads[3], LoadSpec::Pressure { .. }));
 }
+
+/// `*OUTPUT, FIELD` with a time or number interval sets the model's field interval (one for the
+/// run: the smallest of the dynamic steps', else the static steps'); one without either is
+/// noted and sets none; the deck writer writes the interval back as a request; a deck run
+/// writes the fields of its part and its drum body.
+#[test]
+fn field_output_requests_set_the_field_interval() {
+    let interval = |deck: &skid_cases::deck::DeckModel| deck.model.output.field_interval;
+    let history = "*Output, history, frequency=1\n";
+    let in_dynamic = |request: &str| variant(history, &format!("{request}\n{history}"));
+    let time = in_dynamic("*Output, field, time interval=0.005").expect("deck");
+    assert_eq!(interval(&time), Some(0.005));
+    // the spin-down's period 0.15 s in 30 intervals
+    let number = in_dynamic("*Output, field, number interval=30").expect("deck");
+    assert_eq!(interval(&number), Some(0.15 / 30.0));
+    let both = in_dynamic("*Output, field, number interval=30\n*Output, field, time interval=1e-3")
+        .expect("deck");
+    assert_eq!(interval(&both), Some(1e-3));
+    // a static step's request turns the output on; its interval counts only without dynamic ones
+    let preload = "*Dsload\npad_back, P, 0.35e6\n";
+    let static_only = variant(
+        preload,
+        &format!("{preload}*Output, field, number interval=4\n"),
+    )
+    .expect("deck");
+    assert_eq!(interval(&static_only), Some(0.25));
+    let frequency = in_dynamic("*Output, field, frequency=10").expect("deck");
+    assert_eq!(interval(&frequency), None);
+    assert!(
+        frequency
+            .notes
+            .iter()
+            .any(|n| n.contains("none are written")),
+        "{:?}",
+        frequency.notes
+    );
+    for (request, message) in [
+        ("*Output, field, time interval=-1", "expected a time > 0"),
+        (
+            "*Output, field, number interval=0",
+            "expected a positive integer",
+        ),
+        (
+            "*Output, field, frequency=2, time interval=0.1",
+            "FREQUENCY and TIME INTERVAL exclude each other",
+        ),
+    ] {
+        let err = in_dynamic(request).expect_err(request);
+        assert!(err.contains(message) && err.contains("scene.inp:"), "{err}");
+    }
+    // written back as a request, read back to the same interval
+    let written =
+        skid_cases::deck::write::write_deck(&time.model, &Default::default()).expect("written");
+    assert_eq!(
+        interval(&read_text(&written).expect("read back")),
+        Some(0.005)
+    );
+
+    // a deck run writes the part's and the drum's frames
+    let dir = tempfile::tempdir().expect("tempdir");
+    let deck_path = dir.path().join("fields.inp");
+    std::fs::write(&deck_path, &written).expect("write deck");
+    let out = dir.path().join("out");
+    let summary = run_file(
+        &deck_path,
+        &["steps[1].duration=0.0005".to_string()],
+        Some(&out),
+        DEFAULT_RESTART_EVERY,
+    )
+    .expect("run");
+    assert_eq!(summary.error(), None);
+    let collection = std::fs::read_to_string(out.join("fields/skid.pvd")).expect("pvd");
+    let part = &time.model.part.name;
+    let drum = &time.model.rigid_bodies[0].name;
+    for file in [format!("{part}_0000.vtu"), format!("{drum}_0000.vtu")] {
+        assert!(collection.contains(&file), "{file} in {collection}");
+        assert!(out.join("fields").join(&file).is_file(), "{file}");
+    }
+}

@@ -2,8 +2,9 @@
 //! writes its outputs) leaves no output that looks complete, and `skid run --resume` continues
 //! it to the outputs of the uninterrupted run, byte for byte (`summary.json` wall times aside).
 //!
-//! The short version of `scripts/kill-resume.py`: a shortened 2D drum (45 increments, field
-//! output every millisecond, a restart file every 2 increments), killed at seeded random
+//! The short version of `scripts/kill-resume.py`: a shortened 2D drum case (45 increments) and
+//! a shortened model file (the 2D block on a sliding ground, 20 increments), both with field
+//! output every millisecond and a restart file every 2 increments, killed at seeded random
 //! moments over the run; a resumed run is itself killed again at random until one finishes.
 
 use std::path::Path;
@@ -15,19 +16,38 @@ use serde_json::Value;
 mod common;
 use common::{shipped, skid, without_timings};
 
-/// The overrides that shorten the shipped 2D drum and give it field output.
-const SHORT: [&str; 2] = ["steps[1].duration=0.004", "output.field_interval=0.001"];
+/// A run to kill: a shipped input with the overrides that shorten it and give it field
+/// output, and the name of the input as run in its directory.
+struct Scenario {
+    input: &'static str,
+    sets: &'static [&'static str],
+    as_run: &'static str,
+}
 
-/// `skid run` of the short case into `out` with a restart file every 2 increments.
-fn start(out: &Path) -> Child {
+/// The shipped 2D drum, shortened.
+const DRUM: Scenario = Scenario {
+    input: "drum/2d-analytic.json",
+    sets: &["steps[1].duration=0.004", "output.field_interval=0.001"],
+    as_run: "case.json",
+};
+
+/// The 2D block on a sliding ground, a model file, shortened.
+const MODEL: Scenario = Scenario {
+    input: "verification/2d-block-on-sliding-ground.json",
+    sets: &["steps[1].duration=0.004", "output.field_interval=0.001"],
+    as_run: "model.json",
+};
+
+/// `skid run` of the scenario into `out` with a restart file every 2 increments.
+fn start(scenario: &Scenario, out: &Path) -> Child {
     let mut command = skid();
     command
         .arg("run")
-        .arg(shipped("drum/2d-analytic.json"))
+        .arg(shipped(scenario.input))
         .arg("--out")
         .arg(out)
         .args(["--restart-every", "2"]);
-    for set in SHORT {
+    for set in scenario.sets {
         command.args(["--set", set]);
     }
     spawn(command)
@@ -91,9 +111,10 @@ enum Killed {
 }
 
 /// Checks what a killed run left in `dir`: a `summary.json` only if everything else is there
-/// (the caller compares the files), otherwise no file under a final name that is not whole and
-/// a restart file (if any) that reads; returns where the run was when it was killed.
-fn check_killed(dir: &Path) -> Killed {
+/// (the caller compares the files), otherwise no file under a final name that is not whole
+/// (a history of `history_lines` lines, as the uninterrupted run's) and a restart file (if
+/// any) that reads; returns where the run was when it was killed.
+fn check_killed(dir: &Path, history_lines: usize) -> Killed {
     if dir.join("summary.json").exists() {
         return Killed::Ended;
     }
@@ -108,7 +129,7 @@ fn check_killed(dir: &Path) -> Killed {
         let text = std::fs::read_to_string(&history).expect("history");
         assert_eq!(
             text.lines().count(),
-            47,
+            history_lines,
             "a history.csv under its name is complete"
         );
         Killed::InOutput
@@ -162,7 +183,12 @@ fn kill_in_output_phase(child: &mut Child, dir: &Path) -> bool {
 
 /// Resumes the run in `dir`, killing each resumed run at a random moment within `span` until
 /// one finishes; returns the kills.
-fn resume_to_the_end(dir: &Path, span: Duration, random: &mut Random) -> usize {
+fn resume_to_the_end(
+    dir: &Path,
+    span: Duration,
+    history_lines: usize,
+    random: &mut Random,
+) -> usize {
     let mut kills = 0;
     loop {
         let mut child = resume(dir);
@@ -176,30 +202,35 @@ fn resume_to_the_end(dir: &Path, span: Duration, random: &mut Random) -> usize {
             return kills;
         }
         kills += 1;
-        check_killed(dir);
+        check_killed(dir, history_lines);
     }
 }
 
-#[test]
-fn runs_killed_at_random_moments_resume_to_the_uninterrupted_outputs() {
+/// Kills runs of `scenario` at random moments (seeded by `seed`) until `wanted` kills over at
+/// least `wanted - 1` runs, and checks that each resumes to the uninterrupted run's outputs.
+fn killed_runs_resume_to_the_uninterrupted_outputs(scenario: &Scenario, wanted: usize, seed: u64) {
     let tmp = tempfile::tempdir().expect("tempdir");
     let reference = tmp.path().join("reference");
     let clock = Instant::now();
-    let status = start(&reference).wait().expect("reference run");
+    let status = start(scenario, &reference).wait().expect("reference run");
     let span = clock.elapsed();
     assert!(status.success());
     let expected = results(&reference);
     assert!(expected.iter().any(|(name, _)| name == "fields/skid.pvd"));
+    let history_lines = expected
+        .iter()
+        .find(|(name, _)| name == "history.csv")
+        .map(|(_, text)| text.lines().count())
+        .expect("history.csv");
 
-    let mut random = Random(0x5eed_cafe_f00d_d00d);
+    let mut random = Random(seed);
     let (mut kills, mut in_output) = (0, 0);
-    // until 25 kills (a run may finish before its kill moment), at least 24 runs
     for trial in 0..80 {
-        if trial >= 24 && kills >= 25 {
+        if trial + 1 >= wanted && kills >= wanted {
             break;
         }
         let dir = tmp.path().join(format!("killed-{trial}"));
-        let mut child = start(&dir);
+        let mut child = start(scenario, &dir);
         let killed = if trial % 6 == 5 {
             kill_in_output_phase(&mut child, &dir)
         } else {
@@ -208,13 +239,13 @@ fn runs_killed_at_random_moments_resume_to_the_uninterrupted_outputs() {
         };
         if killed {
             kills += 1;
-            in_output += usize::from(check_killed(&dir) == Killed::InOutput);
+            in_output += usize::from(check_killed(&dir, history_lines) == Killed::InOutput);
             if !dir.join("restart.json").exists() {
                 // killed before its first restart point (or before it wrote its input or made
                 // its directory): nothing to resume, and saying so
                 let expected_message = if !dir.is_dir() {
                     "no such directory"
-                } else if !dir.join("case.json").is_file() {
+                } else if !dir.join(scenario.as_run).is_file() {
                     "expected the input as run"
                 } else {
                     "no restart.json"
@@ -230,20 +261,30 @@ fn runs_killed_at_random_moments_resume_to_the_uninterrupted_outputs() {
                 assert!(message.contains(expected_message), "{message}");
                 continue;
             }
-            kills += resume_to_the_end(&dir, span, &mut random);
+            kills += resume_to_the_end(&dir, span, history_lines, &mut random);
         }
         assert_eq!(results(&dir), expected, "trial {trial}");
     }
     eprintln!("{kills} kills, {in_output} in the output phase");
-    assert!(kills >= 25, "only {kills} kills");
+    assert!(kills >= wanted, "only {kills} kills");
     assert!(in_output >= 1, "no kill landed in the output phase");
+}
+
+#[test]
+fn runs_killed_at_random_moments_resume_to_the_uninterrupted_outputs() {
+    killed_runs_resume_to_the_uninterrupted_outputs(&DRUM, 25, 0x5eed_cafe_f00d_d00d);
+}
+
+#[test]
+fn model_file_runs_with_fields_killed_at_random_moments_resume_alike() {
+    killed_runs_resume_to_the_uninterrupted_outputs(&MODEL, 12, 0x0dd_ba11_5eed_f00d);
 }
 
 #[test]
 fn resume_refuses_another_input_and_says_when_the_run_has_ended() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let dir = tmp.path().join("run");
-    assert!(start(&dir).wait().expect("run").success());
+    assert!(start(&DRUM, &dir).wait().expect("run").success());
     let run = |args: &[&str]| {
         let output = skid().args(args).output().expect("skid runs");
         (
@@ -252,7 +293,7 @@ fn resume_refuses_another_input_and_says_when_the_run_has_ended() {
         )
     };
     let dir_arg = dir.to_str().expect("utf-8 path");
-    let case = shipped("drum/2d-analytic.json");
+    let case = shipped(DRUM.input);
     let case_arg = case.to_str().expect("utf-8 path");
     // another input (the unshortened case) is refused
     let (code, message) = run(&["run", case_arg, "--resume", dir_arg]);
@@ -260,7 +301,7 @@ fn resume_refuses_another_input_and_says_when_the_run_has_ended() {
     assert!(message.contains("is not the input"), "{message}");
     // the same input is accepted; the run has ended, so nothing is run again
     let mut same = vec!["run", case_arg, "--resume", dir_arg];
-    for set in SHORT {
+    for set in DRUM.sets {
         same.extend(["--set", set]);
     }
     let (code, message) = run(&same);

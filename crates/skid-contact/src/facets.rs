@@ -6,7 +6,7 @@ use std::f64::consts::{PI, TAU};
 use nalgebra::{Matrix3, Vector2, Vector3};
 
 use crate::error::ContactError;
-use crate::surface::{AnalyticCylinder, Projection, RigidSurface};
+use crate::surface::{AnalyticCylinder, Projection, RigidSurface, SurfaceShape};
 
 /// Convex regular prism of `n` facets inscribed in the circle of radius `R` about the body-frame
 /// unit axis `e` through the origin, of infinite axial extent.
@@ -154,6 +154,13 @@ impl FacetedCylinder {
 }
 
 impl RigidSurface for FacetedCylinder {
+    fn shape(&self) -> SurfaceShape {
+        SurfaceShape::Prism {
+            axis: self.axis,
+            vertices: (0..self.facets).map(|k| self.vertex(k)).collect(),
+        }
+    }
+
     fn project(&self, y: &Vector3<f64>) -> Option<Projection> {
         if !y.iter().all(|c| c.is_finite()) {
             return None;

@@ -38,6 +38,20 @@ impl RotatingFrame {
         let axis = Unit::try_new(self.axis, 0.0).filter(|a| a.iter().all(|c| c.is_finite()))?;
         Some((axis, Rotation3::from_axis_angle(&axis, self.angle)))
     }
+
+    /// The world position `x = c + Q(theta) y` of the body-frame point `y`; `None` if the frame
+    /// is degenerate.
+    pub fn to_world(&self, y: &Vector3<f64>) -> Option<Vector3<f64>> {
+        let (_, rotation) = self.orientation()?;
+        Some(self.center + rotation * y)
+    }
+
+    /// The body-frame point `y = Q(theta)^T (x - c)` at the world position `x`; `None` if the
+    /// frame is degenerate.
+    pub fn to_body(&self, x: &Vector3<f64>) -> Option<Vector3<f64>> {
+        let (_, rotation) = self.orientation()?;
+        Some(rotation.inverse_transform_vector(&(x - self.center)))
+    }
 }
 
 /// Gap, convected coordinates and their exact first and second derivatives for one slave node.

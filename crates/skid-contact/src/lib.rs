@@ -33,5 +33,5 @@ pub use kinematics::{
     gap_discrete_gradient, rotation_column, slip_increment,
 };
 pub use plane::RigidPlane;
-pub use surface::{AnalyticCylinder, DiscreteGradient, Projection, RigidSurface};
+pub use surface::{AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, SurfaceShape};
 pub use triangles::{CylinderChart, TriangulatedSurface};

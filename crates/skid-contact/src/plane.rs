@@ -3,7 +3,7 @@
 use nalgebra::{Matrix3, Vector2, Vector3};
 
 use crate::error::ContactError;
-use crate::surface::{Projection, RigidSurface};
+use crate::surface::{Projection, RigidSurface, SurfaceShape};
 
 /// The plane through the body-frame origin with outward unit normal `n`.
 ///
@@ -45,6 +45,13 @@ impl RigidPlane {
 }
 
 impl RigidSurface for RigidPlane {
+    fn shape(&self) -> SurfaceShape {
+        SurfaceShape::Plane {
+            normal: self.normal,
+            tangents: [self.t1, self.t2],
+        }
+    }
+
     fn project(&self, y: &Vector3<f64>) -> Option<Projection> {
         y.iter().all(|c| c.is_finite()).then(|| Projection {
             gap: self.normal.dot(y),

@@ -22,8 +22,45 @@ pub struct Projection {
     pub coords_hessian: [Matrix3<f64>; 2],
 }
 
+/// The geometry of a rigid surface in its body frame, for drawing it: what the surface is, not
+/// how it is projected on.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SurfaceShape {
+    /// The cylinder of `radius` about the unit `axis` through the origin, unbounded along it;
+    /// `reference` is the unit direction perpendicular to the axis where the arc-length
+    /// coordinate is zero.
+    Cylinder {
+        /// Radius `R`.
+        radius: f64,
+        /// Unit axis `e`.
+        axis: Vector3<f64>,
+        /// Unit reference direction `b1`, perpendicular to `e`.
+        reference: Vector3<f64>,
+    },
+    /// The plane through the origin with unit outward `normal`, unbounded; `tangents` are the
+    /// unit in-plane directions `t1` and `t2 = n x t1`.
+    Plane {
+        /// Unit outward normal `n`.
+        normal: Vector3<f64>,
+        /// `[t1, t2]`.
+        tangents: [Vector3<f64>; 2],
+    },
+    /// The prism over the closed polygon `vertices` (in the plane `e.y = 0`, counter-clockwise
+    /// about `axis`), unbounded along the unit `axis`.
+    Prism {
+        /// Unit axis `e`.
+        axis: Vector3<f64>,
+        /// Polygon vertices in order.
+        vertices: Vec<Vector3<f64>>,
+    },
+    /// Triangles by their corners, counter-clockwise seen from outside.
+    Triangles(Vec<[Vector3<f64>; 3]>),
+}
+
 /// A rigid surface, static in the body frame of its rigid body.
 pub trait RigidSurface: Send + Sync + std::fmt::Debug {
+    /// The surface's geometry in the body frame (see [`SurfaceShape`]).
+    fn shape(&self) -> SurfaceShape;
     /// Closest-point projection of the body-frame point `y`; `None` only where the projection is
     /// undefined (e.g. on the axis of a cylinder) or `y` is not finite.
     fn project(&self, y: &Vector3<f64>) -> Option<Projection>;
@@ -130,6 +167,14 @@ impl AnalyticCylinder {
 }
 
 impl RigidSurface for AnalyticCylinder {
+    fn shape(&self) -> SurfaceShape {
+        SurfaceShape::Cylinder {
+            radius: self.radius,
+            axis: self.axis,
+            reference: self.b1,
+        }
+    }
+
     fn project(&self, y: &Vector3<f64>) -> Option<Projection> {
         if !y.iter().all(|c| c.is_finite()) {
             return None;
@@ -242,6 +287,69 @@ mod tests {
             c.gap_discrete_gradient(&y0, &y1, &Vector3::new(1.0, 0.0, 0.0))
                 .is_none()
         );
+        Ok(())
+    }
+
+    /// Every surface's shape lies on it: the cylinder's reference direction at radius R (arc
+    /// length 0), the plane's span, the prism's vertices, the triangles' corners; the frames are
+    /// orthonormal and right-handed.
+    #[test]
+    fn shapes_lie_on_their_surfaces() -> Result<(), ContactError> {
+        use crate::facets::FacetedCylinder;
+        use crate::plane::RigidPlane;
+        use crate::triangles::TriangulatedSurface;
+        let axis = Vector3::new(0.3, -0.5, 0.8);
+        let on_surface = |s: &dyn RigidSurface, y: Vector3<f64>| {
+            let p = s.project(&y).expect("projection");
+            assert!(p.gap.abs() < 1e-14, "gap {} at {y:?}", p.gap);
+            p
+        };
+        let cylinder = AnalyticCylinder::new(0.2, axis)?;
+        let SurfaceShape::Cylinder {
+            radius,
+            axis: e,
+            reference,
+        } = cylinder.shape()
+        else {
+            panic!("a cylinder");
+        };
+        assert_eq!(radius, 0.2);
+        assert!(e.dot(&reference).abs() < 1e-15 && (e.norm() - 1.0).abs() < 1e-15);
+        let p = on_surface(&cylinder, reference * radius + e * 0.3);
+        assert!(p.coords[0].abs() < 1e-15 && (p.coords[1] - 0.3).abs() < 1e-15);
+
+        let plane = RigidPlane::new(Vector3::new(0.0, 2.0, 1.0), Vector3::x())?;
+        let SurfaceShape::Plane { normal, tangents } = plane.shape() else {
+            panic!("a plane");
+        };
+        assert!((tangents[0].cross(&tangents[1]) - normal).norm() < 1e-15);
+        let p = on_surface(&plane, tangents[0] * 0.4 - tangents[1] * 0.1);
+        assert!((p.coords - Vector2::new(0.4, -0.1)).norm() < 1e-15);
+
+        let prism = FacetedCylinder::new(0.2, axis, 7, 0.1)?;
+        let SurfaceShape::Prism { axis: e, vertices } = prism.shape() else {
+            panic!("a prism");
+        };
+        assert_eq!(vertices.len(), 7);
+        for (k, v) in vertices.iter().enumerate() {
+            on_surface(&prism, *v + e * 0.05);
+            // counter-clockwise about the axis
+            let next = vertices[(k + 1) % 7];
+            assert!(v.cross(&next).dot(&e) > 0.0);
+        }
+
+        let triangles = TriangulatedSurface::closed_prism(
+            &FacetedCylinder::new(0.2, Vector3::z(), 6, 0.0)?,
+            [-0.1, 0.1],
+        )?;
+        let SurfaceShape::Triangles(corners) = triangles.shape() else {
+            panic!("triangles");
+        };
+        assert_eq!(corners.len(), 4 * 6);
+        // the end caps' centres lie on the chart axis, where the projection is undefined
+        for corner in corners.iter().flatten().filter(|c| c.xy().norm() > 0.0) {
+            on_surface(&triangles, *corner);
+        }
         Ok(())
     }
 

@@ -8,7 +8,7 @@ use rstar::{AABB, PointDistance, RTree, RTreeObject};
 
 use crate::error::ContactError;
 use crate::facets::FacetedCylinder;
-use crate::surface::{AnalyticCylinder, Projection, RigidSurface};
+use crate::surface::{AnalyticCylinder, Projection, RigidSurface, SurfaceShape};
 
 /// Cylinder whose coordinates label points of a triangulated drum: `xi_0 = R atan2(p.b2, p.b1)`,
 /// `xi_1 = e.p` for a surface point `p`, with `b1`, `b2` as in [`AnalyticCylinder`].
@@ -380,6 +380,10 @@ impl TriangulatedSurface {
 }
 
 impl RigidSurface for TriangulatedSurface {
+    fn shape(&self) -> SurfaceShape {
+        SurfaceShape::Triangles(self.triangles.iter().map(|t| t.corners).collect())
+    }
+
     fn project(&self, y: &Vector3<f64>) -> Option<Projection> {
         if !y.iter().all(|c| c.is_finite()) {
             return None;

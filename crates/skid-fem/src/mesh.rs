@@ -191,6 +191,38 @@ impl<const D: usize> SolidMesh<D> {
         }
         Ok(())
     }
+
+    /// The faces of the elements that no other element shares (the mesh's boundary), each
+    /// with its corners in the outward order of [`face_corners`], in element order. Elements
+    /// of the wrong corner count are skipped ([`Self::validate`] refuses them).
+    pub fn exterior_faces(&self) -> Vec<Vec<usize>> {
+        let faces: Vec<Vec<usize>> = self
+            .elements
+            .iter()
+            .filter(|element| element.len() == corner_count(D))
+            .flat_map(|element| {
+                (0..D).flat_map(move |axis| {
+                    [false, true].into_iter().filter_map(move |upper| {
+                        let local = face_corners::<D>(axis, upper).ok()?;
+                        Some(local.iter().map(|&c| element[c]).collect::<Vec<usize>>())
+                    })
+                })
+            })
+            .collect();
+        let sorted = |face: &[usize]| {
+            let mut key = face.to_vec();
+            key.sort_unstable();
+            key
+        };
+        let mut count: BTreeMap<Vec<usize>, usize> = BTreeMap::new();
+        for face in &faces {
+            *count.entry(sorted(face)).or_default() += 1;
+        }
+        faces
+            .into_iter()
+            .filter(|face| count.get(&sorted(face)) == Some(&1))
+            .collect()
+    }
 }
 
 #[cfg(test)]
@@ -227,6 +259,22 @@ mod tests {
         assert_eq!(m3.node_sets.len(), 6);
         m2.validate()?;
         m3.validate()
+    }
+
+    /// A structured block's exterior faces are exactly the faces of its boundary surfaces, in
+    /// the same outward order.
+    #[test]
+    fn exterior_faces_are_the_boundary_surfaces() -> Result<(), FemError> {
+        fn check<const D: usize>(mesh: &SolidMesh<D>) {
+            let mut exterior = mesh.exterior_faces();
+            let mut boundary: Vec<Vec<usize>> = mesh.surfaces.values().flatten().cloned().collect();
+            exterior.sort();
+            boundary.sort();
+            assert_eq!(exterior, boundary);
+        }
+        check(&block_2d()?);
+        check(&block_3d()?);
+        Ok(())
     }
 
     #[test]

@@ -10,8 +10,8 @@
 
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 use skid_contact::kinematics::{
-    ContactKinematics, IncrementStart, RotatingFrame, evaluate, gap_discrete_gradient,
-    rotation_column, slip_increment,
+    ContactKinematics, IncrementStart, evaluate, gap_discrete_gradient, rotation_column,
+    slip_increment,
 };
 use skid_fem::cell::embed;
 
@@ -201,11 +201,7 @@ pub fn contact_rows<const D: usize>(
     let mut k = 0;
     for (p, pair) in model.contacts().iter().enumerate() {
         let body = &model.bodies()[pair.body];
-        let frame = RotatingFrame {
-            center: embed(&(body.reference_point + dofs.body_displacement(x, pair.body))),
-            axis: body.rotation_axis.unwrap_or_else(Vector3::z),
-            angle: dofs.body_angle(x, pair.body),
-        };
+        let frame = model.body_frame(x, pair.body);
         let start_center =
             start.map(|x0| embed(&(body.reference_point + dofs.body_displacement(x0, pair.body))));
         for &node in &pair.nodes {

@@ -3,6 +3,7 @@
 //! during a run.
 
 use nalgebra::{DVector, SVector, Vector3};
+use skid_contact::kinematics::RotatingFrame;
 use skid_contact::surface::RigidSurface;
 use skid_fem::cell::embed;
 use skid_fem::material::Hyperelastic;
@@ -26,6 +27,8 @@ pub struct Section {
 /// The deformable solid: mesh, materials and section data.
 #[derive(Debug)]
 pub struct SolidPart<const D: usize> {
+    /// Name used in messages and output file names.
+    pub name: String,
     /// Mesh of one-point elements (quads in 2D, hexahedra in 3D).
     pub mesh: SolidMesh<D>,
     /// Sections (at least one).
@@ -484,6 +487,18 @@ impl<const D: usize> Model<D> {
     /// Index of the rigid body with this name.
     pub fn body_index(&self, name: &str) -> Option<usize> {
         self.bodies.iter().position(|b| b.name == name)
+    }
+
+    /// The frame of rigid body `body` in the state `x`: its current reference point `c` (the
+    /// reference point plus its displacement), its rotation axis (+z for a body that cannot
+    /// rotate) and its angle, so that a body-frame point `y` is at `c + Q(theta) y`.
+    pub fn body_frame(&self, x: &DVector<f64>, body: usize) -> RotatingFrame {
+        let b = &self.bodies[body];
+        RotatingFrame {
+            center: embed(&(b.reference_point + self.dofs.body_displacement(x, body))),
+            axis: b.rotation_axis.unwrap_or_else(Vector3::z),
+            angle: self.dofs.body_angle(x, body),
+        }
     }
 
     /// Current position of a node embedded in 3D (z = 0 in 2D).

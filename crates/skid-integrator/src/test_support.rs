@@ -24,6 +24,7 @@ pub(crate) fn pad_block<const D: usize>(
     )
     .expect("mesh");
     SolidPart {
+        name: "pad".into(),
         mesh,
         sections: vec![Section {
             material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6).expect("material")),

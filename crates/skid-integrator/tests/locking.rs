@@ -39,6 +39,7 @@ fn tip_deflection(k_over_mu: f64) -> f64 {
     let tip = *mesh.node_sets["xmax"].get(2).expect("mid-height tip node");
     let material = PolynomialN1::new(MU / 2.0, 0.0, 2.0 / (k_over_mu * MU)).expect("material");
     let part = SolidPart {
+        name: "block".into(),
         mesh,
         sections: vec![Section {
             material: Box::new(material),

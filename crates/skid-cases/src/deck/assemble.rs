@@ -13,8 +13,8 @@ use super::fields::key;
 use super::keywords::{DeckError, Location};
 use super::mesh::ElementKind;
 use super::read::{
-    BoundaryDef, Change, Definitions, FaceLabel, InitialDef, Procedure, RigidDef, SectionKind,
-    StepDef, SurfaceDef,
+    BoundaryDef, Change, Definitions, FaceLabel, FieldRequest, InitialDef, Procedure, RigidDef,
+    SectionKind, StepDef, SurfaceDef,
 };
 use super::rigid::{prism, triangles};
 use crate::model_spec::{
@@ -237,7 +237,9 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
         contact,
         steps,
         solver: SolverSpec::default(),
-        output: OutputSpec::default(),
+        output: OutputSpec {
+            field_interval: field_interval(&defs.steps),
+        },
     })
 }
 

@@ -187,6 +187,18 @@ pub struct StepDef {
     pub loads: Vec<LoadChange>,
     /// `NLGEOM` as given (`None`: absent).
     pub nlgeom: Option<bool>,
+    /// The step's `*OUTPUT, FIELD` requests that give an interval.
+    pub field_output: Vec<FieldRequest>,
+}
+
+/// When an `*OUTPUT, FIELD` request asks for frames: every `TIME INTERVAL`, or at `NUMBER
+/// INTERVAL` equal divisions of the step's time period.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FieldRequest {
+    /// `TIME INTERVAL=t`, s.
+    Time(f64),
+    /// `NUMBER INTERVAL=n`.
+    Number(u64),
 }
 
 /// General contact: `*CONTACT` with its inclusions and property assignment.
@@ -937,6 +949,7 @@ fn start_step(defs: &Definitions, block: &Block) -> Result<StepDef, DeckError> {
         boundary: Vec::new(),
         loads: Vec::new(),
         nlgeom,
+        field_output: Vec::new(),
     })
 }
 
@@ -1018,11 +1031,15 @@ fn read_step_block(
             )?;
             no_data(block)?;
             if flag(block, "FIELD")? {
-                defs.notes.push(format!(
-                    "{}: *OUTPUT, FIELD: field output of model files is not written yet \
-                     (history.csv and summary.json are)",
-                    block.location
-                ));
+                match field_request(block)? {
+                    Some(request) => step.field_output.push(request),
+                    None => defs.notes.push(format!(
+                        "{}: *OUTPUT, FIELD without TIME INTERVAL or NUMBER INTERVAL: skid \
+                         writes field frames at a time interval, so none are written for it \
+                         (give TIME INTERVAL= or NUMBER INTERVAL=)",
+                        block.location
+                    )),
+                }
             }
         }
         "NODE OUTPUT" | "CONTACT OUTPUT" | "ENERGY OUTPUT" => {
@@ -1053,6 +1070,33 @@ fn read_step_block(
         other => return Err(outside_subset(block, other)),
     }
     Ok(())
+}
+
+/// The interval an `*OUTPUT, FIELD` block asks for: `TIME INTERVAL` (a time > 0) or `NUMBER
+/// INTERVAL` (a positive integer), which exclude each other and `FREQUENCY`; `None` without
+/// either (`FREQUENCY` counts increments, which skid's field output does not).
+fn field_request(block: &Block) -> Result<Option<FieldRequest>, DeckError> {
+    let given: Vec<&str> = ["FREQUENCY", "NUMBER INTERVAL", "TIME INTERVAL"]
+        .into_iter()
+        .filter(|p| block.parameter(p).is_some())
+        .collect();
+    if given.len() > 1 {
+        return Err(block.error(format!("{} exclude each other", given.join(" and "))));
+    }
+    if let Some(t) = super::fields::real_parameter(block, "TIME INTERVAL")? {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(block.error(format!("TIME INTERVAL={t}: expected a time > 0")));
+        }
+        return Ok(Some(FieldRequest::Time(t)));
+    }
+    match valued(block, "NUMBER INTERVAL")? {
+        Some(n) => super::fields::parse_label(n)
+            .map(|n| Some(FieldRequest::Number(n)))
+            .ok_or_else(|| {
+                block.error(format!("NUMBER INTERVAL={n}: expected a positive integer"))
+            }),
+        None => Ok(None),
+    }
 }
 
 fn is_model_keyword(name: &str) -> bool {

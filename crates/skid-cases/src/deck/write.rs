@@ -2,7 +2,8 @@
 //! the same scene: the part with its sets and surfaces, each rigid body as a reference node with
 //! its point mass and inertia and its surface (analytical, or the rigid elements the caller
 //! gives for faceted and triangulated surfaces), contact, boundary and initial conditions, and
-//! the steps. Numbers are written so that they read back to the same bits.
+//! the steps, with the field interval as an `*OUTPUT, FIELD, TIME INTERVAL=` request. Numbers
+//! are written so that they read back to the same bits.
 //!
 //! Two settings have no keyword and are refused: a static step's regularisation time other
 //! than the default, and adaptive increments; loads that change between steps and initial
@@ -375,6 +376,10 @@ pub fn write_deck(
         }
         if i == 0 {
             write_loads(&mut out, spec)?;
+            // a request holds in the later steps too
+            if let Some(interval) = spec.output.field_interval {
+                let _ = writeln!(out, "*OUTPUT, FIELD, TIME INTERVAL={}", num(interval));
+            }
         }
         let _ = writeln!(out, "*END STEP");
     }

@@ -24,6 +24,7 @@ use crate::model_spec::{
     StepBoundarySpec,
 };
 use crate::schema::{AdaptiveSpec, MaterialSpec, SolverSpec};
+use crate::validate::check_file_name;
 
 /// A built scene: model, steps and solver settings.
 #[derive(Debug)]
@@ -244,9 +245,11 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
     }
     if let Some(interval) = spec.output.field_interval {
         positive("output.field_interval", interval)?;
+        check_field_file_names(spec)?;
     }
 
     let part = SolidPart {
+        name: spec.part.name.clone(),
         mesh,
         sections,
         element_sections,
@@ -347,6 +350,31 @@ fn sections(spec: &ModelSpec, elements: usize) -> Result<(Vec<Section>, Vec<usiz
         of_element.clear();
     }
     Ok((sections, of_element))
+}
+
+/// The field output ([`crate::fields`]) names its files after the part and the rigid bodies
+/// that carry a contact pair's master surface: those names must be file names, and distinct
+/// also where a file system ignores the case of letters.
+fn check_field_file_names(spec: &ModelSpec) -> Result<(), SpecError> {
+    let mut named = vec![("part.name".to_string(), spec.part.name.as_str())];
+    for (i, body) in spec.rigid_bodies.iter().enumerate() {
+        if spec.contact.iter().any(|pair| pair.master == body.name) {
+            named.push((format!("rigid_bodies[{i}].name"), body.name.as_str()));
+        }
+    }
+    let mut seen = BTreeMap::new();
+    for (field, name) in named {
+        let role = "it names the field output's files, as output.field_interval asks";
+        check_file_name(&field, name, role)
+            .map_err(|(field, message)| SpecError { field, message })?;
+        if let Some(first) = seen.insert(name.to_ascii_lowercase(), field.clone()) {
+            return fail(
+                field,
+                format!("'{name}' names the same field output files as {first}: rename one"),
+            );
+        }
+    }
+    Ok(())
 }
 
 /// The part's mesh: nodes, elements of every block, sorted node sets, checked surfaces.

@@ -39,6 +39,7 @@ pub fn block_part(
     )
     .expect("mesh");
     SolidPart {
+        name: "pad".into(),
         mesh,
         sections: vec![Section {
             material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, d1).expect("material")),

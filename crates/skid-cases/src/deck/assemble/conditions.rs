@@ -253,6 +253,34 @@ pub(super) fn step_spec(
     })
 }
 
+/// The model's field interval from the steps' `*OUTPUT, FIELD` requests (skid writes one
+/// interval for the whole run): `TIME INTERVAL` as given, `NUMBER INTERVAL=n` the step's time
+/// period over `n`; the smallest over the dynamic steps' requests, or, if only static steps
+/// ask (whose frames are written at their end whatever the interval), over theirs. `None`
+/// without a request.
+pub(super) fn field_interval(steps: &[StepDef]) -> Option<f64> {
+    let smallest = |dynamic: bool| {
+        steps
+            .iter()
+            .filter_map(|step| {
+                match step.procedure.as_ref()?.0 {
+                    Procedure::Static { period, .. } if !dynamic => Some(period),
+                    Procedure::Dynamic { period, .. } if dynamic => Some(period),
+                    _ => None,
+                }
+                .map(|period| (step, period))
+            })
+            .flat_map(|(step, period)| {
+                step.field_output.iter().map(move |request| match *request {
+                    FieldRequest::Time(t) => t,
+                    FieldRequest::Number(n) => period / n as f64,
+                })
+            })
+            .reduce(f64::min)
+    };
+    smallest(true).or_else(|| smallest(false))
+}
+
 /// The degrees of freedom (1..=6) of a boundary condition that apply to a rigid body in
 /// dimension `dim`: a 2D body has no z translation and no in-plane rotations, so a range or a
 /// named condition (ENCASTRE, symmetry) drops 3 to 5; a single one of them stays, to be refused.
