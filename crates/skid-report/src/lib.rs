@@ -24,6 +24,7 @@
 //! number formatting and check lists shared by the sections.
 
 pub mod bench;
+pub mod block_on_flat;
 pub mod convergence;
 pub mod format;
 pub mod hard;

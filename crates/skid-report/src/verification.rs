@@ -11,30 +11,28 @@
 //!   pressure's change from one level to the next shrinks too, so that it converges, to
 //!   whatever the finite block and finite strain make of Hertz's answer), and the pressure
 //!   plot of the finest level;
-//! - Coulomb friction (any other scene with a frictional pair): the friction resultant never
-//!   exceeds `mu` times the normal one, `|T| <= mu N (1 + tol)`, in any increment; and in the
-//!   last increment in which every closed contact slides (there must be one), `|T| = mu N` to
-//!   [`COULOMB_TOLERANCE`] (in 3D the slip directions settle first, and the resultant of
-//!   forces in different directions is short of `mu N` until they have).
+//! - Coulomb friction (any other scene with a frictional pair, [`coulomb`]): the friction
+//!   resultant never exceeds `mu N` and equals it while every contact slides; a block on a
+//!   fixed flat sticks or slides as its held loads say, and the runs of a scene that stick and
+//!   slide bracket its threshold.
+
+pub mod coulomb;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use super::format::{Checks, Counts, Sig, percent, show};
+use super::format::{Checks, Counts, Sig, percent};
 use super::hertz::{self, HertzMeasure, HertzScene};
 use super::plot::{HERTZ_SVG, plot_hertz_pressure};
 use super::{ReportError, read};
-use skid_cases::csv_out::CsvTable;
 use skid_cases::model_file::contact_nodes::CONTACT_NODES_CSV;
 use skid_cases::model_spec::ModelSpec;
 use skid_cases::runner::MODEL_JSON;
 
 /// Largest relative error of the finest Hertz level's peak pressure.
 pub const PEAK_TOLERANCE: f64 = 0.03;
-/// Relative tolerance of the Coulomb checks (the history carries 10 significant digits).
-pub const COULOMB_TOLERANCE: f64 = 1e-6;
 
 /// The fields of a model run's `summary.json` this section reads.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -173,7 +171,7 @@ pub fn section(
         files.extend(file);
     }
     if !coulomb_runs.is_empty() {
-        out.push_str(&coulomb_section(&coulomb_runs, &mut checks)?);
+        out.push_str(&coulomb::section(&coulomb_runs, &mut checks)?);
     }
     for name in unchecked {
         checks.skip(
@@ -337,124 +335,4 @@ fn hertz_section(
         );
     }
     Ok((out, Some(plot)))
-}
-
-/// The Coulomb part of the section (see the module documentation).
-fn coulomb_section(runs: &[&SceneRun], checks: &mut Checks) -> Result<String, ReportError> {
-    let mut out = String::from(
-        "### Coulomb friction of the block scenes\n\n\
-         Per frictional pair, from `history.csv`: the largest `|T| / (mu N)` over all \
-         increments, and `|T| / (mu N)` in the last increment in which every closed contact \
-         slides.\n\n\
-         | run | pair | mu | increments | max \\|T\\| / (mu N) | last sliding increment \
-         | there: \\|T\\| / (mu N) |\n|---|---|---|---|---|---|---|\n",
-    );
-    for run in runs {
-        if !run.completed() {
-            checks.record(
-                &format!("{}: status", run.name),
-                false,
-                run.summary
-                    .error
-                    .clone()
-                    .unwrap_or_else(|| run.summary.status.clone()),
-            );
-            continue;
-        }
-        let path = run.dir.join("history.csv");
-        let text = read(&path)?;
-        for pair in run.spec.contact.iter().filter(|p| p.mu > 0.0) {
-            let rows = friction_rows(&text, &path, &pair.name, run.spec.dimension)?;
-            let ratio =
-                |r: &FrictionRow| (r.normal > 0.0).then(|| r.tangential / (pair.mu * r.normal));
-            let worst = rows
-                .iter()
-                .filter_map(ratio)
-                .fold(None, |w: Option<f64>, v| Some(w.map_or(v, |w| w.max(v))));
-            let last_sliding = rows
-                .iter()
-                .rposition(|r| r.active > 0 && r.sliding == r.active);
-            let last = last_sliding.map(|k| &rows[k]);
-            let _ = writeln!(
-                out,
-                "| {} | {} | {} | {} | {} | {} | {} |",
-                run.name,
-                pair.name,
-                pair.mu,
-                rows.len(),
-                show(worst),
-                last_sliding
-                    .map_or_else(|| "none".into(), |k| format!("{} of {}", k + 1, rows.len())),
-                show(last.and_then(ratio)),
-            );
-            let label = format!("{} ({})", run.name, pair.name);
-            checks.record(
-                &format!("{label}: |T| <= mu N in every increment"),
-                worst.is_some_and(|w| w <= 1.0 + COULOMB_TOLERANCE),
-                format!("largest |T| / (mu N) {}", show(worst)),
-            );
-            checks.record(
-                &format!("{label}: |T| = mu N in the last increment in which every contact slides"),
-                last.and_then(ratio)
-                    .is_some_and(|v| (v - 1.0).abs() <= COULOMB_TOLERANCE),
-                last.map_or_else(
-                    || "no increment in which every closed contact slides".into(),
-                    |r| {
-                        format!(
-                            "{} contacts sliding, |T| / (mu N) = {}",
-                            r.sliding,
-                            show(ratio(r))
-                        )
-                    },
-                ),
-            );
-        }
-    }
-    Ok(out)
-}
-
-/// A pair's resultants in one increment of the history.
-struct FrictionRow {
-    normal: f64,
-    /// `|T|`, the norm of the friction resultant.
-    tangential: f64,
-    active: usize,
-    sliding: usize,
-}
-
-/// The rows of `pair` in a model run's `history.csv` text of dimension `dimension`.
-fn friction_rows(
-    text: &str,
-    path: &Path,
-    pair: &str,
-    dimension: usize,
-) -> Result<Vec<FrictionRow>, ReportError> {
-    let table = CsvTable::new(text, path)?;
-    let names: Vec<String> = (1..dimension)
-        .map(|k| format!("tangential_force_{k}"))
-        .chain(["normal_force", "active", "sliding"].map(String::from))
-        .map(|what| format!("{pair}.{what}"))
-        .collect();
-    let columns = names
-        .iter()
-        .map(|n| table.column(n))
-        .collect::<Result<Vec<_>, _>>()?;
-    let (tangential, rest) = columns.split_at(dimension - 1);
-    let [normal, active, sliding] = [rest[0], rest[1], rest[2]];
-    let mut rows = Vec::new();
-    for row in table {
-        let row = row?;
-        let mut t2 = 0.0;
-        for &c in tangential {
-            let t: f64 = row.number(c)?;
-            t2 += t * t;
-        }
-        rows.push(FrictionRow {
-            normal: row.number(normal)?,
-            tangential: t2.sqrt(),
-            active: row.number(active)?,
-            sliding: row.number(sliding)?,
-        });
-    }
-    Ok(rows)
 }

@@ -1,8 +1,8 @@
-//! The Hertz verification scene (`cases/verification/2d-hertz-n4.json`, the coarsest level:
-//! a rigid cylinder pressed frictionlessly on an elastic block in plane strain) against
-//! Hertz's answer, and the verification section of the report on its run directory and on
-//! that of a block sliding on a flat: it passes them, and flags them once their outputs are
-//! made wrong.
+//! The verification section of the report on runs of the verification scenes: the Hertz scene
+//! (`cases/verification/2d-hertz-n4.json`, the coarsest level: a rigid cylinder pressed
+//! frictionlessly on an elastic block in plane strain) against Hertz's answer, a block sliding
+//! on a flat, and a block that sticks just below the Coulomb threshold beside one that slides
+//! just above it: the section passes them, and flags them once their outputs are made wrong.
 
 use std::path::{Path, PathBuf};
 
@@ -19,10 +19,16 @@ fn repo(path: &str) -> PathBuf {
 
 /// Runs the shipped verification scene `name` into `dir/name`.
 fn run_scene(name: &str, dir: &Path) -> PathBuf {
-    let out = dir.join(name);
+    run_scene_as(name, &[], name, dir)
+}
+
+/// Runs the shipped verification scene `name` with the overrides `sets` into `dir/run`.
+fn run_scene_as(name: &str, sets: &[&str], run: &str, dir: &Path) -> PathBuf {
+    let out = dir.join(run);
     let path = repo(&format!("cases/verification/{name}.json"));
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     let RunSummary::Model(summary) =
-        run_file(&path, &[], Some(&out), DEFAULT_RESTART_EVERY).expect("runs")
+        run_file(&path, &sets, Some(&out), DEFAULT_RESTART_EVERY).expect("runs")
     else {
         panic!("a model file gives a model summary");
     };
@@ -35,6 +41,21 @@ fn report(dir: &Path) -> (String, usize) {
     let runs = verification::load(dir).expect("runs load");
     let (text, counts, _) = verification::section(dir, &runs, dir).expect("section");
     (text, counts.failed)
+}
+
+/// Sets column `column` of the last row of the CSV file `path` to `value`.
+fn set_last(path: &Path, column: &str, value: &str) {
+    let text = std::fs::read_to_string(path).expect("read");
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let k = lines[0]
+        .split(',')
+        .position(|c| c == column)
+        .unwrap_or_else(|| panic!("no column {column}"));
+    let last = lines.last_mut().expect("rows");
+    let mut fields: Vec<&str> = last.split(',').collect();
+    fields[k] = value;
+    *last = fields.join(",");
+    std::fs::write(path, lines.join("\n") + "\n").expect("write");
 }
 
 /// Multiplies the numbers of column `column` in the CSV file `path` by `factor`.
@@ -119,4 +140,64 @@ fn the_report_flags_friction_beyond_coulomb() {
     let (text, failed) = report(dir.path());
     assert_eq!(failed, 2, "{text}");
     assert!(text.contains("- **FAIL** 2d-block-pushed-on-flat (block-ground): |T| <= mu N"));
+}
+
+/// The block pushed on a flat at 0.995 mu N sticks once its loads are held, with resultants
+/// that balance them, and at 1.005 mu N it slides: the report passes both and the threshold
+/// they bracket, flags a history in which a contact of the sticking block slides at its end
+/// (and so the bracket), and one whose last friction resultant no longer balances the push.
+#[test]
+fn the_report_checks_stick_below_the_threshold_and_slip_above_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = "2d-block-pushed-on-flat";
+    let stick = run_scene_as(scene, &["loads[1].force=[5.97, 0.0]"], "below", dir.path());
+    run_scene_as(scene, &["loads[1].force=[6.03, 0.0]"], "above", dir.path());
+    let (text, failed) = report(dir.path());
+    assert_eq!(failed, 0, "{text}");
+    for passed in [
+        "- **PASS** below (block-ground): held loads at r = T / (mu N) = 0.9950: no contact slides",
+        "- **PASS** below (block-ground): the friction and normal resultants balance the held loads",
+        "- **PASS** above (block-ground): held loads at r = T / (mu N) = 1.005: every closed contact slides",
+        "- **PASS** below and above: the stick/slip threshold lies at r = 1",
+    ] {
+        assert!(text.contains(passed), "{passed} in {text}");
+    }
+
+    let history = stick.join("history.csv");
+    let original = std::fs::read_to_string(&history).expect("history");
+    set_last(&history, "block-ground.sliding", "1");
+    let (text, failed) = report(dir.path());
+    assert_eq!(failed, 2, "{text}");
+    assert!(
+        text.contains("- **FAIL** below (block-ground): held loads"),
+        "{text}"
+    );
+    assert!(
+        text.contains("- **FAIL** below and above: the stick/slip threshold"),
+        "{text}"
+    );
+
+    std::fs::write(&history, &original).expect("restore");
+    // the last increment's friction 1e-4 larger: the mean of the last two off by 5e-5
+    let k = original
+        .lines()
+        .next()
+        .and_then(|h| {
+            h.split(',')
+                .position(|c| c == "block-ground.tangential_force_1")
+        })
+        .expect("friction column");
+    let last = original.lines().last().expect("rows").split(',').nth(k);
+    let friction: f64 = last.and_then(|v| v.parse().ok()).expect("friction");
+    set_last(
+        &history,
+        "block-ground.tangential_force_1",
+        &format!("{:.9e}", 1.0001 * friction),
+    );
+    let (text, failed) = report(dir.path());
+    assert_eq!(failed, 1, "{text}");
+    assert!(
+        text.contains("- **FAIL** below (block-ground): the friction and normal resultants"),
+        "{text}"
+    );
 }

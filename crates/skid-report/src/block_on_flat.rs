@@ -1,0 +1,281 @@
+//! A deformable block on a fixed rigid flat under loads that are then held (the scenes
+//! `cases/verification/*-block-pushed-on-flat*` and `*-block-on-incline*`): whether Coulomb's
+//! law makes it stick or slide, from the model as run.
+//!
+//! The flat is the master of the scene's one frictional pair: a rigid plane on a body held in
+//! every degree of freedom. The loads are concentrated forces (on rigid bodies, or on every
+//! node of a node set) and gravity on the whole model, each its amplitude's value at the step
+//! time times its full value, in one dynamic step. Once every amplitude has reached its last
+//! point at `t_hold`, the loads are held at their resultant `R`. In equilibrium the flat alone
+//! carries it (the scene must leave nothing to other supports): a normal resultant
+//! `N = -R . n` across the flat's normal `n` and a friction resultant of size
+//! `T = |R - (R . n) n|` along it. Coulomb's law lets the block stick while `T < mu N`, so the
+//! ratio `r = T / (mu N)` of the held loads decides: below 1 it sticks, above 1 it slides.
+//!
+//! The dynamic step's response to the loading takes time to settle (partial slip near the
+//! threshold persists for a few increments after `t_hold`: measured on the incline at 0.995 of
+//! its threshold, the last sliding contact at 10.5 ms for a hold from 10 ms), so the held state
+//! is judged in the second half of the hold, from `t_hold + (t_end - t_hold) / 2` on.
+
+use skid_cases::model_file::build::build;
+use skid_cases::model_spec::{Dof, LoadSpec, ModelSpec, ModelStepSpec, RigidSurfaceSpec};
+
+/// A block on a fixed flat: what the stick or slip of its held loads needs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlockOnFlat {
+    /// Name of the frictional pair between the block and the flat.
+    pub pair: String,
+    /// Friction coefficient of the pair.
+    pub mu: f64,
+    /// Normal resultant `N` of the held loads, N.
+    pub normal: f64,
+    /// Size `T` of the tangential resultant of the held loads, N.
+    pub tangential: f64,
+    /// Time from which every amplitude has reached its last point, s.
+    pub hold_time: f64,
+    /// End of the step, s.
+    pub end_time: f64,
+}
+
+impl BlockOnFlat {
+    /// The scene of `spec`, if it is one (see the module documentation): one contact pair,
+    /// frictional, whose master is a plane on a body held in all its degrees of freedom; no
+    /// other support (no boundary condition on the part, none on another body that the held
+    /// loads push along); concentrated forces without moments and gravity on the whole model,
+    /// none changed per step; one dynamic step whose loads are held before it ends; every
+    /// other body tied to the part; and a held normal resultant pressing the block onto the
+    /// flat.
+    pub fn recognise(spec: &ModelSpec) -> Option<Self> {
+        let dim = spec.dimension;
+        let [pair] = spec.contact.as_slice() else {
+            return None;
+        };
+        let flat = spec.rigid_bodies.iter().find(|b| b.name == pair.master)?;
+        let Some(RigidSurfaceSpec::Plane { normal, .. }) = flat.surface else {
+            return None;
+        };
+        let [
+            ModelStepSpec::Dynamic {
+                duration, boundary, ..
+            },
+        ] = spec.steps.as_slice()
+        else {
+            return None;
+        };
+        let held = |body: &str, dof: Dof| {
+            spec.boundary
+                .iter()
+                .any(|b| b.body.as_deref() == Some(body) && b.dofs.contains(&dof))
+        };
+        let others_tied = spec
+            .rigid_bodies
+            .iter()
+            .all(|b| b.name == flat.name || spec.ties.iter().any(|t| t.body == b.name));
+        if pair.mu <= 0.0
+            || !boundary.is_empty()
+            || !others_tied
+            || spec.boundary.iter().any(|b| b.node_set.is_some())
+            || !Dof::all(dim).iter().all(|&dof| held(&flat.name, dof))
+        {
+            return None;
+        }
+
+        let mut resultant = [0.0; 3];
+        let mut hold_time: f64 = 0.0;
+        for load in &spec.loads {
+            if load.step_factors().is_some() {
+                return None;
+            }
+            let (factor, last) = match load.amplitude() {
+                None => (1.0, 0.0),
+                Some(name) => {
+                    let amplitude = spec.amplitudes.iter().find(|a| a.name == name)?;
+                    let &[t, value] = amplitude.points.last()?;
+                    (value, t)
+                }
+            };
+            hold_time = hold_time.max(last);
+            let (vector, times) = match load {
+                LoadSpec::Concentrated {
+                    node_set,
+                    body,
+                    force,
+                    moment,
+                    ..
+                } => {
+                    if moment.is_some_and(|m| m.iter().any(|&c| c != 0.0)) {
+                        return None;
+                    }
+                    let count = match (node_set, body) {
+                        (Some(set), None) => spec.part.node_sets.get(set)?.len() as f64,
+                        (None, Some(_)) => 1.0,
+                        _ => return None,
+                    };
+                    (force.clone().unwrap_or_default(), count)
+                }
+                LoadSpec::Gravity {
+                    acceleration,
+                    element_set: None,
+                    ..
+                } => (acceleration.clone(), carried_mass(spec)?),
+                _ => return None,
+            };
+            if vector.len() != dim {
+                return None;
+            }
+            for (r, v) in resultant.iter_mut().zip(&vector) {
+                *r += factor * times * v;
+            }
+        }
+        // a support other than the flat would carry what pushes along one of its held axes
+        for body in spec.rigid_bodies.iter().filter(|b| b.name != flat.name) {
+            for dof in Dof::all(dim) {
+                if let Some(axis) = dof.translation_axis()
+                    && held(&body.name, *dof)
+                    && resultant[axis] != 0.0
+                {
+                    return None;
+                }
+            }
+        }
+        let length = normal.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let n = normal.map(|c| c / length);
+        let along: f64 = resultant.iter().zip(&n).map(|(r, n)| r * n).sum();
+        let tangential = (0..3)
+            .map(|k| (resultant[k] - along * n[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        (-along > 0.0 && hold_time < *duration).then(|| Self {
+            pair: pair.name.clone(),
+            mu: pair.mu,
+            normal: -along,
+            tangential,
+            hold_time,
+            end_time: *duration,
+        })
+    }
+
+    /// `r = T / (mu N)` of the held loads.
+    pub fn ratio(&self) -> f64 {
+        self.tangential / (self.mu * self.normal)
+    }
+
+    /// Whether Coulomb's law lets the block stick under the held loads (`r < 1`).
+    pub fn sticks(&self) -> bool {
+        self.ratio() < 1.0
+    }
+
+    /// The time from which the held state is judged, s.
+    pub fn settled_from(&self) -> f64 {
+        self.hold_time + 0.5 * (self.end_time - self.hold_time)
+    }
+}
+
+/// The mass that gravity pulls onto the flat: the part's, `sum_e rho_e V_e` over its elements
+/// as the solver builds them, and the point masses of the bodies tied to it (`None` if the
+/// model does not build).
+fn carried_mass(spec: &ModelSpec) -> Option<f64> {
+    let part = match spec.dimension {
+        2 => part_mass::<2>(spec)?,
+        3 => part_mass::<3>(spec)?,
+        _ => return None,
+    };
+    let bodies: f64 = spec
+        .rigid_bodies
+        .iter()
+        .filter(|b| spec.ties.iter().any(|t| t.body == b.name))
+        .map(|b| b.mass)
+        .sum();
+    Some(part + bodies)
+}
+
+fn part_mass<const D: usize>(spec: &ModelSpec) -> Option<f64> {
+    let scene = build::<D>(spec).ok()?;
+    let part = scene.model.part();
+    let mass = scene
+        .model
+        .elements()
+        .iter()
+        .enumerate()
+        .map(|(e, element)| part.density(e) * element.volume())
+        .sum();
+    Some(mass)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn scene(file: &str) -> ModelSpec {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../cases/verification")
+            .join(file);
+        let text = std::fs::read_to_string(&path).expect("scene");
+        serde_json::from_str(&text).expect("model file")
+    }
+
+    /// The pushed block: N = 20 N down, F = 9 N sideways (1.5 mu N), held from 25 ms.
+    #[test]
+    fn the_pushed_block_slides_at_one_and_a_half_times_mu_n() {
+        for file in [
+            "2d-block-pushed-on-flat.json",
+            "3d-block-pushed-on-flat.json",
+        ] {
+            let block = BlockOnFlat::recognise(&scene(file)).expect(file);
+            assert_eq!((block.normal, block.tangential), (20.0, 9.0), "{file}");
+            assert!(
+                (block.ratio() - 1.5).abs() < 1e-12 && !block.sticks(),
+                "{file}"
+            );
+            assert_eq!((block.hold_time, block.end_time), (0.025, 0.04), "{file}");
+            assert!((block.settled_from() - 0.0325).abs() < 1e-15, "{file}");
+        }
+    }
+
+    /// The incline: gravity on the 1 g block (its mass from the mesh) and the push, turned so
+    /// that the flat is y = 0: `N = G cos a + F sin a`, `T = F cos a - G sin a`, and the push
+    /// given is 1.005 times the threshold `F / G = (tan a + mu) / (1 - mu tan a)`.
+    #[test]
+    fn the_incline_carries_the_weight_of_its_mesh() {
+        let (a, mu, weight) = (10f64.to_radians(), 0.3, 1e-3 * 9.81);
+        let push = 1.005 * (a.tan() + mu) / (1.0 - mu * a.tan()) * weight;
+        for file in ["2d-block-on-incline.json", "3d-block-on-incline.json"] {
+            let block = BlockOnFlat::recognise(&scene(file)).expect(file);
+            let (n, t) = (
+                weight * a.cos() + push * a.sin(),
+                push * a.cos() - weight * a.sin(),
+            );
+            assert!(
+                (block.normal - n).abs() < 1e-12 * n,
+                "{file}: N {}",
+                block.normal
+            );
+            assert!(
+                (block.tangential - t).abs() < 1e-9 * t,
+                "{file}: T {}",
+                block.tangential
+            );
+            assert!(!block.sticks(), "{file}");
+        }
+    }
+
+    /// What the flat does not carry alone is not this scene: a flat that may move, a support
+    /// along the push, a pressure load, two steps.
+    #[test]
+    fn scenes_with_other_supports_or_loads_are_not_recognised() {
+        let pushed = scene("2d-block-pushed-on-flat.json");
+        assert!(BlockOnFlat::recognise(&pushed).is_some());
+        let mut free_flat = pushed.clone();
+        free_flat.boundary[0].dofs.retain(|&d| d != Dof::X);
+        assert_eq!(BlockOnFlat::recognise(&free_flat), None);
+        let mut held_plate = pushed.clone();
+        held_plate.boundary[1].dofs.push(Dof::X);
+        assert_eq!(BlockOnFlat::recognise(&held_plate), None);
+        let ground = scene("2d-block-on-sliding-ground.json");
+        assert_eq!(BlockOnFlat::recognise(&ground), None);
+        let mut two_steps = pushed.clone();
+        two_steps.steps.push(two_steps.steps[0].clone());
+        assert_eq!(BlockOnFlat::recognise(&two_steps), None);
+    }
+}
