@@ -147,7 +147,9 @@ impl Workspace {
     }
 }
 
-/// Solves one increment from `start`. `held[eq]` marks equations kept at their start value.
+/// Solves one increment from `start`. `held[eq]` marks the constrained equations: kept at
+/// their start value, or, for those of `prescribed` (`(equation, value)`), set to the value
+/// there at the increment's end.
 ///
 /// With [`ContactSolve::Global`], an increment that fails is tried once more with
 /// [`ContactSolve::Reduced`] (counted in [`IncrementCounters::contact_fallbacks`]), and the
@@ -160,13 +162,20 @@ pub fn solve_increment<const D: usize>(
     workspace: &mut Workspace,
     start: &State,
     kind: IncrementKind,
-    held: &[bool],
+    (held, prescribed): (&[bool], &[(usize, f64)]),
     settings: &Settings,
     timings: &mut Timings,
 ) -> Result<(State, IncrementCounters), IncrementFailure> {
     let mut attempt = |method| {
         solve_increment_with(
-            model, workspace, start, kind, held, settings, method, timings,
+            model,
+            workspace,
+            start,
+            kind,
+            (held, prescribed),
+            settings,
+            method,
+            timings,
         )
     };
     match settings.contact_solve {
@@ -190,7 +199,7 @@ fn solve_increment_with<const D: usize>(
     workspace: &mut Workspace,
     start: &State,
     kind: IncrementKind,
-    held: &[bool],
+    (held, prescribed): (&[bool], &[(usize, f64)]),
     settings: &Settings,
     method: ContactSolve,
     timings: &mut Timings,
@@ -242,6 +251,11 @@ fn solve_increment_with<const D: usize>(
             x[eq] = start.x[eq];
         }
     }
+    let mut moving = vec![false; n];
+    for &(eq, value) in prescribed {
+        x[eq] = value;
+        moving[eq] = true;
+    }
     assembler.start_mixed_pressures(model, &start.x)?;
     let mut counters = IncrementCounters::default();
     let mut warm = start.warm_forces.clone();
@@ -274,8 +288,10 @@ fn solve_increment_with<const D: usize>(
                 let (mut v, mut a) =
                     hht.velocity_and_acceleration(h, &start.x, &start.v, &start.a, &x);
                 mean_rates(quasi_static, h, &start.x, &x, &mut v, &mut a);
+                // a held equation stands still; a prescribed one moves as Newmark's relations
+                // give for its prescribed path
                 for (eq, &h) in held.iter().enumerate() {
-                    if h {
+                    if h && !moving[eq] {
                         v[eq] = 0.0;
                         a[eq] = 0.0;
                     }
@@ -317,6 +333,13 @@ fn solve_increment_with<const D: usize>(
         assembler.add_diagonal(&(m_term * m_factor));
         let rows = contact_rows(model, &x, row_start, &previous_coords, held)?;
         assembler.add_contact_curvature(&rows, &warm);
+        // what the constraints must balance, before their rows become identities
+        let held_residual: Vec<(usize, f64)> = held
+            .iter()
+            .enumerate()
+            .filter(|(_, h)| **h)
+            .map(|(eq, _)| (eq, residual[eq]))
+            .collect();
         for (eq, &h) in held.iter().enumerate() {
             if h {
                 residual[eq] = 0.0;
@@ -369,6 +392,19 @@ fn solve_increment_with<const D: usize>(
             if force_residual <= newton.force_tolerance
                 && contact_residual <= newton.contact_tolerance
             {
+                let held_contact = if held_residual.is_empty() {
+                    DVector::zeros(n)
+                } else {
+                    let all =
+                        contact_rows(model, &x, row_start, &previous_coords, &vec![false; n])?;
+                    all.transpose_times(r, n)
+                };
+                let mut reaction = DVector::zeros(n);
+                for &(eq, value) in &held_residual {
+                    reaction[eq] = value - held_contact[eq];
+                }
+                let held_contact =
+                    DVector::from_fn(n, |eq, _| if held[eq] { held_contact[eq] } else { 0.0 });
                 let iterate = Iterate {
                     x,
                     v,
@@ -376,6 +412,9 @@ fn solve_increment_with<const D: usize>(
                     net,
                     f_ext,
                     internal,
+                    reaction,
+                    held_contact,
+                    moving,
                 };
                 let state = finish(model, start, kind, iterate, &rows, r, warm);
                 return Ok((state, counters));
@@ -634,6 +673,13 @@ struct Iterate {
     net: DVector<f64>,
     f_ext: DVector<f64>,
     internal: InternalState,
+    /// What each constrained equation's constraint adds to its residual `R_i`: `R_i` without
+    /// contact less the contact forces on it, `(H^T r)_i` over every candidate.
+    reaction: DVector<f64>,
+    /// `(H^T r)_i` of the constrained equations (zero elsewhere).
+    held_contact: DVector<f64>,
+    /// The equations that move as prescribed.
+    moving: Vec<bool>,
 }
 
 /// Builds the converged state and updates the energy ledger.
@@ -653,16 +699,26 @@ fn finish<const D: usize>(
         net,
         f_ext,
         internal,
+        reaction,
+        held_contact,
+        moving,
     } = iterate;
     // The mean contact force over the increment and, for a dynamic increment, the velocity and
-    // smooth acceleration with the contact impulse (see `crate::hht`).
-    let (r, v, a) = match kind {
-        IncrementKind::Static { .. } => (r.clone(), v, a),
+    // smooth acceleration with the contact impulse (see `crate::hht`); a prescribed
+    // equation's reaction, and the contact forces on it, act as the contact forces do: an
+    // impulse over the increment.
+    let (r, reaction, held_contact, v, a) = match kind {
+        IncrementKind::Static { .. } => (r.clone(), reaction, held_contact, v, a),
         IncrementKind::Dynamic { hht, h, .. } => {
-            let contact = model.acceleration_of(&rows.transpose_times(r, x.len()));
+            let mut impulse = rows.transpose_times(r, x.len());
+            for (eq, _) in moving.iter().enumerate().filter(|(_, m)| **m) {
+                impulse[eq] += reaction[eq] + held_contact[eq];
+            }
+            let contact = model.acceleration_of(&impulse);
             let (mut v, mut a) = hht.split_impulse(h, &start.v, &start.a, &a, &contact);
             mean_rates(model.quasi_static(), h, &start.x, &x, &mut v, &mut a);
-            (r * hht.impulse_force_factor(), v, a)
+            let mean = hht.impulse_force_factor();
+            (r * mean, reaction * mean, held_contact * mean, v, a)
         }
     };
     let r = &r;
@@ -710,6 +766,18 @@ fn finish<const D: usize>(
     };
     let dx = &x - &start.x;
     let contact_reaction = rows.transpose_times(r, x.len());
+    let mut reaction_work = 0.0;
+    let mut moving_reaction = contact_reaction.clone();
+    for (eq, _) in moving.iter().enumerate().filter(|(_, m)| **m) {
+        let mean = match kind {
+            IncrementKind::Static { .. } => {
+                0.5 * (reaction[eq] + start.reaction.get(eq).copied().unwrap_or(0.0))
+            }
+            IncrementKind::Dynamic { .. } => reaction[eq],
+        };
+        reaction_work += mean * dx[eq];
+        moving_reaction[eq] += reaction[eq] + held_contact[eq];
+    }
     let algorithmic = match kind {
         IncrementKind::Static { .. } => 0.0,
         IncrementKind::Dynamic { hht, h, .. } => hht.algorithmic_dissipation(
@@ -722,7 +790,7 @@ fn finish<const D: usize>(
                 f1: &net,
                 a0: &start.a,
                 a1: &a,
-                contact: &contact_reaction,
+                contact: &moving_reaction,
             },
         ),
     };
@@ -731,6 +799,7 @@ fn finish<const D: usize>(
         strain: internal.strain_energy,
         hourglass: internal.hourglass_energy,
         external_work: start.energy.external_work + 0.5 * (&start.external_force + &f_ext).dot(&dx),
+        reaction_work: start.energy.reaction_work + reaction_work,
         friction_dissipation: start.energy.friction_dissipation + friction,
         normal_work: start.energy.normal_work + normal_work,
         algorithmic_dissipation: start.energy.algorithmic_dissipation + algorithmic,
@@ -739,6 +808,7 @@ fn finish<const D: usize>(
         time,
         load_factor,
         contact_reaction,
+        reaction,
         x,
         v,
         a,

@@ -38,6 +38,7 @@ pub mod krylov;
 pub mod loads;
 pub mod mixed;
 pub mod model;
+pub mod motion;
 pub mod ordering;
 pub mod quasi_definite;
 pub mod settings;
@@ -53,6 +54,7 @@ pub use loads::{
     StepVariation, Variation,
 };
 pub use model::{ContactPair, Model, Section, SolidPart, Tie};
+pub use motion::{BodyMotion, MotionTarget, PrescribedMotion};
 pub use settings::Settings;
 pub use state::State;
 pub use stepper::{

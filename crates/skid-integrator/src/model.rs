@@ -14,6 +14,7 @@ use skid_fem::solid::OnePointSolid;
 use crate::dof::DofMap;
 use crate::error::ModelError;
 use crate::loads::{DeadLoad, Loads, PressureLoad, Scene};
+use crate::motion::{MotionTarget, PrescribedMotion, body_equation};
 
 /// A material and its mass density, shared by a group of elements.
 #[derive(Debug)]
@@ -109,6 +110,8 @@ pub struct Model<const D: usize> {
     length_scale: f64,
     /// Initial velocities of the solid's nodes, `(node, velocity)`.
     node_velocities: Vec<(usize, SVector<f64, D>)>,
+    /// Prescribed motions, each with its equation.
+    prescribed: Vec<(usize, PrescribedMotion)>,
 }
 
 fn invalid<T>(msg: String) -> Result<T, ModelError> {
@@ -373,6 +376,7 @@ impl<const D: usize> Model<D> {
             quasi_static,
             length_scale,
             node_velocities: Vec::new(),
+            prescribed: Vec::new(),
         })
     }
 
@@ -425,6 +429,77 @@ impl<const D: usize> Model<D> {
         }
         self.node_velocities.extend(velocities);
         Ok(self)
+    }
+
+    /// The model with these prescribed motions added (see [`crate::motion`]).
+    ///
+    /// # Errors
+    /// [`ModelError::Invalid`] for a body or node that does not exist, an axis beyond the
+    /// dimension, a value that is not finite, a degree of freedom the model fixes (or a body
+    /// does not have), a node tied to a rigid body (prescribe the body's motion), or a degree
+    /// of freedom prescribed twice.
+    pub fn with_prescribed_motions(
+        mut self,
+        motions: Vec<PrescribedMotion>,
+    ) -> Result<Self, ModelError> {
+        for motion in motions {
+            let what = match motion.target {
+                MotionTarget::Body { body, motion } => format!("body {body} {motion:?}"),
+                MotionTarget::Node { node, axis } => format!("node {node} along axis {axis}"),
+            };
+            let what = format!("prescribed motion of {what}");
+            if !motion.value.is_finite() {
+                return invalid(format!(
+                    "{what}: expected a finite value, got {}",
+                    motion.value
+                ));
+            }
+            let equation = match motion.target {
+                MotionTarget::Body { body, motion } => {
+                    if body >= self.bodies.len() {
+                        return invalid(format!(
+                            "{what}: the body does not exist ({} bodies)",
+                            self.bodies.len()
+                        ));
+                    }
+                    body_equation(&self.dofs, body, motion)
+                }
+                MotionTarget::Node { node, axis } => {
+                    let n_nodes = self.part.mesh.nodes.len();
+                    if node >= n_nodes || axis >= D {
+                        return invalid(format!(
+                            "{what}: expected a node below {n_nodes} and an axis below {D}"
+                        ));
+                    }
+                    if let Some(tie) = self.ties.iter().find(|t| t.nodes.contains(&node)) {
+                        return invalid(format!(
+                            "{what}: the node is tied to rigid body '{}' and moves with it; \
+                             prescribe the body's motion",
+                            self.bodies[tie.body].name
+                        ));
+                    }
+                    self.dofs.node(node)[axis]
+                }
+            };
+            let Some(equation) = equation else {
+                return invalid(format!(
+                    "{what}: the model fixes this degree of freedom (or has none such): \
+                     a boundary condition holds it at 0"
+                ));
+            };
+            if self.prescribed.iter().any(|(eq, _)| *eq == equation) {
+                return invalid(format!(
+                    "{what}: this degree of freedom is prescribed twice"
+                ));
+            }
+            self.prescribed.push((equation, motion));
+        }
+        Ok(self)
+    }
+
+    /// The prescribed motions, each with its equation.
+    pub fn prescribed(&self) -> &[(usize, PrescribedMotion)] {
+        &self.prescribed
     }
 
     /// The deformable solid.

@@ -47,6 +47,11 @@ pub struct EnergyLedger {
     /// Work of the normal contact forces `sum r_N Delta g`, `r_N` taken as for the friction
     /// (zero for a persistent contact).
     pub normal_work: f64,
+    /// Work of the reactions of prescribed motions, `sum P . Delta x` over their equations,
+    /// `P` taken as the contact forces are: the mean force of a dynamic increment, the mean of
+    /// the start and end forces of a static one.
+    #[serde(default)]
+    pub reaction_work: f64,
     /// Energy removed by the time integration itself (HHT's numerical damping and the end-point
     /// equilibrium of quasi-static solids, see [`crate::hht::Hht::algorithmic_dissipation`]).
     #[serde(default)]
@@ -60,10 +65,12 @@ impl EnergyLedger {
     }
 
     /// Energy lost unaccounted for since the ledger `start`, J (positive when lost):
-    /// `-(dE - dW_ext - dW_N + dD_friction + dD_algorithmic)`, `E` the mechanical energy.
+    /// `-(dE - dW_ext - dW_R - dW_N + dD_friction + dD_algorithmic)`, `E` the mechanical
+    /// energy.
     pub fn unaccounted_since(&self, start: &Self) -> f64 {
         -((self.mechanical() - start.mechanical())
             - (self.external_work - start.external_work)
+            - (self.reaction_work - start.reaction_work)
             - (self.normal_work - start.normal_work)
             + (self.friction_dissipation - start.friction_dissipation)
             + (self.algorithmic_dissipation - start.algorithmic_dissipation))
@@ -90,6 +97,11 @@ pub struct State {
     /// Generalized contact forces `H^T r` per equation (forces on nodes and bodies; the
     /// torque on a drum sits in its rotation equation).
     pub contact_reaction: DVector<f64>,
+    /// Reactions of the held and prescribed equations (zero elsewhere; empty in a state
+    /// written before they were kept): the force or moment each constraint applies, the mean
+    /// over a dynamic increment as for the contact forces.
+    #[serde(default)]
+    pub reaction: DVector<f64>,
     /// Contact candidates, pair by pair, node by node.
     pub contacts: Vec<ContactPointState>,
     /// Contact forces `r` of the last contact solve, one per contact row (`[r_N, r_T..]` per

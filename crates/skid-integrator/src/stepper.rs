@@ -36,6 +36,7 @@ use crate::hht::Hht;
 use crate::increment::{IncrementCounters, IncrementKind, Workspace, solve_increment};
 use crate::loads::{LoadInstant, Variation};
 use crate::model::Model;
+use crate::motion::{BodyMotion, body_equation};
 use crate::settings::Settings;
 use crate::state::{ContactPointState, EnergyLedger, State};
 
@@ -236,15 +237,6 @@ pub struct Step {
     pub held: Vec<HeldMotion>,
 }
 
-/// A motion of a rigid body's reference node.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BodyMotion {
-    /// Translation along global axis `i`.
-    Translation(usize),
-    /// The rotation about the body's free axis.
-    Rotation,
-}
-
 /// A rigid-body motion held during a step: one motion, or every free motion of the body.
 /// Holding a motion that the model already fixes changes nothing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -263,13 +255,11 @@ impl HeldMotion {
 
     /// Equations this hold fixes (none for a motion the model already fixes).
     fn equations<const D: usize>(&self, model: &Model<D>) -> Vec<usize> {
-        let dofs = model.dofs();
         match self.motion {
-            None => dofs.body_equations(self.body),
-            Some(BodyMotion::Translation(i)) => {
-                dofs.body_translation(self.body)[i].into_iter().collect()
-            }
-            Some(BodyMotion::Rotation) => dofs.body_rotation(self.body).into_iter().collect(),
+            None => model.dofs().body_equations(self.body),
+            Some(motion) => body_equation(model.dofs(), self.body, motion)
+                .into_iter()
+                .collect(),
         }
     }
 }
@@ -590,6 +580,7 @@ pub fn initial_state<const D: usize>(
         a: DVector::zeros(n),
         net_force: -&f_ext,
         contact_reaction: DVector::zeros(n),
+        reaction: DVector::zeros(n),
         external_force: f_ext,
         warm_forces: DVector::zeros(contacts.len() * D),
         contacts,
@@ -644,9 +635,15 @@ fn validate_steps<const D: usize>(model: &Model<D>, steps: &[Step]) -> Result<()
     let bad = |s: &Step, msg: String| Err(RunError::Invalid(format!("step '{}': {msg}", s.name)));
     let pressures = model.pressures().iter().map(|l| &l.variation).enumerate();
     let dead = model.dead_loads().iter().map(|l| &l.variation).enumerate();
+    let motions = model
+        .prescribed()
+        .iter()
+        .map(|(_, m)| &m.variation)
+        .enumerate();
     let variations = pressures
         .map(|(i, v)| (format!("pressure load {i}"), v))
-        .chain(dead.map(|(i, v)| (format!("concentrated or gravity load {i}"), v)));
+        .chain(dead.map(|(i, v)| (format!("concentrated or gravity load {i}"), v)))
+        .chain(motions.map(|(i, v)| (format!("prescribed motion {i}"), v)));
     for (what, variation) in variations {
         if let Variation::PerStep(per_step) = variation
             && per_step.len() != steps.len()
@@ -905,6 +902,10 @@ impl<const D: usize> Run<'_, D> {
         for eq in step.held.iter().flat_map(|h| h.equations(model)) {
             held[eq] = true;
         }
+        // a prescribed motion moves as prescribed, held by the step or not
+        for (eq, _) in model.prescribed() {
+            held[*eq] = true;
+        }
         let (nominal, span, adaptive) = match step.kind {
             StepKind::Static { increments, .. } => (1.0 / increments as f64, 1.0, None),
             StepKind::Dynamic {
@@ -975,13 +976,19 @@ impl<const D: usize> Run<'_, D> {
                     fraction: progress + dp,
                 },
             };
+            let instant = kind.loads();
+            let prescribed: Vec<(usize, f64)> = model
+                .prescribed()
+                .iter()
+                .map(|(eq, motion)| (*eq, motion.at(&instant)))
+                .collect();
             let before = workspace.counts();
             let solved = solve_increment(
                 model,
                 workspace,
                 &state,
                 kind,
-                &held,
+                (&held, &prescribed),
                 settings,
                 &mut stats.timings,
             );

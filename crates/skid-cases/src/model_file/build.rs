@@ -12,9 +12,10 @@ use skid_fem::cell::{embed, face_corners};
 use skid_fem::material::{Hyperelastic, PolynomialN1};
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
+use skid_integrator::BodyMotion;
 use skid_integrator::settings::{ContactSolve, NewtonSettings};
 use skid_integrator::settings::{CutbackSettings, Settings};
-use skid_integrator::stepper::{Adaptive, BodyMotion, HeldMotion, Step, StepKind};
+use skid_integrator::stepper::{Adaptive, HeldMotion, Step, StepKind};
 use skid_integrator::{ContactPair, Model, Section, SolidPart, Tie};
 
 mod loads;
