@@ -169,6 +169,9 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
             .filter(|d| !free.contains(d))
             .copied()
             .collect(),
+        value: None,
+        amplitude: None,
+        step_factors: None,
     };
     let slave = match case.contact.formulation {
         ContactFormulation::Pair => SlaveSpec::NodeSet {

@@ -305,8 +305,13 @@ impl Dof {
     }
 }
 
-/// Degrees of freedom held at zero displacement: of a rigid body's reference node, or of the
-/// nodes of a node set (translations only).
+/// Degrees of freedom of a rigid body's reference node, or of the nodes of a node set
+/// (translations only), held at zero displacement or, with a `value`, moved as prescribed.
+///
+/// A prescribed degree of freedom is `value` times a factor (a displacement from the reference
+/// configuration, m, or a rotation angle, rad) that varies exactly as a load's does (see
+/// `loads`): its `amplitude` and `step_factors`, else the default ramp. Its reaction (the force
+/// or moment that moves it) does work that the energy balance counts.
 #[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct BoundarySpec {
@@ -318,6 +323,23 @@ pub struct BoundarySpec {
     pub node_set: Option<String>,
     /// The degrees of freedom held.
     pub dofs: Vec<Dof>,
+    /// Full value of a prescribed motion of each degree of freedom, m or rad (absent: held at
+    /// 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub value: Option<f64>,
+    /// Amplitude of the prescribed motion, by name (`amplitudes`); only with `value`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub amplitude: Option<String>,
+    /// The prescribed motion's factor in each step, as a load's; only with `value`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_factors: Option<Vec<f64>>,
+}
+
+impl BoundarySpec {
+    /// Whether the degrees of freedom move as prescribed rather than being held at 0.
+    pub fn is_prescribed(&self) -> bool {
+        self.value.is_some()
+    }
 }
 
 /// The initial velocity of the nodes of a node set.

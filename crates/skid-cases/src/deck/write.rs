@@ -6,8 +6,8 @@
 //! are written so that they read back to the same bits.
 //!
 //! Two settings have no keyword and are refused: a static step's regularisation time other
-//! than the default, and adaptive increments; loads that change between steps and initial
-//! velocities of the part's nodes are refused too. General contact is written as `*CONTACT` with
+//! than the default, and adaptive increments; loads that change between steps, initial
+//! velocities of the part's nodes and prescribed motions are refused too. General contact is written as `*CONTACT` with
 //! all exterior faces, so its search distance is not kept (every exterior node becomes a
 //! candidate).
 
@@ -74,6 +74,12 @@ pub fn write_deck(
              reference nodes only, so those of the part's nodes are not written"
                 .into(),
         );
+    }
+    if let Some(k) = spec.boundary.iter().position(|bc| bc.is_prescribed()) {
+        return Err(format!(
+            "boundary[{k}].value: the deck reader does not read prescribed motions yet, so \
+             they are not written"
+        ));
     }
     let mut out = String::new();
     let _ = writeln!(out, "*HEADING");

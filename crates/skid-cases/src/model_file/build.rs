@@ -19,6 +19,7 @@ use skid_integrator::stepper::{Adaptive, HeldMotion, Step, StepKind};
 use skid_integrator::{ContactPair, Model, Section, SolidPart, Tie};
 
 mod loads;
+mod motions;
 
 use crate::model_spec::{
     BoundarySpec, Dof, MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, RigidSurfaceSpec, SlaveSpec,
@@ -145,16 +146,30 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
     for (i, bc) in spec.boundary.iter().enumerate() {
         let f = |name: &str| format!("boundary[{i}].{name}");
         check_dofs::<D>(&f("dofs"), &bc.dofs)?;
+        // a prescribed motion leaves its degrees of freedom free (see `motions`)
+        let prescribed = bc.is_prescribed();
         match bc {
             BoundarySpec {
                 body: Some(body),
                 node_set: None,
                 dofs,
-            } => body_fixed[body_of(&f("body"), body)?].extend(dofs),
+                ..
+            } => {
+                let body = body_of(&f("body"), body)?;
+                if !prescribed {
+                    body_fixed[body].extend(dofs);
+                }
+            }
+            BoundarySpec {
+                body: None,
+                node_set: Some(_),
+                ..
+            } if prescribed => {}
             BoundarySpec {
                 body: None,
                 node_set: Some(set),
                 dofs,
+                ..
             } => {
                 let nodes = node_set(&f("node_set"), set)?;
                 for dof in dofs {
@@ -283,6 +298,17 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
             .with_node_velocities(velocities)
             .map_err(|e| SpecError {
                 field: format!("initial_velocities[{i}]"),
+                message: e.to_string(),
+            })?;
+    }
+    let named = loads::amplitudes(&spec.amplitudes)?;
+    let prescribed =
+        motions::prescribed_motions(spec, &model.part().mesh, model.bodies(), &named, &body_of)?;
+    for (i, motions) in prescribed {
+        model = model
+            .with_prescribed_motions(motions)
+            .map_err(|e| SpecError {
+                field: format!("boundary[{i}]"),
                 message: e.to_string(),
             })?;
     }

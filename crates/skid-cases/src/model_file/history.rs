@@ -8,15 +8,18 @@
 //! `P.normal_force` (sum of the normal forces, N), `P.tangential_force_1` (and `_2` in 3D: sums
 //! of the friction force components along the master surface's coordinate directions, N),
 //! `P.active`, `P.sliding` (closed contacts, and those at the cone's boundary), `P.max_penetration`
-//! (m); then `kinetic_energy`, `strain_energy`, `hourglass_energy`, `external_work`,
-//! `friction_dissipation`, `normal_work`, `algorithmic_dissipation` (J). Numbers carry 10
-//! significant digits. The file is complete or absent ([`PartialCsv`]).
+//! (m); for each motion of a rigid body that the model prescribes, in model order, the reaction
+//! that moves it, `B.reaction_x` (likewise `y`, `z`; N) or `B.reaction_moment` (N m), the mean
+//! force of the increment; then `kinetic_energy`, `strain_energy`, `hourglass_energy`,
+//! `external_work`, `friction_dissipation`, `normal_work`, `algorithmic_dissipation` and, if the
+//! model prescribes motions, `reaction_work` (J). Numbers carry 10 significant digits. The file
+//! is complete or absent ([`PartialCsv`]).
 
 use std::path::Path;
 
 use skid_integrator::state::EnergyLedger;
 use skid_integrator::stepper::{IncrementReport, Observer};
-use skid_integrator::{Model, State};
+use skid_integrator::{BodyMotion, Model, MotionTarget, State};
 
 use crate::contact_totals::{PairTotals, pair_totals};
 use crate::csv_out::{CsvMark, PartialCsv};
@@ -60,6 +63,9 @@ pub fn columns<const D: usize>(model: &Model<D>) -> Vec<String> {
             names.push(format!("{}.{what}", pair.name));
         }
     }
+    for (name, _) in body_reactions(model) {
+        names.push(name);
+    }
     names.extend(
         [
             "kinetic_energy",
@@ -72,7 +78,31 @@ pub fn columns<const D: usize>(model: &Model<D>) -> Vec<String> {
         ]
         .map(String::from),
     );
+    if !model.prescribed().is_empty() {
+        names.push("reaction_work".into());
+    }
     names
+}
+
+/// The reaction columns: for each prescribed motion of a rigid body, its column name and its
+/// equation.
+fn body_reactions<const D: usize>(model: &Model<D>) -> Vec<(String, usize)> {
+    model
+        .prescribed()
+        .iter()
+        .filter_map(|(eq, motion)| match motion.target {
+            MotionTarget::Body { body, motion } => {
+                let name = &model.bodies()[body].name;
+                Some(match motion {
+                    BodyMotion::Translation(axis) => {
+                        (format!("{name}.reaction_{}", ["x", "y", "z"][axis]), *eq)
+                    }
+                    BodyMotion::Rotation => (format!("{name}.reaction_moment"), *eq),
+                })
+            }
+            MotionTarget::Node { .. } => None,
+        })
+        .collect()
 }
 
 /// A rigid body's motion in one state.
@@ -234,6 +264,9 @@ impl<const D: usize> Observer<D> for ModelRecorder {
             record.max_sliding_separation =
                 record.max_sliding_separation.max(t.max_sliding_separation);
         }
+        for (_, eq) in body_reactions(model) {
+            row.push(number(s.reaction.get(eq).copied().unwrap_or(0.0)));
+        }
         let e = &s.energy;
         row.extend(
             [
@@ -247,6 +280,9 @@ impl<const D: usize> Observer<D> for ModelRecorder {
             ]
             .map(number),
         );
+        if !model.prescribed().is_empty() {
+            row.push(number(e.reaction_work));
+        }
         self.csv.record(row)?;
         record.energy_scale = [
             e.kinetic + e.strain + e.hourglass,
@@ -254,6 +290,7 @@ impl<const D: usize> Observer<D> for ModelRecorder {
             e.normal_work.abs(),
             e.friction_dissipation,
             e.algorithmic_dissipation.abs(),
+            e.reaction_work.abs(),
         ]
         .into_iter()
         .fold(record.energy_scale, f64::max);

@@ -29,6 +29,9 @@ pub(super) fn apply_model_boundary(
                     body: Some(bodies[b].def.name.clone()),
                     node_set: None,
                     dofs,
+                    value: None,
+                    amplitude: None,
+                    step_factors: None,
                 });
             }
             NodeRole::Part(i) => part_nodes.push(i),
@@ -71,6 +74,9 @@ pub(super) fn apply_model_boundary(
             body: None,
             node_set: Some(name),
             dofs,
+            value: None,
+            amplitude: None,
+            step_factors: None,
         });
     }
     Ok(())

@@ -16,7 +16,7 @@ use crate::model_spec::{AmplitudeSpec, Dof, LoadSpec, ModelSpec, ModelStepSpec};
 
 /// The amplitudes by name, each checked: a unique non-empty name, at least one point, finite
 /// times >= 0 that increase strictly, finite factors.
-fn amplitudes(specs: &[AmplitudeSpec]) -> Result<BTreeMap<&str, Amplitude>, SpecError> {
+pub(super) fn amplitudes(specs: &[AmplitudeSpec]) -> Result<BTreeMap<&str, Amplitude>, SpecError> {
     let mut named = BTreeMap::new();
     for (i, a) in specs.iter().enumerate() {
         let f = |name: &str| format!("amplitudes[{i}].{name}");
@@ -52,7 +52,7 @@ fn amplitudes(specs: &[AmplitudeSpec]) -> Result<BTreeMap<&str, Amplitude>, Spec
 /// [`ModelSpec::loads`]): with factors `c_k`, `c_k A(t_s)` with an amplitude `A`; without one
 /// the ramp from `c_{k-1}` (`c_{-1} = 0`) to `c_k` over a static step and `c_k` throughout a
 /// dynamic one. Without factors, the amplitude in every step, or the default ramp.
-fn variation(
+pub(super) fn variation(
     amplitude: Option<Amplitude>,
     step_factors: Option<&[f64]>,
     steps: &[ModelStepSpec],
