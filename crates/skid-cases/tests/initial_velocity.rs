@@ -157,3 +157,73 @@ fn initial_velocities_the_model_cannot_take_are_refused_with_their_field() {
         assert!(error.message.contains(fragment), "{set}: {}", error.message);
     }
 }
+
+/// The launched block as a deck: the writer puts the node velocities in `*INITIAL
+/// CONDITIONS, TYPE=VELOCITY` on their node set, which reads back to the same model; the
+/// components of a node given on several lines and sets combine, a rotating velocity gives
+/// each node its own, and a rotation of a part's node is refused at its line.
+#[test]
+fn initial_velocities_of_part_nodes_go_through_decks() {
+    let spec = launched_block(&[]);
+    let deck = skid_cases::deck::write::write_deck(&spec, &Default::default()).expect("written");
+    assert!(
+        deck.contains("*INITIAL CONDITIONS, TYPE=VELOCITY\nlower, 1, 3.0\nlower, 2, 0.0\n"),
+        "{deck}"
+    );
+    let dir = tempfile::tempdir().expect("tempdir");
+    let read = |text: &str| {
+        let path = dir.path().join("scene.inp");
+        std::fs::write(&path, text).expect("write deck");
+        skid_cases::deck::read_model(&path).map(|d| d.model)
+    };
+    let back = read(&deck).expect("reads back");
+    assert_eq!(back.initial_velocities, spec.initial_velocities);
+    assert_eq!(back.part.node_sets["lower"], spec.part.node_sets["lower"]);
+
+    // two lines on two sets: node 0 is in both, so it takes both components
+    let combined = deck.replace(
+        "lower, 2, 0.0\n",
+        "lower, 2, 0.0\n*INITIAL CONDITIONS, TYPE=VELOCITY\n1, 2, -1.0\n",
+    );
+    let model = read(&combined).expect("reads");
+    let mut velocities: Vec<(Vec<usize>, Vec<f64>)> = model
+        .initial_velocities
+        .iter()
+        .map(|v| {
+            (
+                model.part.node_sets[&v.node_set].clone(),
+                v.velocity.clone(),
+            )
+        })
+        .collect();
+    velocities.sort_by(|a, b| a.0.cmp(&b.0));
+    assert_eq!(
+        velocities,
+        vec![
+            (vec![0], vec![3.0, -1.0]),
+            (vec![1, 2, 3, 4], vec![3.0, 0.0]),
+        ]
+    );
+
+    // a rotating velocity about z through the origin: v = omega (-y, x) at every node
+    let rotating = deck.replace(
+        "*INITIAL CONDITIONS, TYPE=VELOCITY\nlower, 1, 3.0\nlower, 2, 0.0\n",
+        "*INITIAL CONDITIONS, TYPE=ROTATING VELOCITY\nlower, 10.0, 0.0, 0.0, 0.0\n0., 0., 0., 0., 0., 1.\n",
+    );
+    let model = read(&rotating).expect("reads");
+    for v in &model.initial_velocities {
+        for &n in &model.part.node_sets[&v.node_set] {
+            let x = &model.part.nodes[n];
+            assert_eq!(v.velocity, vec![-10.0 * x[1], 10.0 * x[0]], "node {n}");
+        }
+    }
+
+    let rotation = deck.replace("lower, 2, 0.0\n", "lower, 6, 1.0\n");
+    let err = read(&rotation)
+        .expect_err("a part node has no rotation")
+        .to_string();
+    assert!(
+        err.contains("scene.inp:") && err.contains("is a rotation"),
+        "{err}"
+    );
+}

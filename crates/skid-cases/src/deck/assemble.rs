@@ -19,8 +19,8 @@ use super::read::{
 use super::rigid::{prism, triangles};
 use crate::model_spec::{
     BoundarySpec, ContactPairSpec, Dof, ElementBlockSpec, ElementType, LoadSpec,
-    MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, PartSpec, RigidBodySpec, RigidSurfaceSpec,
-    SectionSpec, SlaveSpec, StepBoundarySpec, TieSpec,
+    MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, NodeVelocitySpec, PartSpec, RigidBodySpec,
+    RigidSurfaceSpec, SectionSpec, SlaveSpec, StepBoundarySpec, TieSpec,
 };
 use crate::schema::{OutputSpec, SolverSpec, default_regularization_time};
 
@@ -196,9 +196,26 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
             });
         }
     }
+    let mut part_velocities = BTreeMap::new();
     for def in &defs.initial {
-        apply_initial(defs, &part, &bodies, &mut rigid_specs, def)?;
+        apply_initial(
+            defs,
+            (&part, &part_spec.nodes),
+            &bodies,
+            (&mut rigid_specs, &mut part_velocities),
+            def,
+        )?;
     }
+    let named: Vec<String> = defs
+        .initial
+        .iter()
+        .map(|def| match def {
+            InitialDef::Velocity { target, .. } | InitialDef::Rotating { target, .. } => {
+                target.clone()
+            }
+        })
+        .collect();
+    let initial_velocities = part_initial_velocities(dim, &part_velocities, &named, &mut part_spec);
     let ties = bodies
         .iter()
         .filter_map(|b| b.def.tie.as_ref().map(|t| (b, t)))
@@ -231,7 +248,7 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
         rigid_bodies: rigid_specs,
         boundary: spec_boundary,
         ties,
-        initial_velocities: Vec::new(),
+        initial_velocities,
         loads,
         amplitudes,
         contact,

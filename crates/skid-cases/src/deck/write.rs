@@ -6,8 +6,8 @@
 //! are written so that they read back to the same bits.
 //!
 //! Two settings have no keyword and are refused: a static step's regularisation time other
-//! than the default, and adaptive increments; loads that change between steps, initial
-//! velocities of the part's nodes and prescribed motions are refused too. General contact is written as `*CONTACT` with
+//! than the default, and adaptive increments; loads that change between steps and prescribed
+//! motions are refused too. General contact is written as `*CONTACT` with
 //! all exterior faces, so its search distance is not kept (every exterior node becomes a
 //! candidate).
 
@@ -68,13 +68,6 @@ pub fn write_deck(
 ) -> Result<String, String> {
     let dim = spec.dimension;
     let part = &spec.part;
-    if !spec.initial_velocities.is_empty() {
-        return Err(
-            "initial_velocities: the deck reader takes initial velocities of rigid-body \
-             reference nodes only, so those of the part's nodes are not written"
-                .into(),
-        );
-    }
     if let Some(k) = spec.boundary.iter().position(|bc| bc.is_prescribed()) {
         return Err(format!(
             "boundary[{k}].value: the deck reader does not read prescribed motions yet, so \
@@ -302,6 +295,12 @@ pub fn write_deck(
     }
     for body in &spec.rigid_bodies {
         initial_conditions(&mut out, body, dim);
+    }
+    for initial in &spec.initial_velocities {
+        let _ = writeln!(out, "*INITIAL CONDITIONS, TYPE=VELOCITY");
+        for (i, v) in initial.velocity.iter().enumerate().take(dim) {
+            let _ = writeln!(out, "{}, {}, {}", initial.node_set, i + 1, num(*v));
+        }
     }
 
     for amplitude in &spec.amplitudes {

@@ -475,11 +475,14 @@ pub(super) fn check_axial_range(
     Ok(())
 }
 
+/// Applies one initial condition: to the bodies whose reference nodes it names, and to the
+/// part's nodes it names, whose velocities (by part node, 3 components) it sets in
+/// `part_velocities` (`coordinates`: the part's nodes).
 pub(super) fn apply_initial(
     defs: &Definitions,
-    part: &Part,
+    (part, coordinates): (&Part, &[Vec<f64>]),
     bodies: &[Body],
-    specs: &mut [RigidBodySpec],
+    (specs, part_velocities): (&mut [RigidBodySpec], &mut BTreeMap<usize, [f64; 3]>),
     def: &InitialDef,
 ) -> Result<(), DeckError> {
     let dim = part.dimension;
@@ -493,14 +496,23 @@ pub(super) fn apply_initial(
     };
     let labels = node_labels(defs, target, "*INITIAL CONDITIONS", location)?;
     for label in labels {
-        let NodeRole::Reference(b) = role(part, bodies, label) else {
-            return Err(error(
-                location,
-                format!(
-                    "*INITIAL CONDITIONS: node {label} is not a rigid-body reference node; initial \
-                     velocities of the deformable part are not supported yet"
-                ),
-            ));
+        let b = match role(part, bodies, label) {
+            NodeRole::Reference(b) => b,
+            NodeRole::Part(i) => {
+                let x = Vector3::from_fn(|k, _| coordinates[i].get(k).copied().unwrap_or(0.0));
+                let v = part_velocities.entry(i).or_insert([0.0; 3]);
+                part_node_velocity(dim, def, &x, v)?;
+                continue;
+            }
+            NodeRole::Other => {
+                return Err(error(
+                    location,
+                    format!(
+                        "*INITIAL CONDITIONS: node {label} is neither a node of the part nor a \
+                         rigid-body reference node"
+                    ),
+                ));
+            }
         };
         let spec = &mut specs[b];
         let mut v = spec.initial_velocity.clone().map_or(Vector3::zeros(), |v| {
@@ -544,4 +556,107 @@ pub(super) fn apply_initial(
         spec.initial_angular_velocity = Some(w.into());
     }
     Ok(())
+}
+
+/// Sets the components of a part node's velocity `v` (at `x`) that `def` gives: a translation
+/// of `TYPE=VELOCITY`, or the whole velocity `v0 + omega e x (x - a)` of `TYPE=ROTATING
+/// VELOCITY`. A node of the part has no rotations.
+fn part_node_velocity(
+    dim: usize,
+    def: &InitialDef,
+    x: &Vector3<f64>,
+    v: &mut [f64; 3],
+) -> Result<(), DeckError> {
+    match def {
+        InitialDef::Velocity {
+            dof,
+            value,
+            location,
+            ..
+        } => {
+            let Some(axis) = dof_of(dim, *dof, location)?.translation_axis() else {
+                return Err(error(
+                    location,
+                    format!(
+                        "*INITIAL CONDITIONS: degree of freedom {dof} is a rotation, which a \
+                         node of the deformable part does not have"
+                    ),
+                ));
+            };
+            v[axis] = *value;
+        }
+        InitialDef::Rotating {
+            omega,
+            velocity,
+            a,
+            b,
+            location,
+            ..
+        } => {
+            let a = Vector3::from(*a);
+            let axis = if dim == 2 {
+                Vector3::z()
+            } else {
+                (Vector3::from(*b) - a).try_normalize(0.0).ok_or_else(|| {
+                    error(
+                        location,
+                        "*INITIAL CONDITIONS: the axis points a and b coincide",
+                    )
+                })?
+            };
+            let w = Vector3::from(*velocity) + (axis * *omega).cross(&(x - a));
+            *v = w.into();
+        }
+    }
+    Ok(())
+}
+
+/// The part's initial velocities as node sets: the nodes of equal velocity together, under the
+/// name of a node set of the deck that holds exactly them (one that an initial condition
+/// names, if any does), else `initial-velocity-<k>` (added to `part_spec`), in the order of
+/// their first node.
+pub(super) fn part_initial_velocities(
+    dim: usize,
+    velocities: &BTreeMap<usize, [f64; 3]>,
+    named: &[String],
+    part_spec: &mut PartSpec,
+) -> Vec<NodeVelocitySpec> {
+    let mut groups: Vec<([f64; 3], Vec<usize>)> = Vec::new();
+    for (&node, v) in velocities {
+        match groups.iter_mut().find(|(w, _)| w == v) {
+            Some((_, nodes)) => nodes.push(node),
+            None => groups.push((*v, vec![node])),
+        }
+    }
+    let mut out = Vec::new();
+    for (k, (v, nodes)) in groups.into_iter().enumerate() {
+        let holding: Vec<&String> = part_spec
+            .node_sets
+            .iter()
+            .filter(|(_, set)| {
+                let mut sorted = (*set).clone();
+                sorted.sort_unstable();
+                sorted == nodes
+            })
+            .map(|(name, _)| name)
+            .collect();
+        let existing = holding
+            .iter()
+            .find(|name| named.iter().any(|n| n.eq_ignore_ascii_case(name)))
+            .or(holding.first())
+            .map(|name| (*name).clone());
+        let node_set = existing.unwrap_or_else(|| {
+            let mut name = format!("initial-velocity-{}", k + 1);
+            while part_spec.node_sets.contains_key(&name) {
+                name.push('_');
+            }
+            part_spec.node_sets.insert(name.clone(), nodes);
+            name
+        });
+        out.push(NodeVelocitySpec {
+            node_set,
+            velocity: v[..dim].to_vec(),
+        });
+    }
+    out
 }
