@@ -11,7 +11,7 @@ use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 use skid_fem::solid::OnePointSolid;
 
-use crate::dof::DofMap;
+use crate::dof::{DofMap, EquationOwner};
 use crate::error::ModelError;
 use crate::loads::{DeadLoad, Loads, PressureLoad, Scene};
 use crate::motion::{MotionTarget, PrescribedMotion, body_equation};
@@ -500,6 +500,23 @@ impl<const D: usize> Model<D> {
     /// The prescribed motions, each with its equation.
     pub fn prescribed(&self) -> &[(usize, PrescribedMotion)] {
         &self.prescribed
+    }
+
+    /// Linear momentum `sum_eq m_eq v_eq` along each axis over the translation equations of
+    /// nodes and rigid bodies (an equation of a body carries the masses of the nodes tied to
+    /// it), for the velocities `v`.
+    pub fn linear_momentum(&self, v: &DVector<f64>) -> SVector<f64, D> {
+        let mut p = SVector::zeros();
+        for eq in 0..self.dofs.len() {
+            if let Some(
+                EquationOwner::Node { component, .. }
+                | EquationOwner::BodyTranslation { component, .. },
+            ) = self.dofs.owner(eq)
+            {
+                p[component] += self.mass[eq] * v[eq];
+            }
+        }
+        p
     }
 
     /// The deformable solid.

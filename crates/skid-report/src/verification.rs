@@ -60,8 +60,18 @@ pub struct SceneRun {
 }
 
 impl SceneRun {
-    fn completed(&self) -> bool {
-        self.summary.status == "completed"
+    /// Whether the run completed; if not, a failed check of its status says why.
+    fn completed_or_recorded(&self, checks: &mut Checks) -> bool {
+        let completed = self.summary.status == "completed";
+        if !completed {
+            let why = self.summary.error.clone();
+            checks.record(
+                &format!("{}: status", self.name),
+                false,
+                why.unwrap_or_else(|| self.summary.status.clone()),
+            );
+        }
+        completed
     }
 }
 
@@ -197,15 +207,7 @@ fn hertz_section(
 ) -> Result<(String, Option<PathBuf>), ReportError> {
     let mut levels = Vec::new();
     for (run, scene) in runs {
-        if !run.completed() {
-            checks.record(
-                &format!("{}: status", run.name),
-                false,
-                run.summary
-                    .error
-                    .clone()
-                    .unwrap_or_else(|| run.summary.status.clone()),
-            );
+        if !run.completed_or_recorded(checks) {
             continue;
         }
         let path = run.dir.join(CONTACT_NODES_CSV);

@@ -145,15 +145,7 @@ pub(super) fn section(runs: &[&SceneRun], checks: &mut Checks) -> Result<String,
     );
     let mut families: BTreeMap<String, Vec<(&str, HeldState)>> = BTreeMap::new();
     for run in runs {
-        if !run.completed() {
-            checks.record(
-                &format!("{}: status", run.name),
-                false,
-                run.summary
-                    .error
-                    .clone()
-                    .unwrap_or_else(|| run.summary.status.clone()),
-            );
+        if !run.completed_or_recorded(checks) {
             continue;
         }
         let path = run.dir.join("history.csv");

@@ -48,6 +48,21 @@ pub(super) fn amplitudes(specs: &[AmplitudeSpec]) -> Result<BTreeMap<&str, Ampli
     Ok(named)
 }
 
+/// The amplitude a load or motion names (`field`), if it names one.
+pub(super) fn amplitude_named(
+    named: &BTreeMap<&str, Amplitude>,
+    name: Option<&str>,
+    field: &str,
+) -> Result<Option<Amplitude>, SpecError> {
+    name.map(|name| {
+        named.get(name).cloned().ok_or_else(|| SpecError {
+            field: field.into(),
+            message: format!("no amplitude named '{name}'"),
+        })
+    })
+    .transpose()
+}
+
 /// How a load with `amplitude` and `step_factors` (`field`) varies over `steps` (see
 /// [`ModelSpec::loads`]): with factors `c_k`, `c_k A(t_s)` with an amplitude `A`; without one
 /// the ramp from `c_{k-1}` (`c_{-1} = 0`) to `c_k` over a static step and `c_k` throughout a
@@ -157,15 +172,7 @@ pub(super) fn loads<const D: usize>(
     let mut loads = Loads::default();
     for (i, load) in spec.loads.iter().enumerate() {
         let f = |name: &str| format!("loads[{i}].{name}");
-        let amplitude = load
-            .amplitude()
-            .map(|name| {
-                named.get(name).cloned().ok_or_else(|| SpecError {
-                    field: f("amplitude"),
-                    message: format!("no amplitude named '{name}'"),
-                })
-            })
-            .transpose()?;
+        let amplitude = amplitude_named(&named, load.amplitude(), &f("amplitude"))?;
         let variation = variation(
             amplitude,
             load.step_factors(),

@@ -8,7 +8,7 @@ use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 use skid_integrator::{Amplitude, BodyMotion, MotionTarget, PrescribedMotion};
 
-use super::loads::variation;
+use super::loads::{amplitude_named, variation};
 use super::{SpecError, fail};
 use crate::model_spec::ModelSpec;
 
@@ -42,16 +42,7 @@ pub(super) fn prescribed_motions<const D: usize>(
         if !value.is_finite() {
             return fail(f("value"), format!("expected a finite number, got {value}"));
         }
-        let amplitude = bc
-            .amplitude
-            .as_deref()
-            .map(|name| {
-                amplitudes.get(name).cloned().ok_or_else(|| SpecError {
-                    field: f("amplitude"),
-                    message: format!("no amplitude named '{name}'"),
-                })
-            })
-            .transpose()?;
+        let amplitude = amplitude_named(amplitudes, bc.amplitude.as_deref(), &f("amplitude"))?;
         let variation = variation(
             amplitude,
             bc.step_factors.as_deref(),
