@@ -392,19 +392,19 @@ fn solve_increment_with<const D: usize>(
             if force_residual <= newton.force_tolerance
                 && contact_residual <= newton.contact_tolerance
             {
+                // the contact forces on the constrained equations, which their rows leave out
                 let held_contact = if held_residual.is_empty() {
-                    DVector::zeros(n)
+                    None
                 } else {
                     let all =
                         contact_rows(model, &x, row_start, &previous_coords, &vec![false; n])?;
-                    all.transpose_times(r, n)
+                    Some(all.transpose_times(r, n))
                 };
-                let mut reaction = DVector::zeros(n);
+                let (mut constrained, mut reaction) = (DVector::zeros(n), DVector::zeros(n));
                 for &(eq, value) in &held_residual {
-                    reaction[eq] = value - held_contact[eq];
+                    constrained[eq] = value;
+                    reaction[eq] = value - held_contact.as_ref().map_or(0.0, |c| c[eq]);
                 }
-                let held_contact =
-                    DVector::from_fn(n, |eq, _| if held[eq] { held_contact[eq] } else { 0.0 });
                 let iterate = Iterate {
                     x,
                     v,
@@ -412,8 +412,8 @@ fn solve_increment_with<const D: usize>(
                     net,
                     f_ext,
                     internal,
+                    constrained,
                     reaction,
-                    held_contact,
                     moving,
                 };
                 let state = finish(model, start, kind, iterate, &rows, r, warm);
@@ -673,11 +673,12 @@ struct Iterate {
     net: DVector<f64>,
     f_ext: DVector<f64>,
     internal: InternalState,
-    /// What each constrained equation's constraint adds to its residual `R_i`: `R_i` without
-    /// contact less the contact forces on it, `(H^T r)_i` over every candidate.
+    /// The residual `R_i` of each constrained equation without contact (zero elsewhere): what
+    /// its constraint and the contact forces on it together balance.
+    constrained: DVector<f64>,
+    /// What each constraint adds: `R_i` less the contact forces on the equation, `(H^T r)_i`
+    /// over every candidate.
     reaction: DVector<f64>,
-    /// `(H^T r)_i` of the constrained equations (zero elsewhere).
-    held_contact: DVector<f64>,
     /// The equations that move as prescribed.
     moving: Vec<bool>,
 }
@@ -699,26 +700,26 @@ fn finish<const D: usize>(
         net,
         f_ext,
         internal,
+        constrained,
         reaction,
-        held_contact,
         moving,
     } = iterate;
     // The mean contact force over the increment and, for a dynamic increment, the velocity and
     // smooth acceleration with the contact impulse (see `crate::hht`); a prescribed
     // equation's reaction, and the contact forces on it, act as the contact forces do: an
     // impulse over the increment.
-    let (r, reaction, held_contact, v, a) = match kind {
-        IncrementKind::Static { .. } => (r.clone(), reaction, held_contact, v, a),
+    let (r, reaction, constrained, v, a) = match kind {
+        IncrementKind::Static { .. } => (r.clone(), reaction, constrained, v, a),
         IncrementKind::Dynamic { hht, h, .. } => {
             let mut impulse = rows.transpose_times(r, x.len());
             for (eq, _) in moving.iter().enumerate().filter(|(_, m)| **m) {
-                impulse[eq] += reaction[eq] + held_contact[eq];
+                impulse[eq] += constrained[eq];
             }
             let contact = model.acceleration_of(&impulse);
             let (mut v, mut a) = hht.split_impulse(h, &start.v, &start.a, &a, &contact);
             mean_rates(model.quasi_static(), h, &start.x, &x, &mut v, &mut a);
             let mean = hht.impulse_force_factor();
-            (r * mean, reaction * mean, held_contact * mean, v, a)
+            (r * mean, reaction * mean, constrained * mean, v, a)
         }
     };
     let r = &r;
@@ -766,33 +767,42 @@ fn finish<const D: usize>(
     };
     let dx = &x - &start.x;
     let contact_reaction = rows.transpose_times(r, x.len());
-    let mut reaction_work = 0.0;
-    let mut moving_reaction = contact_reaction.clone();
-    for (eq, _) in moving.iter().enumerate().filter(|(_, m)| **m) {
-        let mean = match kind {
-            IncrementKind::Static { .. } => {
-                0.5 * (reaction[eq] + start.reaction.get(eq).copied().unwrap_or(0.0))
-            }
-            IncrementKind::Dynamic { .. } => reaction[eq],
-        };
-        reaction_work += mean * dx[eq];
-        moving_reaction[eq] += reaction[eq] + held_contact[eq];
-    }
+    let moved: Vec<usize> = (0..x.len()).filter(|&eq| moving[eq]).collect();
+    let reaction_work: f64 = moved
+        .iter()
+        .map(|&eq| {
+            let mean = match kind {
+                IncrementKind::Static { .. } => {
+                    0.5 * (reaction[eq] + start.reaction.get(eq).copied().unwrap_or(0.0))
+                }
+                IncrementKind::Dynamic { .. } => reaction[eq],
+            };
+            mean * dx[eq]
+        })
+        .sum();
     let algorithmic = match kind {
         IncrementKind::Static { .. } => 0.0,
-        IncrementKind::Dynamic { hht, h, .. } => hht.algorithmic_dissipation(
-            h,
-            &IncrementEnds {
-                mass: model.mass(),
-                quasi_static: model.quasi_static(),
-                dx: &dx,
-                f0: &start.net_force,
-                f1: &net,
-                a0: &start.a,
-                a1: &a,
-                contact: &moving_reaction,
-            },
-        ),
+        IncrementKind::Dynamic { hht, h, .. } => {
+            // the forces that act as impulses: the contacts', and all that the constraint of
+            // a prescribed equation balances (its reaction and the contact forces on it)
+            let mut impulse_forces = contact_reaction.clone();
+            for &eq in &moved {
+                impulse_forces[eq] += constrained[eq];
+            }
+            hht.algorithmic_dissipation(
+                h,
+                &IncrementEnds {
+                    mass: model.mass(),
+                    quasi_static: model.quasi_static(),
+                    dx: &dx,
+                    f0: &start.net_force,
+                    f1: &net,
+                    a0: &start.a,
+                    a1: &a,
+                    contact: &impulse_forces,
+                },
+            )
+        }
     };
     let energy = EnergyLedger {
         kinetic: 0.5 * v.component_mul(&v).dot(model.mass()),

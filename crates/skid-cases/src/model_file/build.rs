@@ -249,7 +249,8 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         });
     }
 
-    let loads = loads::loads::<D>(spec, &mesh, &bodies, &body_of)?;
+    let named = loads::amplitudes(&spec.amplitudes)?;
+    let loads = loads::loads::<D>(spec, &mesh, &bodies, &named, &body_of)?;
     let steps = spec
         .steps
         .iter()
@@ -301,7 +302,6 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
                 message: e.to_string(),
             })?;
     }
-    let named = loads::amplitudes(&spec.amplitudes)?;
     let prescribed =
         motions::prescribed_motions(spec, &model.part().mesh, model.bodies(), &named, &body_of)?;
     for (i, motions) in prescribed {

@@ -535,19 +535,7 @@ pub(super) fn apply_initial(
                 b: point_b,
                 ..
             } => {
-                let a = Vector3::from(*a);
-                let axis = if dim == 2 {
-                    Vector3::z()
-                } else {
-                    (Vector3::from(*point_b) - a)
-                        .try_normalize(0.0)
-                        .ok_or_else(|| {
-                            error(
-                                location,
-                                "*INITIAL CONDITIONS: the axis points a and b coincide",
-                            )
-                        })?
-                };
+                let (a, axis) = rotation_axis(dim, a, point_b, location)?;
                 w = axis * *omega;
                 v = Vector3::from(*velocity) + w.cross(&(bodies[b].reference - a));
             }
@@ -593,17 +581,7 @@ fn part_node_velocity(
             location,
             ..
         } => {
-            let a = Vector3::from(*a);
-            let axis = if dim == 2 {
-                Vector3::z()
-            } else {
-                (Vector3::from(*b) - a).try_normalize(0.0).ok_or_else(|| {
-                    error(
-                        location,
-                        "*INITIAL CONDITIONS: the axis points a and b coincide",
-                    )
-                })?
-            };
+            let (a, axis) = rotation_axis(dim, a, b, location)?;
             let w = Vector3::from(*velocity) + (axis * *omega).cross(&(x - a));
             *v = w.into();
         }
@@ -659,4 +637,25 @@ pub(super) fn part_initial_velocities(
         });
     }
     out
+}
+
+/// The axis of a `TYPE=ROTATING VELOCITY` condition through its points `a` and `b`: the point
+/// `a` and the unit direction `e = (b - a) / |b - a|` (in 2D always `+z`).
+fn rotation_axis(
+    dim: usize,
+    a: &[f64; 3],
+    b: &[f64; 3],
+    location: &Location,
+) -> Result<(Vector3<f64>, Vector3<f64>), DeckError> {
+    let a = Vector3::from(*a);
+    if dim == 2 {
+        return Ok((a, Vector3::z()));
+    }
+    let e = (Vector3::from(*b) - a).try_normalize(0.0).ok_or_else(|| {
+        error(
+            location,
+            "*INITIAL CONDITIONS: the axis points a and b coincide",
+        )
+    })?;
+    Ok((a, e))
 }

@@ -158,7 +158,7 @@ fn body_moment<const D: usize>(
     Ok(m)
 }
 
-/// Every load of `spec`, resolved and checked, with the amplitudes they name.
+/// Every load of `spec`, resolved and checked, given the model's amplitudes by name.
 ///
 /// # Errors
 /// The first problem, with its field path.
@@ -166,13 +166,13 @@ pub(super) fn loads<const D: usize>(
     spec: &ModelSpec,
     mesh: &SolidMesh<D>,
     bodies: &[RigidBody<D>],
+    named: &BTreeMap<&str, Amplitude>,
     body_of: &impl Fn(&str, &str) -> Result<usize, SpecError>,
 ) -> Result<Loads<D>, SpecError> {
-    let named = amplitudes(&spec.amplitudes)?;
     let mut loads = Loads::default();
     for (i, load) in spec.loads.iter().enumerate() {
         let f = |name: &str| format!("loads[{i}].{name}");
-        let amplitude = amplitude_named(&named, load.amplitude(), &f("amplitude"))?;
+        let amplitude = amplitude_named(named, load.amplitude(), &f("amplitude"))?;
         let variation = variation(
             amplitude,
             load.step_factors(),
