@@ -238,7 +238,7 @@ fn keywords_parameters_and_values_outside_the_subset_are_errors_at_their_line() 
         (
             "drum_ref, 6, 6\n*Dsload",
             "drum_ref, 6, 6, 0.1\n*Dsload",
-            &["magnitude 0.1", "not supported yet"],
+            &["prescribed here but free in step 2 (spin-down)"],
         ),
         ("*Static, direct", "*Static", &["*STATIC", "add DIRECT"]),
         (

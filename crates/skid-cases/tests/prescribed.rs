@@ -8,12 +8,15 @@
 //! reaction balance the friction at every increment (the plate is massless); the contacts
 //! stick while the block's shear builds up, then all slide with a friction resultant of
 //! exactly mu N; and the reaction's work goes into the frictional dissipation and the strain
-//! energy. Prescriptions the model cannot take are refused with their field.
+//! energy. Prescriptions the model cannot take are refused with their field. The scene's deck
+//! prescribes the same motion with `*BOUNDARY` magnitudes in its steps, and what a deck cannot
+//! express of a motion is refused at its line.
 
 use std::path::{Path, PathBuf};
 
+use skid_cases::deck::read_model;
 use skid_cases::model_file::{self, parse_model};
-use skid_cases::model_spec::ModelSpec;
+use skid_cases::model_spec::{BoundarySpec, ModelSpec};
 use skid_integrator::stepper::{IncrementReport, Observer, run};
 use skid_integrator::{Model, State};
 
@@ -47,7 +50,118 @@ impl<const D: usize> Observer<D> for Record {
 
 #[test]
 fn a_block_dragged_by_a_prescribed_plate_resists_with_exactly_mu_n() {
-    let scene = model_file::build::<2>(&dragged_block(&[])).expect("scene builds");
+    resists_with_exactly_mu_n(&dragged_block(&[]));
+}
+
+/// The scene's deck (`2d-block-dragged-on-flat-deck.inp`: the plate's x held at 0 by
+/// `*BOUNDARY plate, 1, 1, 0.0` in the first step and moved by `plate, 1, 1, 0.001` in the
+/// second) reads to the same prescribed motion, and so does the deck that moves it with an
+/// `AMPLITUDE=` instead; both resist as the model file does.
+#[test]
+fn the_decks_of_the_dragged_block_prescribe_the_same_motion() {
+    let json = dragged_block(&[]);
+    let motions = |spec: &ModelSpec| -> Vec<BoundarySpec> {
+        spec.boundary
+            .iter()
+            .filter(|bc| bc.is_prescribed())
+            .cloned()
+            .collect()
+    };
+    let path = repo("cases/verification/2d-block-dragged-on-flat-deck.inp");
+    let deck = read_model(&path).expect("deck reads").model;
+    assert_eq!(motions(&deck), motions(&json));
+    resists_with_exactly_mu_n(&deck);
+
+    let text = std::fs::read_to_string(&path).expect("read deck");
+    let with_amplitude = text
+        .replacen(
+            "*STEP",
+            "*AMPLITUDE, NAME=Drag\n0.0, 0.0, 1.0, 1.0\n*STEP",
+            1,
+        )
+        .replace(
+            "*BOUNDARY\nplate, 1, 1, 0.001",
+            "*BOUNDARY, AMPLITUDE=drag\nplate, 1, 1, 0.001",
+        );
+    let deck = deck_model(&with_amplitude).expect("deck with an amplitude reads");
+    let mut expected = motions(&json);
+    expected[0].amplitude = Some("Drag".into());
+    assert_eq!(motions(&deck), expected);
+    assert_eq!(
+        deck.amplitudes.iter().map(|a| &a.name).collect::<Vec<_>>(),
+        ["Drag"]
+    );
+    resists_with_exactly_mu_n(&deck);
+}
+
+/// What a deck cannot ask of a prescribed motion is refused at its line.
+#[test]
+fn prescribed_motions_a_deck_cannot_express_are_refused_at_their_line() {
+    let path = repo("cases/verification/2d-block-dragged-on-flat-deck.inp");
+    let text = std::fs::read_to_string(&path).expect("read deck");
+    let line_of = |text: &str, needle: &str| {
+        text.lines()
+            .position(|l| l == needle)
+            .map(|i| i + 1)
+            .expect("line in deck")
+    };
+    for (edit, needle, fragment) in [
+        // free in the first step: the model would hold it there
+        (
+            text.replacen("*BOUNDARY\nplate, 1, 1, 0.0\n", "", 1),
+            "plate, 1, 1, 0.001",
+            "free in step 1 (press)",
+        ),
+        // a magnitude in model data
+        (
+            text.replacen("plate, 6, 6\n", "plate, 6, 6\nplate, 2, 2, 0.001\n", 1),
+            "plate, 2, 2, 0.001",
+            "prescribe a motion inside a step",
+        ),
+        // two amplitudes for one degree of freedom
+        (
+            text.replacen(
+                "*STEP",
+                "*AMPLITUDE, NAME=a\n0.0, 0.0, 1.0, 1.0\n*AMPLITUDE, NAME=b\n0.0, 1.0\n*STEP",
+                1,
+            )
+            .replace(
+                "*BOUNDARY\nplate, 1, 1, 0.0\n",
+                "*BOUNDARY, AMPLITUDE=b\nplate, 1, 1, 0.0005\n",
+            )
+            .replace(
+                "*BOUNDARY\nplate, 1, 1, 0.001",
+                "*BOUNDARY, AMPLITUDE=a\nplate, 1, 1, 0.001",
+            ),
+            "plate, 1, 1, 0.001",
+            "one amplitude for the whole run",
+        ),
+    ] {
+        let err = deck_model(&edit).expect_err(fragment).to_string();
+        let line = line_of(&edit, needle);
+        assert!(
+            err.contains(&format!("deck.inp:{line}")) && err.contains(fragment),
+            "expected line {line} and '{fragment}', got: {err}"
+        );
+    }
+}
+
+/// The model of the deck `text` (read from a temporary file `deck.inp`).
+fn deck_model(text: &str) -> Result<ModelSpec, skid_cases::deck::keywords::DeckError> {
+    let dir = std::env::temp_dir().join(format!("skid-prescribed-deck-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temporary directory");
+    let path = dir.join("deck.inp");
+    std::fs::write(&path, text).expect("write deck");
+    let model = read_model(&path).map(|d| d.model);
+    let _ = std::fs::remove_dir_all(&dir);
+    model
+}
+
+/// Runs `spec`, the dragged block, and checks that the plate follows its prescription, that
+/// its reaction balances the friction, that every contact slides with `mu N` from the second
+/// or third increment of the drag on, and that the reaction's work is accounted for.
+fn resists_with_exactly_mu_n(spec: &ModelSpec) {
+    let scene = model_file::build::<2>(spec).expect("scene builds");
     let model = &scene.model;
     let mut record = Record(Vec::new());
     let (_, result) = run(model, &scene.steps, &scene.settings, &mut record);
@@ -165,8 +279,16 @@ fn prescribed_motions_the_model_cannot_take_are_refused_with_their_field() {
         assert_eq!(error.field, field, "{set}: {error:?}");
         assert!(error.message.contains(fragment), "{set}: {}", error.message);
     }
-    // the deck writer says what it cannot write
-    let refused = skid_cases::deck::write::write_deck(&dragged_block(&[]), &Default::default())
-        .expect_err("no prescribed motions in decks yet");
-    assert!(refused.contains("boundary[2].value"), "{refused}");
+    // the deck writer says what it cannot write: a motion of a node set
+    let spec = dragged_block(&[
+        "part.section.quasi_static=false",
+        r#"boundary[2]={"node_set": "top", "dofs": ["x"], "value": 1e-3}"#,
+        "ties=[]",
+    ]);
+    let refused = skid_cases::deck::write::write_deck(&spec, &Default::default())
+        .expect_err("no prescribed motions of node sets in decks");
+    assert!(
+        refused.contains("boundary[2].value") && refused.contains("rigid bodies only"),
+        "{refused}"
+    );
 }

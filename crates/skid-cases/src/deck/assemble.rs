@@ -27,6 +27,7 @@ use crate::schema::{OutputSpec, SolverSpec, default_regularization_time};
 mod bodies;
 mod conditions;
 mod loads;
+mod motions;
 mod part;
 
 use bodies::*;
@@ -237,8 +238,11 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
     let StepsAndLoads {
         steps,
         loads,
+        motions,
         amplitudes,
     } = steps(defs, &part, &bodies, &mut part_spec, deck)?;
+    let mut spec_boundary = motions::without_prescribed(spec_boundary, &motions);
+    spec_boundary.extend(motions);
     Ok(ModelSpec {
         skid_model: MODEL_FORMAT_VERSION,
         name: name.to_string(),

@@ -100,13 +100,18 @@ pub struct RigidDef {
     pub location: Location,
 }
 
-/// Degrees of freedom (1..=6) held on a node or node set.
+/// Degrees of freedom (1..=6) of a node or node set held at zero or, in a step, at a
+/// magnitude (the total displacement or rotation from the reference configuration).
 #[derive(Clone, Debug)]
 pub struct BoundaryDef {
     /// Node label or node set name.
     pub target: String,
     /// Degrees of freedom 1..=6.
     pub dofs: Vec<usize>,
+    /// The magnitude (0 unless given on a line with a first and last degree of freedom).
+    pub magnitude: f64,
+    /// The keyword's `AMPLITUDE=` (steps only).
+    pub amplitude: Option<String>,
     /// Where.
     pub location: Location,
 }
@@ -418,7 +423,7 @@ fn read_model_block(
         }
         "BOUNDARY" => {
             allow_parameters(block, &[])?;
-            defs.boundary.extend(read_boundary(block)?);
+            defs.boundary.extend(read_boundary(block, false)?);
         }
         "INITIAL CONDITIONS" => read_initial(defs, block)?,
         "AMPLITUDE" => {
@@ -793,10 +798,13 @@ fn read_general_option(defs: &mut Definitions, block: &Block) -> Result<(), Deck
 
 /// Data lines `node or set, first dof[, last dof[, magnitude]]` or `node or set, TYPE` with
 /// `ENCASTRE` (1-6), `PINNED` (1-3), `XSYMM` (1, 5, 6), `YSYMM` (2, 4, 6), `ZSYMM` (3, 4, 5).
-fn read_boundary(block: &Block) -> Result<Vec<BoundaryDef>, DeckError> {
+/// A nonzero magnitude (a prescribed motion) is read in a step (`in_step`) only.
+fn read_boundary(block: &Block, in_step: bool) -> Result<Vec<BoundaryDef>, DeckError> {
+    let amplitude = valued(block, "AMPLITUDE")?.map(str::to_string);
     let mut out = Vec::new();
     for line in &block.data {
         at_most(block, line, 4)?;
+        let mut magnitude = 0.0;
         let target = field(line, 0)
             .ok_or_else(|| line_error(block, line, "field 1 (node or node set) is missing"))?;
         let second = field(line, 1)
@@ -823,13 +831,14 @@ fn read_boundary(block: &Block) -> Result<Vec<BoundaryDef>, DeckError> {
                         ),
                     ));
                 }
-                let magnitude = real_or(block, line, 3, "magnitude", 0.0)?;
-                if magnitude != 0.0 {
+                magnitude = real_or(block, line, 3, "magnitude", 0.0)?;
+                if magnitude != 0.0 && !in_step {
                     return Err(line_error(
                         block,
                         line,
                         format!(
-                            "magnitude {magnitude}: prescribed nonzero displacements are not supported yet"
+                            "magnitude {magnitude}: model data holds degrees of freedom at zero; \
+                             prescribe a motion inside a step"
                         ),
                     ));
                 }
@@ -839,6 +848,8 @@ fn read_boundary(block: &Block) -> Result<Vec<BoundaryDef>, DeckError> {
         out.push(BoundaryDef {
             target: target.to_string(),
             dofs,
+            magnitude,
+            amplitude: amplitude.clone(),
             location: line.location.clone(),
         });
     }
@@ -1007,10 +1018,15 @@ fn read_step_block(
             step.procedure = Some((procedure, block.location.clone()));
         }
         "BOUNDARY" => {
-            allow_parameters(block, &["OP"])?;
+            allow_parameters(block, &["OP", "AMPLITUDE"])?;
+            if let Some(name) = valued(block, "AMPLITUDE")?
+                && !defs.amplitudes.contains_key(&key(name))
+            {
+                return Err(block.error(format!("AMPLITUDE={name}: no *AMPLITUDE named {name}")));
+            }
             step.boundary.push(Change {
                 replace: op_new(block)?,
-                items: read_boundary(block)?,
+                items: read_boundary(block, true)?,
             });
         }
         "CLOAD" | "DLOAD" | "DSLOAD" => {

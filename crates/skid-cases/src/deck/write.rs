@@ -7,7 +7,8 @@
 //!
 //! Two settings have no keyword and are refused: a static step's regularisation time other
 //! than the default, and adaptive increments; loads that change between steps and prescribed
-//! motions are refused too. General contact is written as `*CONTACT` with
+//! motions of node sets are refused too (prescribed motions of rigid bodies are written in
+//! every step, at their value times the step's factor). General contact is written as `*CONTACT` with
 //! all exterior faces, so its search distance is not kept (every exterior node becomes a
 //! candidate).
 
@@ -20,7 +21,8 @@ use skid_fem::tetra::TetMesh;
 
 use super::mesh::ElementKind;
 use crate::model_spec::{
-    Dof, LoadSpec, ModelSpec, ModelStepSpec, RigidBodySpec, RigidSurfaceSpec, SlaveSpec,
+    BoundarySpec, Dof, LoadSpec, ModelSpec, ModelStepSpec, RigidBodySpec, RigidSurfaceSpec,
+    SlaveSpec,
 };
 use crate::schema::{MaterialSpec, default_regularization_time};
 
@@ -68,10 +70,14 @@ pub fn write_deck(
 ) -> Result<String, String> {
     let dim = spec.dimension;
     let part = &spec.part;
-    if let Some(k) = spec.boundary.iter().position(|bc| bc.is_prescribed()) {
+    if let Some(k) = spec
+        .boundary
+        .iter()
+        .position(|bc| bc.is_prescribed() && bc.body.is_none())
+    {
         return Err(format!(
-            "boundary[{k}].value: the deck reader does not read prescribed motions yet, so \
-             they are not written"
+            "boundary[{k}].value: the deck reader reads prescribed motions of rigid bodies \
+             only, so those of node sets are not written"
         ));
     }
     let mut out = String::new();
@@ -279,9 +285,11 @@ pub fn write_deck(
     }
 
     // boundary and initial conditions
-    if !spec.boundary.is_empty() {
+    let (prescribed, held): (Vec<&BoundarySpec>, Vec<&BoundarySpec>) =
+        spec.boundary.iter().partition(|bc| bc.is_prescribed());
+    if !held.is_empty() {
         let _ = writeln!(out, "**\n*BOUNDARY");
-        for bc in &spec.boundary {
+        for bc in held {
             let target = bc
                 .body
                 .as_deref()
@@ -379,6 +387,7 @@ pub fn write_deck(
                 let _ = writeln!(out, "{}, {k}, {k}", hold.body);
             }
         }
+        write_motions(&mut out, &prescribed, i);
         if i == 0 {
             write_loads(&mut out, spec)?;
             // a request holds in the later steps too
@@ -389,6 +398,29 @@ pub fn write_deck(
         let _ = writeln!(out, "*END STEP");
     }
     Ok(out)
+}
+
+/// The prescribed motions of rigid bodies in step `step`: a `*BOUNDARY` block each (with its
+/// amplitude as a parameter), each degree of freedom at its value times the step's factor.
+fn write_motions(out: &mut String, motions: &[&BoundarySpec], step: usize) {
+    for motion in motions {
+        let (Some(body), Some(value)) = (&motion.body, motion.value) else {
+            continue;
+        };
+        let factor = motion.step_factors.as_ref().map_or(1.0, |f| f[step]);
+        match &motion.amplitude {
+            Some(name) => {
+                let _ = writeln!(out, "*BOUNDARY, AMPLITUDE={name}");
+            }
+            None => {
+                let _ = writeln!(out, "*BOUNDARY");
+            }
+        }
+        for dof in &motion.dofs {
+            let k = dof_number(*dof);
+            let _ = writeln!(out, "{body}, {k}, {k}, {}", num(value * factor));
+        }
+    }
 }
 
 /// The loads, one keyword block each (its amplitude is a parameter of the keyword):

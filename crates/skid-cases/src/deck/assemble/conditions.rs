@@ -1,7 +1,8 @@
 //! Boundary conditions of a deck (model data on bodies and part nodes, changes per step) and
 //! its steps with their loads.
 
-use super::loads::{InForce, apply_loads, model_loads};
+use super::loads::{InForce, amplitude_name, amplitude_spec, apply_loads, model_loads};
+use super::motions::{Held, prescribed_motions};
 use super::*;
 use crate::model_spec::AmplitudeSpec;
 
@@ -113,10 +114,11 @@ pub(super) fn check_held_ties(
     Ok(())
 }
 
-/// A deck's steps and the model's loads with the amplitudes they name.
+/// A deck's steps and the model's loads and prescribed motions with the amplitudes they name.
 pub(super) struct StepsAndLoads {
     pub steps: Vec<ModelStepSpec>,
     pub loads: Vec<LoadSpec>,
+    pub motions: Vec<BoundarySpec>,
     pub amplitudes: Vec<AmplitudeSpec>,
 }
 
@@ -135,10 +137,10 @@ pub(super) fn steps(
     if defs.steps.is_empty() {
         return Err(error(deck, "the deck has no *STEP"));
     }
-    let mut held: BTreeMap<usize, BTreeSet<usize>> = BTreeMap::new();
+    let mut held: BTreeMap<usize, BTreeMap<usize, Held>> = BTreeMap::new();
     let mut loads_in_force: Vec<InForce> = Vec::new();
     let mut per_step = Vec::new();
-    let mut out = Vec::new();
+    let mut held_per_step = Vec::new();
     for (i, step) in defs.steps.iter().enumerate() {
         if step.nlgeom == Some(false) || (i == 0 && step.nlgeom.is_none()) {
             return Err(error(
@@ -153,13 +155,18 @@ pub(super) fn steps(
             apply_loads(defs, part, bodies, part_spec, change, &mut loads_in_force)?;
         }
         per_step.push(loads_in_force.clone());
+        held_per_step.push(held.clone());
+    }
+    let prescribed = prescribed_motions(defs, part, bodies, &held_per_step)?;
+    let mut out = Vec::new();
+    for (step, held) in defs.steps.iter().zip(&held_per_step) {
         let boundary = held
             .iter()
             .filter_map(|(&b, dofs)| {
                 let dofs: Vec<usize> = dofs
-                    .iter()
+                    .keys()
                     .copied()
-                    .filter(|k| !bodies[b].fixed.contains(k))
+                    .filter(|&k| !bodies[b].fixed.contains(&k) && !prescribed.moves(b, k))
                     .collect();
                 (!dofs.is_empty()).then_some((b, dofs))
             })
@@ -176,20 +183,32 @@ pub(super) fn steps(
             .collect::<Result<Vec<_>, DeckError>>()?;
         out.push(step_spec(step, boundary)?);
     }
-    let (loads, amplitudes) = model_loads(defs, part, bodies, &per_step);
+    let (loads, mut amplitudes) = model_loads(defs, part, bodies, &per_step);
+    for name in prescribed
+        .motions
+        .iter()
+        .filter_map(|m| m.amplitude.as_deref())
+    {
+        if !amplitudes.iter().any(|a| a.name == name) {
+            amplitudes.push(amplitude_spec(defs, name));
+        }
+    }
     Ok(StepsAndLoads {
         steps: out,
         loads,
+        motions: prescribed.motions,
         amplitudes,
     })
 }
 
+/// Applies one `*BOUNDARY` block of a step to the conditions in force on rigid bodies: `OP=NEW`
+/// first drops those of earlier steps, then each line sets its degrees of freedom.
 pub(super) fn apply_step_boundary(
     defs: &Definitions,
     part: &Part,
     bodies: &[Body],
     change: &Change<BoundaryDef>,
-    held: &mut BTreeMap<usize, BTreeSet<usize>>,
+    held: &mut BTreeMap<usize, BTreeMap<usize, Held>>,
 ) -> Result<(), DeckError> {
     if change.replace {
         held.clear();
@@ -206,9 +225,20 @@ pub(super) fn apply_step_boundary(
                     ),
                 ));
             };
+            let amplitude = bc
+                .amplitude
+                .as_deref()
+                .map(|name| amplitude_name(defs, name));
             for k in body_dofs(part.dimension, &bc.dofs) {
                 dof_of(part.dimension, k, &bc.location)?;
-                held.entry(b).or_default().insert(k);
+                held.entry(b).or_default().insert(
+                    k,
+                    Held {
+                        magnitude: bc.magnitude,
+                        amplitude: amplitude.clone(),
+                        location: bc.location.clone(),
+                    },
+                );
             }
         }
     }

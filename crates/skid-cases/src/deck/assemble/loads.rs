@@ -87,11 +87,10 @@ pub(super) fn apply_loads(
         in_force.retain(|l| l.keyword() != change.keyword);
     }
     for load in &change.items {
-        let amplitude = load.amplitude.as_ref().map(|name| {
-            defs.amplitudes
-                .get(&key(name))
-                .map_or_else(|| name.clone(), |a| a.name.clone())
-        });
+        let amplitude = load
+            .amplitude
+            .as_deref()
+            .map(|name| amplitude_name(defs, name));
         let resolved = match &load.kind {
             LoadKind::Pressure(p) => InForce::Pressure {
                 keyword: change.keyword,
@@ -440,20 +439,32 @@ pub(super) fn model_loads(
     }
     let mut amplitudes: Vec<AmplitudeSpec> = Vec::new();
     for name in loads.iter().filter_map(LoadSpec::amplitude) {
-        if amplitudes.iter().any(|a| a.name == name) {
-            continue;
+        if !amplitudes.iter().any(|a| a.name == name) {
+            amplitudes.push(amplitude_spec(defs, name));
         }
-        let points = defs
-            .amplitudes
-            .get(&key(name))
-            .map(|a| a.value.iter().map(|&(t, v)| [t, v]).collect())
-            .unwrap_or_default();
-        amplitudes.push(AmplitudeSpec {
-            name: name.to_string(),
-            points,
-        });
     }
     (loads, amplitudes)
+}
+
+/// The name of the deck's amplitude that a keyword's `AMPLITUDE=name` refers to, as the
+/// `*AMPLITUDE` spells it (names are case-insensitive; the reader has checked that it exists).
+pub(super) fn amplitude_name(defs: &Definitions, name: &str) -> String {
+    defs.amplitudes
+        .get(&key(name))
+        .map_or_else(|| name.to_string(), |a| a.name.clone())
+}
+
+/// The model's amplitude of the deck's `*AMPLITUDE` named `name`.
+pub(super) fn amplitude_spec(defs: &Definitions, name: &str) -> AmplitudeSpec {
+    let points = defs
+        .amplitudes
+        .get(&key(name))
+        .map(|a| a.value.iter().map(|&(t, v)| [t, v]).collect())
+        .unwrap_or_default();
+    AmplitudeSpec {
+        name: name.to_string(),
+        points,
+    }
 }
 
 /// A load's history split into parts that change in one ratio: each part's value (that of the
