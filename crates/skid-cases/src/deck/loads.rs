@@ -147,6 +147,21 @@ pub fn read_amplitude(block: &Block) -> Result<Named<AmplitudeDef>, DeckError> {
     })
 }
 
+/// The keyword's `AMPLITUDE=` parameter, if given.
+///
+/// # Errors
+/// At the keyword, if the deck defines no `*AMPLITUDE` of that name (amplitudes are model data,
+/// so they come before the steps).
+pub fn defined_amplitude(defs: &Definitions, block: &Block) -> Result<Option<String>, DeckError> {
+    let amplitude = valued(block, "AMPLITUDE")?.map(str::to_string);
+    if let Some(name) = &amplitude
+        && !defs.amplitudes.contains_key(&key(name))
+    {
+        return Err(block.error(format!("AMPLITUDE={name}: no *AMPLITUDE named {name}")));
+    }
+    Ok(amplitude)
+}
+
 /// Reads a load keyword of a step (`CLOAD`, `DLOAD`, `DSLOAD`) with its `OP` and `AMPLITUDE`.
 ///
 /// # Errors
@@ -157,12 +172,7 @@ pub fn read_load_block(
     replace: bool,
 ) -> Result<LoadChange, DeckError> {
     allow_parameters(block, &["OP", "AMPLITUDE"])?;
-    let amplitude = valued(block, "AMPLITUDE")?.map(str::to_string);
-    if let Some(name) = &amplitude
-        && !defs.amplitudes.contains_key(&key(name))
-    {
-        return Err(block.error(format!("AMPLITUDE={name}: no *AMPLITUDE named {name}")));
-    }
+    let amplitude = defined_amplitude(defs, block)?;
     let keyword = match block.name.as_str() {
         "CLOAD" => "CLOAD",
         "DLOAD" => "DLOAD",

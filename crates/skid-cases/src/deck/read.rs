@@ -8,7 +8,7 @@ use super::fields::{
     allow_parameters, at_most, field, flag, key, label, line_error, real, real_or, required, valued,
 };
 use super::keywords::{Block, DeckError, Location};
-use super::loads::{AmplitudeDef, LoadChange, read_amplitude, read_load_block};
+use super::loads::{AmplitudeDef, LoadChange, defined_amplitude, read_amplitude, read_load_block};
 use super::mesh::Mesh;
 use super::rigid::{AnalyticalKind, AnalyticalSurface, read_analytical};
 use crate::schema::MaterialSpec;
@@ -423,7 +423,7 @@ fn read_model_block(
         }
         "BOUNDARY" => {
             allow_parameters(block, &[])?;
-            defs.boundary.extend(read_boundary(block, false)?);
+            defs.boundary.extend(read_boundary(block, None)?);
         }
         "INITIAL CONDITIONS" => read_initial(defs, block)?,
         "AMPLITUDE" => {
@@ -798,9 +798,14 @@ fn read_general_option(defs: &mut Definitions, block: &Block) -> Result<(), Deck
 
 /// Data lines `node or set, first dof[, last dof[, magnitude]]` or `node or set, TYPE` with
 /// `ENCASTRE` (1-6), `PINNED` (1-3), `XSYMM` (1, 5, 6), `YSYMM` (2, 4, 6), `ZSYMM` (3, 4, 5).
-/// A nonzero magnitude (a prescribed motion) is read in a step (`in_step`) only.
-fn read_boundary(block: &Block, in_step: bool) -> Result<Vec<BoundaryDef>, DeckError> {
-    let amplitude = valued(block, "AMPLITUDE")?.map(str::to_string);
+/// In a step, `step` gives the keyword's amplitude; a nonzero magnitude (a prescribed motion)
+/// is read in a step only.
+fn read_boundary(
+    block: &Block,
+    step: Option<Option<String>>,
+) -> Result<Vec<BoundaryDef>, DeckError> {
+    let in_step = step.is_some();
+    let amplitude = step.flatten();
     let mut out = Vec::new();
     for line in &block.data {
         at_most(block, line, 4)?;
@@ -1019,14 +1024,10 @@ fn read_step_block(
         }
         "BOUNDARY" => {
             allow_parameters(block, &["OP", "AMPLITUDE"])?;
-            if let Some(name) = valued(block, "AMPLITUDE")?
-                && !defs.amplitudes.contains_key(&key(name))
-            {
-                return Err(block.error(format!("AMPLITUDE={name}: no *AMPLITUDE named {name}")));
-            }
+            let amplitude = defined_amplitude(defs, block)?;
             step.boundary.push(Change {
                 replace: op_new(block)?,
-                items: read_boundary(block, true)?,
+                items: read_boundary(block, Some(amplitude))?,
             });
         }
         "CLOAD" | "DLOAD" | "DSLOAD" => {

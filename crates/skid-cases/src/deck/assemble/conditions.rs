@@ -114,7 +114,8 @@ pub(super) fn check_held_ties(
     Ok(())
 }
 
-/// A deck's steps and the model's loads and prescribed motions with the amplitudes they name.
+/// A deck's steps and the model's loads and prescribed motions with the amplitudes they name
+/// (in the order first named).
 pub(super) struct StepsAndLoads {
     pub steps: Vec<ModelStepSpec>,
     pub loads: Vec<LoadSpec>,
@@ -183,12 +184,15 @@ pub(super) fn steps(
             .collect::<Result<Vec<_>, DeckError>>()?;
         out.push(step_spec(step, boundary)?);
     }
-    let (loads, mut amplitudes) = model_loads(defs, part, bodies, &per_step);
-    for name in prescribed
-        .motions
-        .iter()
-        .filter_map(|m| m.amplitude.as_deref())
-    {
+    let loads = model_loads(part, bodies, &per_step);
+    let mut amplitudes: Vec<AmplitudeSpec> = Vec::new();
+    let named = loads.iter().filter_map(LoadSpec::amplitude).chain(
+        prescribed
+            .motions
+            .iter()
+            .filter_map(|m| m.amplitude.as_deref()),
+    );
+    for name in named {
         if !amplitudes.iter().any(|a| a.name == name) {
             amplitudes.push(amplitude_spec(defs, name));
         }

@@ -352,8 +352,7 @@ struct History {
     given: [bool; 6],
 }
 
-/// The loads of the model from the loads in force in each step, and the amplitudes they name
-/// (in the order first named).
+/// The loads of the model from the loads in force in each step.
 ///
 /// The loads in force that act at one place with one amplitude make one load of the model
 /// (a concentrated load on one target gathers its force components from DOFs 1-3 and its moment
@@ -362,11 +361,10 @@ struct History {
 /// removed). Components that change in different ratios become loads of their own, one per
 /// ratio sequence; a load whose factors are all 1 has none.
 pub(super) fn model_loads(
-    defs: &Definitions,
     part: &Part,
     bodies: &[Body],
     per_step: &[Vec<InForce>],
-) -> (Vec<LoadSpec>, Vec<AmplitudeSpec>) {
+) -> Vec<LoadSpec> {
     let dim = part.dimension;
     let steps = per_step.len();
     let mut histories: Vec<History> = Vec::new();
@@ -437,13 +435,7 @@ pub(super) fn model_loads(
             });
         }
     }
-    let mut amplitudes: Vec<AmplitudeSpec> = Vec::new();
-    for name in loads.iter().filter_map(LoadSpec::amplitude) {
-        if !amplitudes.iter().any(|a| a.name == name) {
-            amplitudes.push(amplitude_spec(defs, name));
-        }
-    }
-    (loads, amplitudes)
+    loads
 }
 
 /// The name of the deck's amplitude that a keyword's `AMPLITUDE=name` refers to, as the

@@ -81,20 +81,19 @@ pub(super) fn prescribed_motions(
             let condition = conditions.get(&b).and_then(|dofs| dofs.get(&k));
             match condition {
                 Some(h) => {
-                    if let Some(a) = &h.amplitude {
-                        if amplitude.is_some_and(|earlier| earlier != a) {
-                            return Err(error(
-                                &h.location,
-                                format!(
-                                    "*BOUNDARY, AMPLITUDE={a}: degree of freedom {k} of rigid \
-                                     body {name} follows amplitude {} in an earlier step; skid \
-                                     gives a prescribed motion one amplitude for the whole run",
-                                    amplitude.map_or("", |e| e.as_str())
-                                ),
-                            ));
-                        }
-                        amplitude = Some(a);
+                    if let (Some(earlier), Some(a)) = (amplitude, &h.amplitude)
+                        && earlier != a
+                    {
+                        return Err(error(
+                            &h.location,
+                            format!(
+                                "*BOUNDARY, AMPLITUDE={a}: degree of freedom {k} of rigid body \
+                                 {name} follows amplitude {earlier} in an earlier step; skid \
+                                 gives a prescribed motion one amplitude for the whole run"
+                            ),
+                        ));
                     }
+                    amplitude = amplitude.or(h.amplitude.as_ref());
                     magnitudes.push(h.magnitude);
                 }
                 None if in_model_data => magnitudes.push(0.0),
