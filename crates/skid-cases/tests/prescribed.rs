@@ -10,7 +10,7 @@
 //! exactly mu N; and the reaction's work goes into the frictional dissipation and the strain
 //! energy. Prescriptions the model cannot take are refused with their field. The scene's deck
 //! prescribes the same motion with `*BOUNDARY` magnitudes in its steps, and what a deck cannot
-//! express of a motion is refused at its line.
+//! express of a motion is refused at its line (part nodes' motions: `tests/node_motions.rs`).
 
 use std::path::{Path, PathBuf};
 
@@ -111,6 +111,16 @@ fn prescribed_motions_a_deck_cannot_express_are_refused_at_their_line() {
             text.replacen("*BOUNDARY\nplate, 1, 1, 0.0\n", "", 1),
             "plate, 1, 1, 0.001",
             "free in step 1 (press)",
+        ),
+        // a motion of nodes tied to the plate
+        (
+            text.replacen(
+                "*BOUNDARY\nplate, 1, 1, 0.0\n",
+                "*BOUNDARY\nplate, 1, 1, 0.0\ntop, 2, 2, -0.0001\n",
+                1,
+            ),
+            "top, 2, 2, -0.0001",
+            "tied to rigid body plate",
         ),
         // a magnitude in model data
         (
@@ -279,16 +289,4 @@ fn prescribed_motions_the_model_cannot_take_are_refused_with_their_field() {
         assert_eq!(error.field, field, "{set}: {error:?}");
         assert!(error.message.contains(fragment), "{set}: {}", error.message);
     }
-    // the deck writer says what it cannot write: a motion of a node set
-    let spec = dragged_block(&[
-        "part.section.quasi_static=false",
-        r#"boundary[2]={"node_set": "top", "dofs": ["x"], "value": 1e-3}"#,
-        "ties=[]",
-    ]);
-    let refused = skid_cases::deck::write::write_deck(&spec, &Default::default())
-        .expect_err("no prescribed motions of node sets in decks");
-    assert!(
-        refused.contains("boundary[2].value") && refused.contains("rigid bodies only"),
-        "{refused}"
-    );
 }

@@ -235,13 +235,15 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
         })
         .collect::<Result<Vec<_>, DeckError>>()?;
     check_held_ties(defs, &part, &bodies)?;
+    let model_held = held_part_dofs(&spec_boundary, &part_spec.node_sets);
     let StepsAndLoads {
         steps,
         loads,
         motions,
         amplitudes,
-    } = steps(defs, &part, &bodies, &mut part_spec, deck)?;
-    let mut spec_boundary = motions::without_prescribed(spec_boundary, &motions);
+    } = steps(defs, &part, &bodies, &mut part_spec, &model_held, deck)?;
+    let mut spec_boundary =
+        motions::without_prescribed(spec_boundary, &motions, &mut part_spec.node_sets);
     spec_boundary.extend(motions);
     Ok(ModelSpec {
         skid_model: MODEL_FORMAT_VERSION,
@@ -262,6 +264,24 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
             field_interval: field_interval(&defs.steps),
         },
     })
+}
+
+/// The (node, degree of freedom 1..=3) of the part that the node-set entries of `boundary`
+/// hold.
+fn held_part_dofs(
+    boundary: &[BoundarySpec],
+    node_sets: &BTreeMap<String, Vec<usize>>,
+) -> BTreeSet<(usize, usize)> {
+    boundary
+        .iter()
+        .filter_map(|bc| Some((bc, node_sets.get(bc.node_set.as_ref()?)?)))
+        .flat_map(|(bc, nodes)| {
+            bc.dofs
+                .iter()
+                .filter_map(|dof| dof.translation_axis())
+                .flat_map(move |axis| nodes.iter().map(move |&n| (n, axis + 1)))
+        })
+        .collect()
 }
 
 /// The body and rigid-node role of a node label.

@@ -6,9 +6,9 @@
 //! are written so that they read back to the same bits.
 //!
 //! Two settings have no keyword and are refused: a static step's regularisation time other
-//! than the default, and adaptive increments; loads that change between steps and prescribed
-//! motions of node sets are refused too (prescribed motions of rigid bodies are written in
-//! every step, at their value times the step's factor). General contact is written as `*CONTACT` with
+//! than the default, and adaptive increments; loads that change between steps are refused too
+//! (prescribed motions of rigid bodies and node sets are written in every step, at their value
+//! times the step's factor). General contact is written as `*CONTACT` with
 //! all exterior faces, so its search distance is not kept (every exterior node becomes a
 //! candidate).
 
@@ -70,16 +70,6 @@ pub fn write_deck(
 ) -> Result<String, String> {
     let dim = spec.dimension;
     let part = &spec.part;
-    if let Some(k) = spec
-        .boundary
-        .iter()
-        .position(|bc| bc.is_prescribed() && bc.body.is_none())
-    {
-        return Err(format!(
-            "boundary[{k}].value: the deck reader reads prescribed motions of rigid bodies \
-             only, so those of node sets are not written"
-        ));
-    }
     let mut out = String::new();
     let _ = writeln!(out, "*HEADING");
     for line in spec.description.lines().filter(|l| !l.trim().is_empty()) {
@@ -400,11 +390,14 @@ pub fn write_deck(
     Ok(out)
 }
 
-/// The prescribed motions of rigid bodies in step `step`: a `*BOUNDARY` block each (with its
+/// The prescribed motions of rigid bodies and node sets in step `step`: a `*BOUNDARY` block each (with its
 /// amplitude as a parameter), each degree of freedom at its value times the step's factor.
 fn write_motions(out: &mut String, motions: &[&BoundarySpec], step: usize) {
     for motion in motions {
-        let (Some(body), Some(value)) = (&motion.body, motion.value) else {
+        let (Some(target), Some(value)) = (
+            motion.body.as_ref().or(motion.node_set.as_ref()),
+            motion.value,
+        ) else {
             continue;
         };
         let factor = motion.step_factors.as_ref().map_or(1.0, |f| f[step]);
@@ -418,7 +411,7 @@ fn write_motions(out: &mut String, motions: &[&BoundarySpec], step: usize) {
         }
         for dof in &motion.dofs {
             let k = dof_number(*dof);
-            let _ = writeln!(out, "{body}, {k}, {k}, {}", num(value * factor));
+            let _ = writeln!(out, "{target}, {k}, {k}, {}", num(value * factor));
         }
     }
 }

@@ -10,11 +10,14 @@
 //! `P.active`, `P.sliding` (closed contacts, and those at the cone's boundary), `P.max_penetration`
 //! (m); for each motion of a rigid body that the model prescribes, in model order, the reaction
 //! that moves it, `B.reaction_x` (likewise `y`, `z`; N) or `B.reaction_moment` (N m), the mean
-//! force of the increment; then `kinetic_energy`, `strain_energy`, `hourglass_energy`,
+//! force of the increment; for each prescribed translation of a node set `S`, in the order of
+//! the model's `boundary`, the sum of its nodes' reactions, `S.reaction_x` (likewise `y`, `z`;
+//! N); then `kinetic_energy`, `strain_energy`, `hourglass_energy`,
 //! `external_work`, `friction_dissipation`, `normal_work`, `algorithmic_dissipation` and, if the
 //! model prescribes motions, `reaction_work` (J). Numbers carry 10 significant digits. The file
 //! is complete or absent ([`PartialCsv`]).
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use skid_integrator::state::EnergyLedger;
@@ -23,12 +26,54 @@ use skid_integrator::{BodyMotion, Model, MotionTarget, State};
 
 use crate::contact_totals::{PairTotals, pair_totals};
 use crate::csv_out::{CsvMark, PartialCsv};
+use crate::model_spec::ModelSpec;
 
 /// File name of the history.
 pub const HISTORY_CSV: &str = "history.csv";
 
-/// The column names of a model's history.
-pub fn columns<const D: usize>(model: &Model<D>) -> Vec<String> {
+/// The reaction columns of a model's history: each a name and the equations whose reactions it
+/// sums (one for a motion of a rigid body, one per node for a node set's).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ReactionColumns(Vec<(String, Vec<usize>)>);
+
+impl ReactionColumns {
+    /// The reaction columns of `model`, built from `spec` (see the module documentation).
+    pub fn new<const D: usize>(spec: &ModelSpec, model: &Model<D>) -> Self {
+        let mut columns = body_reactions(model);
+        let equation: HashMap<(usize, usize), usize> = model
+            .prescribed()
+            .iter()
+            .filter_map(|(eq, motion)| match motion.target {
+                MotionTarget::Node { node, axis } => Some(((node, axis), *eq)),
+                MotionTarget::Body { .. } => None,
+            })
+            .collect();
+        for bc in spec.boundary.iter().filter(|bc| bc.is_prescribed()) {
+            let Some(set) = &bc.node_set else { continue };
+            let nodes = spec.part.node_sets.get(set).map_or(&[][..], Vec::as_slice);
+            for axis in bc.dofs.iter().filter_map(|dof| dof.translation_axis()) {
+                let eqs = nodes
+                    .iter()
+                    .filter_map(|&node| equation.get(&(node, axis)).copied())
+                    .collect();
+                columns.push((format!("{set}.reaction_{}", ["x", "y", "z"][axis]), eqs));
+            }
+        }
+        Self(columns)
+    }
+
+    /// The column of each reaction in `state`.
+    fn values<'a>(&'a self, state: &'a State) -> impl Iterator<Item = f64> + 'a {
+        self.0.iter().map(|(_, eqs)| {
+            eqs.iter()
+                .map(|&eq| state.reaction.get(eq).copied().unwrap_or(0.0))
+                .sum()
+        })
+    }
+}
+
+/// The column names of a model's history, with its reaction columns.
+pub fn columns<const D: usize>(model: &Model<D>, reactions: &ReactionColumns) -> Vec<String> {
     let mut names: Vec<String> = [
         "time",
         "step",
@@ -63,8 +108,8 @@ pub fn columns<const D: usize>(model: &Model<D>) -> Vec<String> {
             names.push(format!("{}.{what}", pair.name));
         }
     }
-    for (name, _) in body_reactions(model) {
-        names.push(name);
+    for (name, _) in &reactions.0 {
+        names.push(name.clone());
     }
     names.extend(
         [
@@ -84,9 +129,9 @@ pub fn columns<const D: usize>(model: &Model<D>) -> Vec<String> {
     names
 }
 
-/// The reaction columns: for each prescribed motion of a rigid body, its column name and its
-/// equation.
-fn body_reactions<const D: usize>(model: &Model<D>) -> Vec<(String, usize)> {
+/// The reaction columns of the prescribed motions of rigid bodies: each one's column name and
+/// its equation.
+fn body_reactions<const D: usize>(model: &Model<D>) -> Vec<(String, Vec<usize>)> {
     model
         .prescribed()
         .iter()
@@ -94,10 +139,11 @@ fn body_reactions<const D: usize>(model: &Model<D>) -> Vec<(String, usize)> {
             MotionTarget::Body { body, motion } => {
                 let name = &model.bodies()[body].name;
                 Some(match motion {
-                    BodyMotion::Translation(axis) => {
-                        (format!("{name}.reaction_{}", ["x", "y", "z"][axis]), *eq)
-                    }
-                    BodyMotion::Rotation => (format!("{name}.reaction_moment"), *eq),
+                    BodyMotion::Translation(axis) => (
+                        format!("{name}.reaction_{}", ["x", "y", "z"][axis]),
+                        vec![*eq],
+                    ),
+                    BodyMotion::Rotation => (format!("{name}.reaction_moment"), vec![*eq]),
                 })
             }
             MotionTarget::Node { .. } => None,
@@ -172,31 +218,44 @@ pub struct RunRecord {
 /// Observer writing a model's `history.csv` and keeping its [`RunRecord`].
 pub struct ModelRecorder {
     csv: PartialCsv,
+    reactions: ReactionColumns,
     record: RunRecord,
 }
 
 impl ModelRecorder {
-    /// Creates `dir/history.csv.partial` with the header for `model`.
+    /// Creates `dir/history.csv.partial` with the header for `model` and its reaction columns.
     ///
     /// # Errors
     /// I/O errors.
-    pub fn create<const D: usize>(dir: &Path, model: &Model<D>) -> std::io::Result<Self> {
-        let columns = columns(model);
+    pub fn create<const D: usize>(
+        dir: &Path,
+        model: &Model<D>,
+        reactions: ReactionColumns,
+    ) -> std::io::Result<Self> {
+        let columns = columns(model, &reactions);
         let names: Vec<&str> = columns.iter().map(String::as_str).collect();
         Ok(Self {
             csv: PartialCsv::create(&dir.join(HISTORY_CSV), &names)?,
+            reactions,
             record: RunRecord::default(),
         })
     }
 
     /// Continues the history of an interrupted run: `dir/history.csv.partial` reopened at
-    /// `mark` ([`PartialCsv::reopen`]), with the record up to that point.
+    /// `mark` ([`PartialCsv::reopen`]), with the record up to that point and the reaction
+    /// columns the history was created with.
     ///
     /// # Errors
     /// As [`PartialCsv::reopen`].
-    pub fn reopen(dir: &Path, mark: &CsvMark, record: RunRecord) -> std::io::Result<Self> {
+    pub fn reopen(
+        dir: &Path,
+        mark: &CsvMark,
+        record: RunRecord,
+        reactions: ReactionColumns,
+    ) -> std::io::Result<Self> {
         Ok(Self {
             csv: PartialCsv::reopen(&dir.join(HISTORY_CSV), mark)?,
+            reactions,
             record,
         })
     }
@@ -264,9 +323,7 @@ impl<const D: usize> Observer<D> for ModelRecorder {
             record.max_sliding_separation =
                 record.max_sliding_separation.max(t.max_sliding_separation);
         }
-        for (_, eq) in body_reactions(model) {
-            row.push(number(s.reaction.get(eq).copied().unwrap_or(0.0)));
-        }
+        row.extend(self.reactions.values(s).map(number));
         let e = &s.energy;
         row.extend(
             [

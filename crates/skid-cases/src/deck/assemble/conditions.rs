@@ -2,7 +2,7 @@
 //! its steps with their loads.
 
 use super::loads::{InForce, amplitude_name, amplitude_spec, apply_loads, model_loads};
-use super::motions::{Held, prescribed_motions};
+use super::motions::{Held, HeldInStep, Holder, prescribed_motions};
 use super::*;
 use crate::model_spec::AmplitudeSpec;
 
@@ -48,22 +48,10 @@ pub(super) fn apply_model_boundary(
         }
     }
     if !part_nodes.is_empty() {
-        let mut dofs = Vec::new();
-        for &k in &bc.dofs {
-            match k {
-                1..=3 if k <= dim => dofs.push(dof_of(dim, k, &bc.location)?),
-                // solid nodes have no rotations (ENCASTRE and symmetry conditions name them)
-                4..=6 if bc.dofs.len() > 1 => {}
-                _ => {
-                    return Err(error(
-                        &bc.location,
-                        format!(
-                            "*BOUNDARY: degree of freedom {k} does not exist on the nodes of a {dim}D solid"
-                        ),
-                    ));
-                }
-            }
-        }
+        let dofs = solid_dofs(dim, bc)?
+            .into_iter()
+            .map(|k| dof_of(dim, k, &bc.location))
+            .collect::<Result<_, _>>()?;
         let name = defs
             .mesh
             .node_sets
@@ -83,8 +71,30 @@ pub(super) fn apply_model_boundary(
     Ok(())
 }
 
-/// Refuses a model-data boundary condition on a part node that a `TIE NSET` ties to a rigid
-/// body: the tied node moves with the body, so holding it contradicts the tie.
+/// The degrees of freedom (1..=3) that a boundary condition holds on the nodes of a solid in
+/// dimension `dim`: solid nodes have no rotations, so a range or a named condition (ENCASTRE,
+/// symmetry) drops them, and a single one is refused.
+fn solid_dofs(dim: usize, bc: &BoundaryDef) -> Result<Vec<usize>, DeckError> {
+    let mut dofs = Vec::new();
+    for &k in &bc.dofs {
+        match k {
+            1..=3 if k <= dim => dofs.push(k),
+            4..=6 if bc.dofs.len() > 1 => {}
+            _ => {
+                return Err(error(
+                    &bc.location,
+                    format!(
+                        "*BOUNDARY: degree of freedom {k} does not exist on the nodes of a {dim}D solid"
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(dofs)
+}
+
+/// Refuses a boundary condition (model data or a step's) on a part node that a `TIE NSET` ties
+/// to a rigid body: the tied node moves with the body, so holding it contradicts the tie.
 pub(super) fn check_held_ties(
     defs: &Definitions,
     part: &Part,
@@ -93,7 +103,12 @@ pub(super) fn check_held_ties(
     for body in bodies {
         let Some(tie) = &body.def.tie else { continue };
         let tied = defs.mesh.nodes_named(tie).unwrap_or_default();
-        for bc in &defs.boundary {
+        let in_steps = defs
+            .steps
+            .iter()
+            .flat_map(|step| &step.boundary)
+            .flat_map(|change| &change.items);
+        for bc in defs.boundary.iter().chain(in_steps) {
             let held = defs.mesh.nodes_named(&bc.target).unwrap_or_default();
             if let Some(n) = held
                 .iter()
@@ -132,13 +147,14 @@ pub(super) fn steps(
     part: &Part,
     bodies: &[Body],
     part_spec: &mut PartSpec,
+    model_held: &BTreeSet<(usize, usize)>,
     deck: &Location,
 ) -> Result<StepsAndLoads, DeckError> {
     let dim = part.dimension;
     if defs.steps.is_empty() {
         return Err(error(deck, "the deck has no *STEP"));
     }
-    let mut held: BTreeMap<usize, BTreeMap<usize, Held>> = BTreeMap::new();
+    let mut held = HeldInStep::new();
     let mut loads_in_force: Vec<InForce> = Vec::new();
     let mut per_step = Vec::new();
     let mut held_per_step = Vec::new();
@@ -158,12 +174,20 @@ pub(super) fn steps(
         per_step.push(loads_in_force.clone());
         held_per_step.push(held.clone());
     }
-    let prescribed = prescribed_motions(defs, part, bodies, &held_per_step)?;
+    let prescribed = prescribed_motions(
+        defs,
+        part,
+        bodies,
+        &held_per_step,
+        model_held,
+        &mut part_spec.node_sets,
+    )?;
     let mut out = Vec::new();
     for (step, held) in defs.steps.iter().zip(&held_per_step) {
         let boundary = held
             .iter()
-            .filter_map(|(&b, dofs)| {
+            .filter_map(|(&who, dofs)| {
+                let Holder::Body(b) = who else { return None };
                 let dofs: Vec<usize> = dofs
                     .keys()
                     .copied()
@@ -188,7 +212,7 @@ pub(super) fn steps(
     let mut amplitudes: Vec<AmplitudeSpec> = Vec::new();
     let named = loads.iter().filter_map(LoadSpec::amplitude).chain(
         prescribed
-            .motions
+            .boundary
             .iter()
             .filter_map(|m| m.amplitude.as_deref()),
     );
@@ -200,46 +224,57 @@ pub(super) fn steps(
     Ok(StepsAndLoads {
         steps: out,
         loads,
-        motions: prescribed.motions,
+        motions: prescribed.boundary,
         amplitudes,
     })
 }
 
-/// Applies one `*BOUNDARY` block of a step to the conditions in force on rigid bodies: `OP=NEW`
-/// first drops those of earlier steps, then each line sets its degrees of freedom.
+/// Applies one `*BOUNDARY` block of a step to the conditions in force: `OP=NEW` first drops
+/// those of earlier steps, then each line sets its degrees of freedom on rigid-body reference
+/// nodes and part nodes.
 pub(super) fn apply_step_boundary(
     defs: &Definitions,
     part: &Part,
     bodies: &[Body],
     change: &Change<BoundaryDef>,
-    held: &mut BTreeMap<usize, BTreeMap<usize, Held>>,
+    held: &mut HeldInStep,
 ) -> Result<(), DeckError> {
     if change.replace {
         held.clear();
     }
     for bc in &change.items {
         let labels = node_labels(defs, &bc.target, "*BOUNDARY", &bc.location)?;
+        let amplitude = bc
+            .amplitude
+            .as_deref()
+            .map(|name| amplitude_name(defs, name));
         for label in labels {
-            let NodeRole::Reference(b) = role(part, bodies, label) else {
-                return Err(error(
-                    &bc.location,
-                    format!(
-                        "*BOUNDARY: node {label}: boundary conditions inside steps apply to \
-                         rigid-body reference nodes only so far (give those on the part as model data)"
-                    ),
-                ));
+            let (who, dofs) = match role(part, bodies, label) {
+                NodeRole::Reference(b) => {
+                    let dofs: Vec<usize> = body_dofs(part.dimension, &bc.dofs).collect();
+                    for &k in &dofs {
+                        dof_of(part.dimension, k, &bc.location)?;
+                    }
+                    (Holder::Body(b), dofs)
+                }
+                NodeRole::Part(i) => (Holder::Node(i), solid_dofs(part.dimension, bc)?),
+                NodeRole::Other => {
+                    return Err(error(
+                        &bc.location,
+                        format!(
+                            "*BOUNDARY: node {label} is a node of a rigid body but not its \
+                             reference node: hold the reference node"
+                        ),
+                    ));
+                }
             };
-            let amplitude = bc
-                .amplitude
-                .as_deref()
-                .map(|name| amplitude_name(defs, name));
-            for k in body_dofs(part.dimension, &bc.dofs) {
-                dof_of(part.dimension, k, &bc.location)?;
-                held.entry(b).or_default().insert(
+            for k in dofs {
+                held.entry(who).or_default().insert(
                     k,
                     Held {
                         magnitude: bc.magnitude,
                         amplitude: amplitude.clone(),
+                        target: bc.target.clone(),
                         location: bc.location.clone(),
                     },
                 );

@@ -1,32 +1,52 @@
 //! Prescribed motions of a deck: a step's `*BOUNDARY` line with a nonzero magnitude on a rigid
-//! body's reference node moves that degree of freedom to the magnitude (a displacement or a
-//! rotation from the reference configuration), carried into later steps as the loads are.
+//! body's reference node or on nodes of the part moves that degree of freedom to the magnitude
+//! (a displacement or a rotation from the reference configuration), carried into later steps
+//! as the loads are.
 //!
-//! A degree of freedom with a nonzero magnitude in some step becomes one `boundary` entry of
-//! the model with a `value` (its first nonzero magnitude) and a factor per step (its magnitude
-//! there over the value; 0 where it is held at zero, by model data or a line without magnitude),
-//! so that it varies as the model file says a load does: ramped over a static step from the
-//! previous step's value, at once in a dynamic one, or times its `AMPLITUDE=` in the step time.
-//! The model holds a prescribed degree of freedom in every step, so a deck that leaves it free
-//! in one step (before it is prescribed, or after `OP=NEW` drops it) is refused, as is one that
-//! gives it different amplitudes in different steps.
+//! A degree of freedom with a nonzero magnitude in some step becomes part of one `boundary`
+//! entry of the model with a `value` (its first nonzero magnitude) and a factor per step (its
+//! magnitude there over the value; 0 where it is held at zero, by model data or a line without
+//! magnitude), so that it varies as the model file says a load does: ramped over a static step
+//! from the previous step's value, at once in a dynamic one, or times its `AMPLITUDE=` in the
+//! step time. Part nodes that move alike (same degree of freedom, value, amplitude and factors)
+//! share one entry on a node set: the deck's set of exactly those nodes if it has one, a new
+//! `motion-N` set otherwise. The model holds a prescribed degree of freedom in every step, so a
+//! deck that leaves it free in one step (before it is prescribed, or after `OP=NEW` drops it) is
+//! refused, as is one that gives it different amplitudes in different steps. A part node that
+//! steps hold at zero only is held throughout if every step holds it (a `held-N` set), and
+//! refused otherwise: the model's steps change the conditions of rigid bodies only.
 
 use super::*;
 
-/// A degree of freedom of a rigid body held by a step's `*BOUNDARY`: at `magnitude`, times
-/// `amplitude` if one is named.
+/// Who a step's `*BOUNDARY` holds: a rigid body's reference node or a node of the part.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(super) enum Holder {
+    /// Rigid body, by index.
+    Body(usize),
+    /// Node of the part, by its number from 0.
+    Node(usize),
+}
+
+/// A degree of freedom held by a step's `*BOUNDARY`: at `magnitude`, times `amplitude` if one
+/// is named.
 #[derive(Clone, Debug)]
 pub(super) struct Held {
     pub magnitude: f64,
     pub amplitude: Option<String>,
+    /// The node or node set the line names.
+    pub target: String,
     pub location: Location,
 }
 
+/// The conditions in force in one step: holder -> degree of freedom (1..=6) -> condition.
+pub(super) type HeldInStep = BTreeMap<Holder, BTreeMap<usize, Held>>;
+
 /// The prescribed motions of a deck (see the module documentation).
 pub(super) struct Prescribed {
-    /// The model's `boundary` entries with a value.
-    pub motions: Vec<BoundarySpec>,
-    /// The degrees of freedom they move: (body, degree of freedom 1..=6).
+    /// The model's `boundary` entries with a value, and the part nodes held at zero by every
+    /// step.
+    pub boundary: Vec<BoundarySpec>,
+    /// The degrees of freedom of rigid bodies they move: (body, degree of freedom 1..=6).
     moved: BTreeSet<(usize, usize)>,
 }
 
@@ -37,49 +57,87 @@ impl Prescribed {
     }
 }
 
-/// The prescribed motions of the bodies' degrees of freedom from the conditions in force in
-/// each step, `held[s]` (body -> degree of freedom -> condition).
+/// How one degree of freedom is held over the steps: its value, amplitude and factor per step
+/// (see the module documentation).
+#[derive(Clone, Debug, PartialEq)]
+struct History {
+    value: f64,
+    amplitude: Option<String>,
+    factors: Option<Vec<f64>>,
+}
+
+/// Part nodes held alike in one degree of freedom.
+struct NodeGroup<'a> {
+    /// The degree of freedom, 1..=3.
+    dof: usize,
+    /// How it is held (`None`: at zero in every step).
+    history: Option<History>,
+    /// The node or node set named by the first line that holds one of them.
+    target: &'a str,
+    /// The nodes, in increasing order.
+    nodes: Vec<usize>,
+}
+
+/// The prescribed motions of the degrees of freedom from the conditions in force in each step,
+/// `held[s]`; `model_held` holds the part's (node, degree of freedom) that model data holds, and
+/// `node_sets` the part's node sets, to which the sets of moved nodes are added.
 ///
 /// # Errors
 /// At the line of a nonzero magnitude whose degree of freedom is free in some step, that
 /// changes its amplitude between steps, or that rotates a body held in that rotation by model
-/// data (model data fixes which rotation a body has).
+/// data (model data fixes which rotation a body has); at the line that holds a part node in a
+/// step if another step leaves it free.
 pub(super) fn prescribed_motions(
     defs: &Definitions,
     part: &Part,
     bodies: &[Body],
-    held: &[BTreeMap<usize, BTreeMap<usize, Held>>],
+    held: &[HeldInStep],
+    model_held: &BTreeSet<(usize, usize)>,
+    node_sets: &mut BTreeMap<String, Vec<usize>>,
 ) -> Result<Prescribed, DeckError> {
     let dim = part.dimension;
-    let mut places: BTreeMap<(usize, usize), &Held> = BTreeMap::new();
+    // the first condition of each degree of freedom, and whether it ever has a magnitude
+    let mut places: BTreeMap<(Holder, usize), (&Held, bool)> = BTreeMap::new();
     for conditions in held {
-        for (&b, dofs) in conditions {
+        for (&who, dofs) in conditions {
             for (&k, h) in dofs {
-                if h.magnitude != 0.0 {
-                    places.entry((b, k)).or_insert(h);
+                let place = places.entry((who, k)).or_insert((h, false));
+                if h.magnitude != 0.0 && !place.1 {
+                    *place = (h, true);
                 }
             }
         }
     }
-    // one entry per body, value, amplitude and factors, by body and degree of freedom
-    let mut motions: Vec<BoundarySpec> = Vec::new();
-    for (&(b, k), first) in &places {
-        let name = &bodies[b].def.name;
-        let in_model_data = bodies[b].fixed.contains(&k);
-        if in_model_data && k > 3 {
+    let mut boundary: Vec<BoundarySpec> = Vec::new();
+    let mut moved = BTreeSet::new();
+    let mut node_groups: Vec<NodeGroup> = Vec::new();
+    for (&(who, k), &(first, prescribed)) in &places {
+        let (name, in_model_data) = match who {
+            Holder::Body(b) => (
+                format!("rigid body {}", bodies[b].def.name),
+                bodies[b].fixed.contains(&k),
+            ),
+            Holder::Node(i) => (
+                format!("node {}", part.labels[i]),
+                model_held.contains(&(i, k)),
+            ),
+        };
+        if !prescribed && (in_model_data || matches!(who, Holder::Body(_))) {
+            continue;
+        }
+        if prescribed && in_model_data && k > 3 {
             return Err(error(
                 &first.location,
                 format!(
-                    "*BOUNDARY: rotation {k} of rigid body {name} is prescribed here and held by \
-                     model data, which leaves the body another rotation: hold it in the steps instead"
+                    "*BOUNDARY: rotation {k} of {name} is prescribed here and held by model \
+                     data, which leaves the body another rotation: hold it in the steps instead"
                 ),
             ));
         }
         let mut magnitudes = Vec::with_capacity(held.len());
         let mut amplitude: Option<&String> = None;
         for (s, conditions) in held.iter().enumerate() {
-            let condition = conditions.get(&b).and_then(|dofs| dofs.get(&k));
-            match condition {
+            match conditions.get(&who).and_then(|dofs| dofs.get(&k)) {
                 Some(h) => {
                     if let (Some(earlier), Some(a)) = (amplitude, &h.amplitude)
                         && earlier != a
@@ -87,9 +145,9 @@ pub(super) fn prescribed_motions(
                         return Err(error(
                             &h.location,
                             format!(
-                                "*BOUNDARY, AMPLITUDE={a}: degree of freedom {k} of rigid body \
-                                 {name} follows amplitude {earlier} in an earlier step; skid \
-                                 gives a prescribed motion one amplitude for the whole run"
+                                "*BOUNDARY, AMPLITUDE={a}: degree of freedom {k} of {name} \
+                                 follows amplitude {earlier} in an earlier step; skid gives a \
+                                 prescribed motion one amplitude for the whole run"
                             ),
                         ));
                     }
@@ -98,13 +156,22 @@ pub(super) fn prescribed_motions(
                 }
                 None if in_model_data => magnitudes.push(0.0),
                 None => {
+                    let what = if prescribed {
+                        "prescribed here but free"
+                    } else {
+                        "held here but free"
+                    };
+                    let since = if prescribed {
+                        "skid holds a prescribed degree of freedom throughout the run"
+                    } else {
+                        "skid's steps change the conditions of rigid bodies only, so a part node \
+                         is held throughout the run or not at all"
+                    };
                     return Err(error(
                         &first.location,
                         format!(
-                            "*BOUNDARY: degree of freedom {k} of rigid body {name} is prescribed \
-                             here but free in step {} ({}); skid holds a prescribed degree of \
-                             freedom throughout the run: hold it (at zero) in model data or in \
-                             that step",
+                            "*BOUNDARY: degree of freedom {k} of {name} is {what} in step {} \
+                             ({}); {since}: hold it (at zero) in model data or in that step",
                             s + 1,
                             defs.steps[s].name
                         ),
@@ -112,54 +179,174 @@ pub(super) fn prescribed_motions(
                 }
             }
         }
-        let value = first.magnitude;
-        let factors: Vec<f64> = magnitudes.iter().map(|m| m / value).collect();
-        let motion = BoundarySpec {
-            body: Some(name.clone()),
-            node_set: None,
-            dofs: vec![dof_of(dim, k, &first.location)?],
-            value: Some(value),
-            amplitude: amplitude.cloned(),
-            step_factors: factors.iter().any(|&c| c != 1.0).then_some(factors),
-        };
-        let same = |m: &&mut BoundarySpec| {
-            (&m.body, m.value, &m.amplitude, &m.step_factors)
-                == (
-                    &motion.body,
-                    motion.value,
-                    &motion.amplitude,
-                    &motion.step_factors,
-                )
-        };
-        match motions.iter_mut().find(same) {
-            Some(m) => m.dofs.extend(motion.dofs),
-            None => motions.push(motion),
+        let history = prescribed.then(|| {
+            let value = first.magnitude;
+            let factors: Vec<f64> = magnitudes.iter().map(|m| m / value).collect();
+            History {
+                value,
+                amplitude: amplitude.cloned(),
+                factors: factors.iter().any(|&c| c != 1.0).then_some(factors),
+            }
+        });
+        match who {
+            Holder::Body(b) => {
+                let history = history.expect("bodies held at zero only were skipped");
+                moved.insert((b, k));
+                push_merged(
+                    &mut boundary,
+                    BoundarySpec {
+                        body: Some(bodies[b].def.name.clone()),
+                        node_set: None,
+                        dofs: vec![dof_of(dim, k, &first.location)?],
+                        value: Some(history.value),
+                        amplitude: history.amplitude,
+                        step_factors: history.factors,
+                    },
+                );
+            }
+            Holder::Node(i) => {
+                dof_of(dim, k, &first.location)?;
+                match node_groups
+                    .iter_mut()
+                    .find(|g| (g.dof, &g.history) == (k, &history))
+                {
+                    Some(group) => group.nodes.push(i),
+                    None => node_groups.push(NodeGroup {
+                        dof: k,
+                        history,
+                        target: &first.target,
+                        nodes: vec![i],
+                    }),
+                }
+            }
         }
     }
-    Ok(Prescribed {
-        motions,
-        moved: places.into_keys().collect(),
-    })
+    for NodeGroup {
+        dof: k,
+        history,
+        target,
+        nodes,
+    } in node_groups
+    {
+        let prefix = if history.is_some() { "motion" } else { "held" };
+        let named = defs
+            .mesh
+            .node_sets
+            .get(&key(target))
+            .map(|s| s.name.as_str());
+        let set = node_set_of(node_sets, nodes, named, prefix);
+        let dof = dof_of(dim, k, &defs.steps[0].location)?;
+        push_merged(
+            &mut boundary,
+            BoundarySpec {
+                body: None,
+                node_set: Some(set),
+                dofs: vec![dof],
+                value: history.as_ref().map(|h| h.value),
+                amplitude: history.as_ref().and_then(|h| h.amplitude.clone()),
+                step_factors: history.and_then(|h| h.factors),
+            },
+        );
+    }
+    Ok(Prescribed { boundary, moved })
+}
+
+/// Adds `entry` to `boundary`, as more degrees of freedom of an entry that holds the same
+/// body or node set alike if there is one.
+fn push_merged(boundary: &mut Vec<BoundarySpec>, entry: BoundarySpec) {
+    let alike = |m: &&mut BoundarySpec| {
+        (&m.body, &m.node_set, m.value, &m.amplitude, &m.step_factors)
+            == (
+                &entry.body,
+                &entry.node_set,
+                entry.value,
+                &entry.amplitude,
+                &entry.step_factors,
+            )
+    };
+    match boundary.iter_mut().find(alike) {
+        Some(m) => m.dofs.extend(entry.dofs),
+        None => boundary.push(entry),
+    }
+}
+
+/// The name of a node set of exactly `nodes` (in increasing order): `named` if it is that set,
+/// else an existing one if there is one, else a new one, `prefix-N` with the first free `N`
+/// from 1.
+fn node_set_of(
+    node_sets: &mut BTreeMap<String, Vec<usize>>,
+    nodes: Vec<usize>,
+    named: Option<&str>,
+    prefix: &str,
+) -> String {
+    let same = |set: &Vec<usize>| {
+        let mut set = set.clone();
+        set.sort_unstable();
+        set == nodes
+    };
+    if let Some(name) = named.filter(|name| node_sets.get(*name).is_some_and(same)) {
+        return name.to_string();
+    }
+    if let Some((name, _)) = node_sets.iter().find(|(_, set)| same(set)) {
+        return name.clone();
+    }
+    let name = (1..)
+        .map(|n| format!("{prefix}-{n}"))
+        .find(|name| !node_sets.contains_key(name))
+        .expect("a free name");
+    node_sets.insert(name.clone(), nodes);
+    name
 }
 
 /// Model-data `boundary` entries without the degrees of freedom that `motions` prescribe (the
-/// motion holds them at zero where it is not in force); entries left without any are dropped.
+/// motion holds them at zero where it is not in force): a body's entry loses those degrees of
+/// freedom, a node set's entry keeps holding its other nodes in them on a new set
+/// `<set>-held-N`; entries left without any are dropped.
 pub(super) fn without_prescribed(
     boundary: Vec<BoundarySpec>,
     motions: &[BoundarySpec],
+    node_sets: &mut BTreeMap<String, Vec<usize>>,
 ) -> Vec<BoundarySpec> {
-    boundary
-        .into_iter()
-        .filter_map(|mut bc| {
-            let Some(body) = bc.body.as_deref() else {
-                return Some(bc);
-            };
+    let mut out = Vec::new();
+    for mut bc in boundary {
+        if let Some(body) = bc.body.as_deref() {
             bc.dofs.retain(|dof| {
                 !motions
                     .iter()
                     .any(|m| m.body.as_deref() == Some(body) && m.dofs.contains(dof))
             });
-            (!bc.dofs.is_empty()).then_some(bc)
-        })
-        .collect()
+        } else if let Some(set) = bc.node_set.clone() {
+            let nodes = node_sets.get(&set).cloned().unwrap_or_default();
+            let mut kept = Vec::new();
+            for dof in std::mem::take(&mut bc.dofs) {
+                let moved: BTreeSet<usize> = motions
+                    .iter()
+                    .filter(|m| m.dofs.contains(&dof))
+                    .filter_map(|m| m.node_set.as_ref().and_then(|s| node_sets.get(s)))
+                    .flatten()
+                    .copied()
+                    .collect();
+                let rest: Vec<usize> = nodes
+                    .iter()
+                    .copied()
+                    .filter(|n| !moved.contains(n))
+                    .collect();
+                if rest.len() == nodes.len() {
+                    kept.push(dof);
+                } else if !rest.is_empty() {
+                    let name = node_set_of(node_sets, rest, None, &format!("{set}-held"));
+                    out.push(BoundarySpec {
+                        node_set: Some(name),
+                        dofs: vec![dof],
+                        ..bc.clone()
+                    });
+                }
+            }
+            bc.dofs = kept;
+        }
+        if !bc.dofs.is_empty() {
+            out.push(bc);
+        }
+    }
+    out
 }
