@@ -30,6 +30,7 @@ pub mod format;
 pub mod hard;
 pub mod hertz;
 pub mod markdown;
+pub mod moved_block;
 pub mod plot;
 pub mod scaling;
 pub mod stress;

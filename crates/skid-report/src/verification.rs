@@ -14,9 +14,11 @@
 //! - Coulomb friction (any other scene with a frictional pair, [`coulomb`]): the friction
 //!   resultant never exceeds `mu N` and equals it while every contact slides; a block on a
 //!   fixed flat sticks or slides as its held loads say, and the runs of a scene that stick and
-//!   slide bracket its threshold.
+//!   slide bracket its threshold; a block moved over a fixed flat by prescribed motions makes
+//!   its reactions balance the friction.
 
 pub mod coulomb;
+mod reactions;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! The verification section of the report on runs of the verification scenes: the Hertz scene
 //! (`cases/verification/2d-hertz-n4.json`, the coarsest level: a rigid cylinder pressed
 //! frictionlessly on an elastic block in plane strain) against Hertz's answer, a block sliding
-//! on a flat, and a block that sticks just below the Coulomb threshold beside one that slides
+//! on a flat, a block dragged over a flat by a prescribed motion, and a block that sticks just below the Coulomb threshold beside one that slides
 //! just above it: the section passes them, and flags them once their outputs are made wrong.
 
 use std::path::{Path, PathBuf};
@@ -140,6 +140,32 @@ fn the_report_flags_friction_beyond_coulomb() {
     let (text, failed) = report(dir.path());
     assert_eq!(failed, 2, "{text}");
     assert!(text.contains("- **FAIL** 2d-block-pushed-on-flat (block-ground): |T| <= mu N"));
+}
+
+/// The block dragged over a flat by its plate: the plate's reaction along the flat balances
+/// the friction in every increment and is mu N while every contact slides (measured 2.4e-7 and
+/// 2.4e-8 of mu N); the report passes it, and flags a reaction 1e-4 too large on both counts.
+#[test]
+fn the_report_checks_that_the_reactions_of_a_dragged_block_balance_its_friction() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let run = run_scene("2d-block-dragged-on-flat", dir.path());
+    let (text, failed) = report(dir.path());
+    assert_eq!(failed, 0, "{text}");
+    let balance = "- **PASS** 2d-block-dragged-on-flat (block-ground): the reactions along the \
+                   flat balance the friction in every increment";
+    assert!(text.contains(balance), "{text}");
+    scale_column(&run.join("history.csv"), "plate.reaction_x", 1.0001);
+    let (text, failed) = report(dir.path());
+    assert_eq!(failed, 2, "{text}");
+    for what in [
+        "balance the friction in every increment",
+        "are mu N while every contact slides",
+    ] {
+        let fail = format!(
+            "- **FAIL** 2d-block-dragged-on-flat (block-ground): the reactions along the flat {what}"
+        );
+        assert!(text.contains(&fail), "{text}");
+    }
 }
 
 /// The block pushed on a flat at 0.995 mu N sticks once its loads are held, with resultants

@@ -17,16 +17,20 @@
 //! - runs of one scene that differ only in the size of their loads (a family: the same model
 //!   but for names, descriptions and load values) and that stick and slide bracket the
 //!   threshold: the one that sticks at the largest ratio `r` and the one that slides at the
-//!   smallest must both behave as predicted, within [`THRESHOLD_BRACKET`] of `r = 1`.
+//!   smallest must both behave as predicted, within [`THRESHOLD_BRACKET`] of `r = 1`;
+//! - a block moved over a fixed flat by prescribed motions ([`MovedBlock`]): the reactions
+//!   along the flat balance the friction ([`reactions`]).
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
 use super::SceneRun;
+use super::reactions::{self, MovedRun};
 use crate::ReportError;
 use crate::block_on_flat::BlockOnFlat;
 use crate::format::{Checks, percent, show};
+use crate::moved_block::MovedBlock;
 use crate::read;
 use skid_cases::csv_out::CsvTable;
 use skid_cases::model_spec::{ContactPairSpec, ModelSpec};
@@ -41,18 +45,18 @@ pub const BALANCE_TOLERANCE: f64 = 1e-5;
 pub const THRESHOLD_BRACKET: f64 = 0.01;
 
 /// A pair's resultants in one increment of the history.
-struct FrictionRow {
-    time: f64,
-    normal: f64,
+pub(super) struct FrictionRow {
+    pub time: f64,
+    pub normal: f64,
     /// The friction resultant's components in the surface's tangent directions.
-    tangential: Vec<f64>,
-    active: usize,
-    sliding: usize,
+    pub tangential: Vec<f64>,
+    pub active: usize,
+    pub sliding: usize,
 }
 
 impl FrictionRow {
     /// `|T|`.
-    fn friction(&self) -> f64 {
+    pub fn friction(&self) -> f64 {
         self.tangential.iter().map(|t| t * t).sum::<f64>().sqrt()
     }
 }
@@ -144,6 +148,7 @@ pub(super) fn section(runs: &[&SceneRun], checks: &mut Checks) -> Result<String,
          | there: \\|T\\| / (mu N) | held loads: r |\n|---|---|---|---|---|---|---|---|\n",
     );
     let mut families: BTreeMap<String, Vec<(&str, HeldState)>> = BTreeMap::new();
+    let mut moved = Vec::new();
     for run in runs {
         if !run.completed_or_recorded(checks) {
             continue;
@@ -151,6 +156,14 @@ pub(super) fn section(runs: &[&SceneRun], checks: &mut Checks) -> Result<String,
         let path = run.dir.join("history.csv");
         let text = read(&path)?;
         let block = BlockOnFlat::recognise(&run.spec);
+        if let Some(block) = MovedBlock::recognise(&run.spec) {
+            moved.push(MovedRun {
+                run,
+                rows: friction_rows(&text, &path, &block.pair, run.spec.dimension)?,
+                block,
+                history: text.clone(),
+            });
+        }
         for pair in run.spec.contact.iter().filter(|p| p.mu > 0.0) {
             let rows = friction_rows(&text, &path, &pair.name, run.spec.dimension)?;
             let held = block
@@ -176,6 +189,7 @@ pub(super) fn section(runs: &[&SceneRun], checks: &mut Checks) -> Result<String,
     for members in families.values() {
         bracket_check(&mut out, checks, members);
     }
+    out.push_str(&reactions::section(&moved, checks)?);
     Ok(out)
 }
 
