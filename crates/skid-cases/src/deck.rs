@@ -14,9 +14,9 @@
 //! `*ELASTIC` and `*DENSITY`, `*SOLID SECTION`, `*MEMBRANE SECTION`, `*SHELL SECTION`,
 //! `*MASS`, `*ROTARY INERTIA`, `*SURFACE INTERACTION` with `*FRICTION`, `*CONTACT PAIR`,
 //! `*CONTACT` with `*CONTACT INCLUSIONS, ALL EXTERIOR` and `*CONTACT PROPERTY ASSIGNMENT`,
-//! `*BOUNDARY` (OP=MOD/NEW and, on rigid bodies, magnitudes with AMPLITUDE= in steps: see
-//! `assemble::motions`), `*INITIAL CONDITIONS` (VELOCITY, ROTATING VELOCITY),
-//! `*AMPLITUDE` (TABULAR, step time), `*STEP` (NLGEOM), `*STATIC` and `*DYNAMIC` (DIRECT,
+//! `*BOUNDARY` (OP=MOD/NEW and, on rigid bodies and part nodes, magnitudes with AMPLITUDE= in
+//! steps: see `assemble::motions`), `*INITIAL CONDITIONS` (VELOCITY, ROTATING VELOCITY),
+//! `*AMPLITUDE` (TABULAR, step or total time), `*STEP` (NLGEOM), `*STATIC` and `*DYNAMIC` (DIRECT,
 //! ALPHA), `*CLOAD`, `*DSLOAD` / `*DLOAD` pressures and `*DLOAD` gravity (`GRAV`), each with
 //! `AMPLITUDE=`, `*OUTPUT`, `*NODE OUTPUT`, `*CONTACT OUTPUT`,
 //! `*END STEP`, `*INCLUDE`. Anything else is an error at its line.
@@ -29,9 +29,12 @@
 //!   (`OP=MOD`) or `OP=NEW` removes it; without amplitude it goes linearly over a static step
 //!   from its value at the end of the previous step to the new one (from 0 in the first step;
 //!   a removed load to 0), and takes the new value at once in a dynamic step; with one, it is
-//!   its value in the step times the amplitude at the step time (a static step's runs from 0
-//!   to 1). The model's loads carry their factor in each step (see [`assemble`] and [`loads`]
-//!   for gravity's direction and `OP=NEW`);
+//!   its value in the step times the amplitude at the step or total time (a static step's step
+//!   time runs from 0 to the period of its `*STATIC` line). A load or motion carried into a
+//!   later step with a step-time amplitude that does not hold its end value there is refused:
+//!   Abaqus holds it at that value, the model would restart the amplitude. The model's loads
+//!   carry their factor in each step (see [`assemble`] and [`loads`] for gravity's direction
+//!   and `OP=NEW`);
 //! - `*DYNAMIC` without `ALPHA` takes the keyword's default `-0.05`;
 //! - `*ELASTIC` is the compressible neo-Hookean solid with the same small-strain moduli;
 //! - rigid membranes and shells are contacted on their mid-surface (zero thickness), rigid

@@ -200,6 +200,7 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
                 name: name.clone(),
                 increments: *increments,
                 regularization_time: *regularization_time,
+                time_period: None,
                 boundary: hold(held),
             },
             StepSpec::Dynamic {

@@ -55,9 +55,10 @@ pub struct ModelSpec {
     pub initial_velocities: Vec<NodeVelocitySpec>,
     /// Loads. A load acts in every step at its value times its factor in the step
     /// (`step_factors`, 1 in every step if absent). A load with an `amplitude` is that
-    /// amplitude's value at the step time times the step's factor and its value: the time since
-    /// the step began in a dynamic step, and in a static step (which takes no physical time) the
-    /// completed fraction of the step, 0 to 1 (a static step's time period is 1). A load without
+    /// amplitude's value at its time times the step's factor and its value: the step time is the
+    /// time since the step began in a dynamic step, and in a static step (which takes no
+    /// physical time) the completed fraction of the step times its time period (1 by default);
+    /// the total time adds the time periods of the steps before (see [`AmplitudeTime`]). A load without
     /// amplitude goes linearly over a static step from its factor at the end of the previous
     /// step (0 before the first step) to the step's factor, and takes the step's factor at once
     /// in a dynamic step: without `step_factors` it is ramped from 0 to full value over the
@@ -65,7 +66,8 @@ pub struct ModelSpec {
     /// step is dynamic).
     #[serde(default)]
     pub loads: Vec<LoadSpec>,
-    /// Named amplitudes: piecewise-linear factors of the step time that loads may name.
+    /// Named amplitudes: piecewise-linear factors of the step or total time that loads and
+    /// prescribed motions may name.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub amplitudes: Vec<AmplitudeSpec>,
     /// Contact pairs: nodes of the part against the surface of a rigid body.
@@ -443,16 +445,39 @@ impl LoadSpec {
 }
 
 /// A named amplitude: the factor `a(t)` of the loads that name it, linear between the points
-/// `(t_k, a_k)` (times >= 0, strictly increasing, in the step time), `a_0` before the first
-/// point and the last value after the last.
+/// `(t_k, a_k)` (times >= 0, strictly increasing, in the step time or the total time), `a_0`
+/// before the first point and the last value after the last.
 #[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AmplitudeSpec {
     /// Name (loads refer to it).
     pub name: String,
-    /// Points `[time, factor]`: step time (s in a dynamic step, the completed fraction of a
-    /// static step) and factor.
+    /// Points `[time, factor]`: the time (see `time`) and the factor.
     pub points: Vec<[f64; 2]>,
+    /// The time the points are read against.
+    #[serde(default, skip_serializing_if = "AmplitudeTime::is_step")]
+    pub time: AmplitudeTime,
+}
+
+/// The time an amplitude is read against.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, JsonSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum AmplitudeTime {
+    /// The step time, from 0 at each step's start: s in a dynamic step, and in a static step
+    /// the completed fraction of the step times its time period (1 by default).
+    #[default]
+    Step,
+    /// The total time: the step time plus the time periods of the steps before (a dynamic
+    /// step's duration, a static step's time period), so that the amplitude runs on across
+    /// steps.
+    Total,
+}
+
+impl AmplitudeTime {
+    /// Whether this is the step time (the default, left out of model files).
+    pub fn is_step(&self) -> bool {
+        *self == Self::Step
+    }
 }
 
 /// Frictional contact between nodes of the part and a rigid body's surface.
@@ -499,6 +524,11 @@ pub enum ModelStepSpec {
         /// Time scale of the Newton regularisation `M/h_s^2`, s.
         #[serde(default = "default_regularization_time")]
         regularization_time: f64,
+        /// Time period of the step (1 if absent): a static step takes no physical time, but
+        /// its amplitudes read the step time from 0 to this period as the step goes from start
+        /// to end, and the total time advances by it.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        time_period: Option<f64>,
         /// Rigid-body degrees of freedom held during the step (absent `dofs`: all).
         #[serde(default)]
         boundary: Vec<StepBoundarySpec>,

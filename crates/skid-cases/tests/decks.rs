@@ -273,8 +273,12 @@ fn keywords_parameters_and_values_outside_the_subset_are_errors_at_their_line() 
         ),
         (
             "*Step, name=preload",
-            "*Amplitude, name=ramp, time=total time\n0., 0.\n*Step, name=preload",
-            &["*AMPLITUDE", "TIME=total time", "STEP TIME only"],
+            "*Amplitude, name=ramp, time=normal time\n0., 0.\n*Step, name=preload",
+            &[
+                "*AMPLITUDE",
+                "TIME=normal time",
+                "expected STEP TIME or TOTAL TIME",
+            ],
         ),
         (
             "*Dsload\n",
@@ -505,17 +509,18 @@ ground, ENCASTRE
 /// and amplitude, `*DLOAD, GRAV` on an element set becomes gravity on that element set (its
 /// direction made a unit vector), on no set gravity on the whole model, names are
 /// case-insensitive, and `*AMPLITUDE`
-/// tables the amplitudes the loads name; `OP=NEW` drops the loads of its keyword.
+/// tables the amplitudes the loads name (here against the total time, as the ramped loads are
+/// carried from the preload into the spin-down); `OP=NEW` drops the loads of its keyword.
 #[test]
 fn concentrated_loads_gravity_and_amplitudes_map_onto_the_model() {
-    use skid_cases::model_spec::{AmplitudeSpec, LoadSpec};
+    use skid_cases::model_spec::{AmplitudeSpec, AmplitudeTime, LoadSpec};
     let mesh = std::fs::read_to_string(repo("cases/inp/2d-pad-mesh.inc")).expect("mesh");
     let deck = std::fs::read_to_string(repo("cases/inp/2d-analytic-by-hand.inp")).expect("deck");
     let deck = deck
         .replace("*include, input=2d-pad-mesh.inc\n", &mesh)
         .replacen(
             "*Step, name=preload",
-            "*Amplitude, name=Ramp\n0., 0., 1., 1.\n*Elset, elset=left\n1, 2\n*Step, name=preload",
+            "*Amplitude, name=Ramp, time=total time\n0., 0., 1., 1.\n*Elset, elset=left\n1, 2\n*Step, name=preload",
             1,
         )
         .replacen(
@@ -532,6 +537,7 @@ fn concentrated_loads_gravity_and_amplitudes_map_onto_the_model() {
         vec![AmplitudeSpec {
             name: "Ramp".into(),
             points: vec![[0.0, 0.0], [1.0, 1.0]],
+            time: AmplitudeTime::Total,
         }]
     );
     assert_eq!(m.part.node_sets["cload-1"], vec![0]);

@@ -347,7 +347,7 @@ fn every_load_error_names_its_field() {
         (
             r#"amplitudes[0].points=[[-1.0, 0.0]]"#,
             "amplitudes[0].points[0]",
-            "expected a step time >= 0",
+            "expected a time >= 0",
         ),
         (
             r#"amplitudes[0].points=[]"#,

@@ -3,9 +3,10 @@
 //! `OP=MOD|NEW` and `AMPLITUDE=`.
 //!
 //! How skid reads what the keywords leave open:
-//! - an amplitude is `DEFINITION=TABULAR` read against the step time (`TIME=STEP TIME`), the
-//!   keyword's defaults; a static step's step time runs from 0 to 1 (skid's static steps have
-//!   a time period of 1);
+//! - an amplitude is `DEFINITION=TABULAR`, read against the step time (`TIME=STEP TIME`, the
+//!   default) or the total time (`TIME=TOTAL TIME`); a static step's step time runs from 0 to
+//!   the time period of its `*STATIC` line, and the total time adds the time periods of the
+//!   steps before;
 //! - `GRAV` takes the direction components as a direction: the acceleration is the magnitude
 //!   times the unit vector; without an element set it acts on the whole model (the part and
 //!   every rigid body's point mass);
@@ -16,6 +17,7 @@
 use super::fields::{allow_parameters, at_most, field, key, label, line_error, real, valued};
 use super::keywords::{Block, DeckError, Location};
 use super::read::{Definitions, Named};
+use crate::model_spec::AmplitudeTime;
 
 /// A distributed pressure: on a surface (`*DSLOAD`) or on face `k` of elements (`*DLOAD`).
 #[derive(Clone, Debug)]
@@ -87,8 +89,14 @@ pub struct LoadChange {
     pub items: Vec<LoadDef>,
 }
 
-/// A `*AMPLITUDE` table: `(time, factor)` points.
-pub type AmplitudeDef = Vec<(f64, f64)>;
+/// A `*AMPLITUDE` table: `(time, factor)` points, and the time they are read against.
+#[derive(Clone, Debug)]
+pub struct AmplitudeDef {
+    /// The points.
+    pub points: Vec<(f64, f64)>,
+    /// `TIME=STEP TIME` (the default) or `TIME=TOTAL TIME`.
+    pub time: AmplitudeTime,
+}
 
 /// Reads a `*AMPLITUDE` block: `t1, a1, t2, a2, ...`, up to four pairs a line, times from 0
 /// and increasing.
@@ -100,16 +108,22 @@ pub fn read_amplitude(block: &Block) -> Result<Named<AmplitudeDef>, DeckError> {
     let name = valued(block, "NAME")?
         .ok_or_else(|| block.error("parameter NAME is required"))?
         .to_string();
-    for (parameter, default) in [("DEFINITION", "TABULAR"), ("TIME", "STEP TIME")] {
-        if let Some(v) = valued(block, parameter)?
-            && !v.eq_ignore_ascii_case(default)
-        {
-            return Err(block.error(format!(
-                "{parameter}={v}: skid reads {parameter}={default} only"
-            )));
-        }
+    if let Some(v) = valued(block, "DEFINITION")?
+        && !v.eq_ignore_ascii_case("TABULAR")
+    {
+        return Err(block.error(format!(
+            "DEFINITION={v}: skid reads DEFINITION=TABULAR only"
+        )));
     }
-    let mut points: AmplitudeDef = Vec::new();
+    let time = match valued(block, "TIME")? {
+        None => AmplitudeTime::Step,
+        Some(v) if v.eq_ignore_ascii_case("STEP TIME") => AmplitudeTime::Step,
+        Some(v) if v.eq_ignore_ascii_case("TOTAL TIME") => AmplitudeTime::Total,
+        Some(v) => {
+            return Err(block.error(format!("TIME={v}: expected STEP TIME or TOTAL TIME")));
+        }
+    };
+    let mut points = Vec::new();
     for line in &block.data {
         at_most(block, line, 8)?;
         if line.fields.len() % 2 != 0 {
@@ -123,7 +137,7 @@ pub fn read_amplitude(block: &Block) -> Result<Named<AmplitudeDef>, DeckError> {
                     return Err(line_error(
                         block,
                         line,
-                        format!("time {t}: the step time starts at 0"),
+                        format!("time {t}: the step and total times start at 0"),
                     ));
                 }
                 Some(&(before, _)) if t <= before => {
@@ -142,7 +156,7 @@ pub fn read_amplitude(block: &Block) -> Result<Named<AmplitudeDef>, DeckError> {
     }
     Ok(Named {
         name,
-        value: points,
+        value: AmplitudeDef { points, time },
         location: block.location.clone(),
     })
 }

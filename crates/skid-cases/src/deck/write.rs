@@ -21,8 +21,8 @@ use skid_fem::tetra::TetMesh;
 
 use super::mesh::ElementKind;
 use crate::model_spec::{
-    BoundarySpec, Dof, LoadSpec, ModelSpec, ModelStepSpec, RigidBodySpec, RigidSurfaceSpec,
-    SlaveSpec,
+    AmplitudeTime, BoundarySpec, Dof, LoadSpec, ModelSpec, ModelStepSpec, RigidBodySpec,
+    RigidSurfaceSpec, SlaveSpec,
 };
 use crate::schema::{MaterialSpec, default_regularization_time};
 
@@ -302,7 +302,11 @@ pub fn write_deck(
     }
 
     for amplitude in &spec.amplitudes {
-        let _ = writeln!(out, "**\n*AMPLITUDE, NAME={}", amplitude.name);
+        let time = match amplitude.time {
+            AmplitudeTime::Step => "",
+            AmplitudeTime::Total => ", TIME=TOTAL TIME",
+        };
+        let _ = writeln!(out, "**\n*AMPLITUDE, NAME={}{time}", amplitude.name);
         for chunk in amplitude.points.chunks(4) {
             let _ = writeln!(
                 out,
@@ -323,15 +327,18 @@ pub fn write_deck(
             ModelStepSpec::Static {
                 increments,
                 regularization_time,
+                time_period,
                 ..
             } => {
                 if *regularization_time != default_regularization_time() {
                     return Err(format!("steps[{i}].regularization_time has no keyword"));
                 }
+                let period = time_period.unwrap_or(1.0);
                 let _ = writeln!(
                     out,
-                    "*STATIC, DIRECT\n{}, 1.0",
-                    num(1.0 / *increments as f64)
+                    "*STATIC, DIRECT\n{}, {}",
+                    num(period / *increments as f64),
+                    num(period)
                 );
             }
             ModelStepSpec::Dynamic {

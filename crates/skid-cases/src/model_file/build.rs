@@ -727,12 +727,16 @@ fn step<const D: usize>(
         ModelStepSpec::Static {
             increments,
             regularization_time,
+            time_period,
             ..
         } => {
             if *increments == 0 {
                 return fail(f("increments"), "expected at least 1");
             }
             positive(&f("regularization_time"), *regularization_time)?;
+            if let Some(period) = time_period {
+                positive(&f("time_period"), *period)?;
+            }
             StepKind::Static {
                 increments: *increments,
                 regularization_time: *regularization_time,

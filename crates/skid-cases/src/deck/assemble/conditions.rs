@@ -1,10 +1,10 @@
 //! Boundary conditions of a deck (model data on bodies and part nodes, changes per step) and
 //! its steps with their loads.
 
-use super::loads::{InForce, amplitude_name, amplitude_spec, apply_loads, model_loads};
+use super::loads::{Given, InForce, amplitude_name, amplitude_spec, apply_loads, model_loads};
 use super::motions::{Held, HeldInStep, Holder, prescribed_motions};
 use super::*;
-use crate::model_spec::AmplitudeSpec;
+use crate::model_spec::{AmplitudeSpec, AmplitudeTime};
 
 pub(super) fn apply_model_boundary(
     defs: &Definitions,
@@ -155,7 +155,7 @@ pub(super) fn steps(
         return Err(error(deck, "the deck has no *STEP"));
     }
     let mut held = HeldInStep::new();
-    let mut loads_in_force: Vec<InForce> = Vec::new();
+    let mut loads_in_force: Vec<Given> = Vec::new();
     let mut per_step = Vec::new();
     let mut held_per_step = Vec::new();
     for (i, step) in defs.steps.iter().enumerate() {
@@ -166,12 +166,35 @@ pub(super) fn steps(
             ));
         }
         for change in &step.boundary {
-            apply_step_boundary(defs, part, bodies, change, &mut held)?;
+            apply_step_boundary(defs, (part, bodies), (i, change), &mut held)?;
         }
         for change in &step.loads {
-            apply_loads(defs, part, bodies, part_spec, change, &mut loads_in_force)?;
+            apply_loads(
+                defs,
+                (part, bodies),
+                part_spec,
+                (i, change),
+                &mut loads_in_force,
+            )?;
         }
-        per_step.push(loads_in_force.clone());
+        for given in &loads_in_force {
+            if let Some(name) = given.load.amplitude() {
+                check_carried(defs, name, (given.step, i), "load", &given.location)?;
+            }
+        }
+        for dofs in held.values() {
+            for h in dofs.values() {
+                if let Some(name) = &h.amplitude {
+                    check_carried(defs, name, (h.step, i), "prescribed motion", &h.location)?;
+                }
+            }
+        }
+        per_step.push(
+            loads_in_force
+                .iter()
+                .map(|g| g.load.clone())
+                .collect::<Vec<InForce>>(),
+        );
         held_per_step.push(held.clone());
     }
     let prescribed = prescribed_motions(
@@ -234,9 +257,8 @@ pub(super) fn steps(
 /// nodes and part nodes.
 pub(super) fn apply_step_boundary(
     defs: &Definitions,
-    part: &Part,
-    bodies: &[Body],
-    change: &Change<BoundaryDef>,
+    (part, bodies): (&Part, &[Body]),
+    (step, change): (usize, &Change<BoundaryDef>),
     held: &mut HeldInStep,
 ) -> Result<(), DeckError> {
     if change.replace {
@@ -275,6 +297,7 @@ pub(super) fn apply_step_boundary(
                         magnitude: bc.magnitude,
                         amplitude: amplitude.clone(),
                         target: bc.target.clone(),
+                        step,
                         location: bc.location.clone(),
                     },
                 );
@@ -282,6 +305,73 @@ pub(super) fn apply_step_boundary(
         }
     }
     Ok(())
+}
+
+/// The time period of step `k` of the deck (that of its procedure line; 1 without one, which
+/// is refused elsewhere).
+fn step_period(defs: &Definitions, k: usize) -> f64 {
+    match defs.steps[k].procedure {
+        Some((Procedure::Static { period, .. } | Procedure::Dynamic { period, .. }, _)) => period,
+        None => 1.0,
+    }
+}
+
+/// Refuses a load or prescribed motion (`what`, at `location`) that follows the amplitude
+/// `name` read against the step time, was given in step `given` and is carried into step
+/// `step` without being given there, unless the amplitude holds its value at the end of step
+/// `given` over the whole of step `step`. Abaqus holds such a load at that value; the model
+/// reads every amplitude afresh in each step, so the two differ unless the amplitude is
+/// constant there. A total-time amplitude runs on and needs no check.
+fn check_carried(
+    defs: &Definitions,
+    name: &str,
+    (given, step): (usize, usize),
+    what: &str,
+    location: &Location,
+) -> Result<(), DeckError> {
+    let Some(amplitude) = defs.amplitudes.get(&key(name)) else {
+        return Ok(());
+    };
+    if given == step || amplitude.value.time == AmplitudeTime::Total {
+        return Ok(());
+    }
+    let points = &amplitude.value.points;
+    let at = |t: f64| {
+        let after = points.partition_point(|&(tk, _)| tk <= t);
+        match (after.checked_sub(1), points.get(after)) {
+            (None, _) => points[0].1,
+            (Some(k), None) => points[k].1,
+            (Some(k), Some(&(t1, a1))) => {
+                let (t0, a0) = points[k];
+                a0 + (a1 - a0) * (t - t0) / (t1 - t0)
+            }
+        }
+    };
+    let held = at(step_period(defs, given));
+    let period = step_period(defs, step);
+    let holds = at(0.0) == held
+        && at(period) == held
+        && points
+            .iter()
+            .filter(|&&(t, _)| t > 0.0 && t < period)
+            .all(|&(_, a)| a == held);
+    if holds {
+        return Ok(());
+    }
+    Err(error(
+        location,
+        format!(
+            "this {what} follows AMPLITUDE={name}, read against the step time, and is carried \
+             into step {} ({}) without being given there: Abaqus holds it at its value at the \
+             end of step {} ({}), which skid's model cannot express; define {name} with \
+             TIME=TOTAL TIME, or give the {what} again in step {}",
+            step + 1,
+            defs.steps[step].name,
+            given + 1,
+            defs.steps[given].name,
+            step + 1
+        ),
+    ))
 }
 
 pub(super) fn step_spec(
@@ -314,6 +404,7 @@ pub(super) fn step_spec(
                 name: step.name.clone(),
                 increments: increments as usize,
                 regularization_time: default_regularization_time(),
+                time_period: (*period != 1.0).then_some(*period),
                 boundary,
             }
         }

@@ -38,6 +38,15 @@ pub(super) enum InForce {
 }
 
 impl InForce {
+    /// The amplitude it follows, by name.
+    pub fn amplitude(&self) -> Option<&str> {
+        match self {
+            Self::Pressure { amplitude, .. }
+            | Self::Concentrated { amplitude, .. }
+            | Self::Gravity { amplitude, .. } => amplitude.as_deref(),
+        }
+    }
+
     fn keyword(&self) -> &'static str {
         match self {
             Self::Pressure { keyword, .. } => keyword,
@@ -73,20 +82,32 @@ impl InForce {
     }
 }
 
-/// Applies one load keyword block of a step to the loads in force: `OP=NEW` first drops those
-/// of its keyword, then each line replaces the load at its place or adds one.
+/// A load in force and where it was last given: the step (from 0) and the line.
+#[derive(Clone, Debug)]
+pub(super) struct Given {
+    pub load: InForce,
+    pub step: usize,
+    pub location: Location,
+}
+
+/// Applies one load keyword block of step `step` to the loads in force: `OP=NEW` first drops
+/// those of its keyword, then each line replaces the load at its place or adds one.
 pub(super) fn apply_loads(
     defs: &Definitions,
-    part: &Part,
-    bodies: &[Body],
+    (part, bodies): (&Part, &[Body]),
     part_spec: &mut PartSpec,
-    change: &LoadChange,
-    in_force: &mut Vec<InForce>,
+    (step, change): (usize, &LoadChange),
+    in_force: &mut Vec<Given>,
 ) -> Result<(), DeckError> {
     if change.replace {
-        in_force.retain(|l| l.keyword() != change.keyword);
+        in_force.retain(|l| l.load.keyword() != change.keyword);
     }
     for load in &change.items {
+        let location = match &load.kind {
+            LoadKind::Pressure(p) => p.location.clone(),
+            LoadKind::Concentrated(c) => c.location.clone(),
+            LoadKind::Gravity(g) => g.location.clone(),
+        };
         let amplitude = load
             .amplitude
             .as_deref()
@@ -138,9 +159,14 @@ pub(super) fn apply_loads(
                 }
             }
         };
-        match in_force.iter_mut().find(|l| l.same_place(&resolved)) {
-            Some(existing) => *existing = resolved,
-            None => in_force.push(resolved),
+        let given = Given {
+            load: resolved,
+            step,
+            location,
+        };
+        match in_force.iter_mut().find(|l| l.load.same_place(&given.load)) {
+            Some(existing) => *existing = given,
+            None => in_force.push(given),
         }
     }
     Ok(())
@@ -448,14 +474,13 @@ pub(super) fn amplitude_name(defs: &Definitions, name: &str) -> String {
 
 /// The model's amplitude of the deck's `*AMPLITUDE` named `name`.
 pub(super) fn amplitude_spec(defs: &Definitions, name: &str) -> AmplitudeSpec {
-    let points = defs
-        .amplitudes
-        .get(&key(name))
-        .map(|a| a.value.iter().map(|&(t, v)| [t, v]).collect())
-        .unwrap_or_default();
+    let amplitude = defs.amplitudes.get(&key(name));
     AmplitudeSpec {
         name: name.to_string(),
-        points,
+        points: amplitude
+            .map(|a| a.value.points.iter().map(|&(t, v)| [t, v]).collect())
+            .unwrap_or_default(),
+        time: amplitude.map(|a| a.value.time).unwrap_or_default(),
     }
 }
 

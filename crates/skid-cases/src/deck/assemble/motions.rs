@@ -35,6 +35,8 @@ pub(super) struct Held {
     pub amplitude: Option<String>,
     /// The node or node set the line names.
     pub target: String,
+    /// The step (from 0) whose line gives it.
+    pub step: usize,
     pub location: Location,
 }
 

@@ -12,107 +12,7 @@ use skid_integrator::{
 };
 
 use super::{SpecError, fail, finite_point, vector3};
-use crate::model_spec::{AmplitudeSpec, Dof, LoadSpec, ModelSpec, ModelStepSpec};
-
-/// The amplitudes by name, each checked: a unique non-empty name, at least one point, finite
-/// times >= 0 that increase strictly, finite factors.
-pub(super) fn amplitudes(specs: &[AmplitudeSpec]) -> Result<BTreeMap<&str, Amplitude>, SpecError> {
-    let mut named = BTreeMap::new();
-    for (i, a) in specs.iter().enumerate() {
-        let f = |name: &str| format!("amplitudes[{i}].{name}");
-        if a.name.is_empty() || named.contains_key(a.name.as_str()) {
-            return fail(
-                f("name"),
-                format!("expected a unique non-empty name, got '{}'", a.name),
-            );
-        }
-        if let Some(k) = a.points.iter().position(|&[t, _]| t < 0.0) {
-            return fail(
-                format!("{}[{k}]", f("points")),
-                format!(
-                    "expected a step time >= 0, got {} (step time starts at 0)",
-                    a.points[k][0]
-                ),
-            );
-        }
-        let points = a.points.iter().map(|&[t, v]| (t, v)).collect();
-        let amplitude = Amplitude::new(points).map_err(|e| SpecError {
-            field: match e.point {
-                Some(k) => format!("{}[{k}]", f("points")),
-                None => f("points"),
-            },
-            message: e.message,
-        })?;
-        named.insert(a.name.as_str(), amplitude);
-    }
-    Ok(named)
-}
-
-/// The amplitude a load or motion names (`field`), if it names one.
-pub(super) fn amplitude_named(
-    named: &BTreeMap<&str, Amplitude>,
-    name: Option<&str>,
-    field: &str,
-) -> Result<Option<Amplitude>, SpecError> {
-    name.map(|name| {
-        named.get(name).cloned().ok_or_else(|| SpecError {
-            field: field.into(),
-            message: format!("no amplitude named '{name}'"),
-        })
-    })
-    .transpose()
-}
-
-/// How a load with `amplitude` and `step_factors` (`field`) varies over `steps` (see
-/// [`ModelSpec::loads`]): with factors `c_k`, `c_k A(t_s)` with an amplitude `A`; without one
-/// the ramp from `c_{k-1}` (`c_{-1} = 0`) to `c_k` over a static step and `c_k` throughout a
-/// dynamic one. Without factors, the amplitude in every step, or the default ramp.
-pub(super) fn variation(
-    amplitude: Option<Amplitude>,
-    step_factors: Option<&[f64]>,
-    steps: &[ModelStepSpec],
-    field: &str,
-) -> Result<Variation, SpecError> {
-    let Some(factors) = step_factors else {
-        return Ok(amplitude.map_or(Variation::Ramp, Variation::Amplitude));
-    };
-    if factors.len() != steps.len() {
-        return fail(
-            field,
-            format!(
-                "expected one factor per step ({} steps), got {}",
-                steps.len(),
-                factors.len()
-            ),
-        );
-    }
-    if let Some(k) = factors.iter().position(|c| !c.is_finite()) {
-        return fail(
-            format!("{field}[{k}]"),
-            format!("expected a finite number, got {}", factors[k]),
-        );
-    }
-    let mut previous = 0.0;
-    let per_step = factors
-        .iter()
-        .zip(steps)
-        .map(|(&c, step)| {
-            let from = match step {
-                ModelStepSpec::Static { .. } => previous,
-                ModelStepSpec::Dynamic { .. } => c,
-            };
-            previous = c;
-            match &amplitude {
-                Some(a) => StepVariation::Amplitude {
-                    amplitude: a.clone(),
-                    scale: c,
-                },
-                None => StepVariation::Ramp { from, to: c },
-            }
-        })
-        .collect();
-    Ok(Variation::PerStep(per_step))
-}
+use crate::model_spec::{AmplitudeSpec, AmplitudeTime, Dof, LoadSpec, ModelSpec, ModelStepSpec};
 
 /// Checks that every element of every element set exists (`elements` of them).
 pub(super) fn check_element_sets(spec: &ModelSpec, elements: usize) -> Result<(), SpecError> {
@@ -158,6 +58,214 @@ fn body_moment<const D: usize>(
     Ok(m)
 }
 
+/// An amplitude of the model file with the time it is read against.
+#[derive(Clone, Debug)]
+pub(super) struct TimedAmplitude {
+    amplitude: Amplitude,
+    time: AmplitudeTime,
+}
+
+/// The amplitudes by name, each checked: a unique non-empty name, at least one point, finite
+/// times >= 0 that increase strictly, finite factors.
+pub(super) fn amplitudes(
+    specs: &[AmplitudeSpec],
+) -> Result<BTreeMap<&str, TimedAmplitude>, SpecError> {
+    let mut named = BTreeMap::new();
+    for (i, a) in specs.iter().enumerate() {
+        let f = |name: &str| format!("amplitudes[{i}].{name}");
+        if a.name.is_empty() || named.contains_key(a.name.as_str()) {
+            return fail(
+                f("name"),
+                format!("expected a unique non-empty name, got '{}'", a.name),
+            );
+        }
+        if let Some(k) = a.points.iter().position(|&[t, _]| t < 0.0) {
+            return fail(
+                format!("{}[{k}]", f("points")),
+                format!(
+                    "expected a time >= 0, got {} (step and total time start at 0)",
+                    a.points[k][0]
+                ),
+            );
+        }
+        let points = a.points.iter().map(|&[t, v]| (t, v)).collect();
+        let amplitude = Amplitude::new(points).map_err(|e| SpecError {
+            field: match e.point {
+                Some(k) => format!("{}[{k}]", f("points")),
+                None => f("points"),
+            },
+            message: e.message,
+        })?;
+        named.insert(
+            a.name.as_str(),
+            TimedAmplitude {
+                amplitude,
+                time: a.time,
+            },
+        );
+    }
+    Ok(named)
+}
+
+/// The amplitude a load or motion names (`field`), if it names one.
+pub(super) fn amplitude_named(
+    named: &BTreeMap<&str, TimedAmplitude>,
+    name: Option<&str>,
+    field: &str,
+) -> Result<Option<TimedAmplitude>, SpecError> {
+    name.map(|name| {
+        named.get(name).cloned().ok_or_else(|| SpecError {
+            field: field.into(),
+            message: format!("no amplitude named '{name}'"),
+        })
+    })
+    .transpose()
+}
+
+/// The time period of each step (a dynamic step's duration, a static step's `time_period`, 1
+/// by default) and the total time at its start.
+///
+/// # Errors
+/// A time period that is not a finite number > 0.
+fn step_periods(steps: &[ModelStepSpec]) -> Result<Vec<(f64, f64)>, SpecError> {
+    let mut start = 0.0;
+    let mut periods = Vec::with_capacity(steps.len());
+    for (k, step) in steps.iter().enumerate() {
+        let period = match step {
+            ModelStepSpec::Static { time_period, .. } => time_period.unwrap_or(1.0),
+            ModelStepSpec::Dynamic { duration, .. } => *duration,
+        };
+        if !(period.is_finite() && period > 0.0) {
+            let field = match step {
+                ModelStepSpec::Static { .. } => "time_period",
+                ModelStepSpec::Dynamic { .. } => "duration",
+            };
+            return fail(
+                format!("steps[{k}].{field}"),
+                format!("expected a finite value > 0, got {period}"),
+            );
+        }
+        periods.push((period, start));
+        start += period;
+    }
+    Ok(periods)
+}
+
+/// `a` as the solver reads it in step `step` of `steps` with `periods` (see [`step_periods`]):
+/// against the solver's step time `s` (s in a dynamic step, the completed fraction of a static
+/// one), `a(t_0 + c s)`, `t_0` the total time at the step's start for a total-time amplitude
+/// (0 otherwise) and `c` the time period of a static step (1 in a dynamic one). A
+/// piecewise-linear table transforms exactly: its times become `(t_k - t_0) / c`. `None` if
+/// `a` is read unchanged (`t_0 = 0`, `c = 1`).
+fn in_step(
+    a: &TimedAmplitude,
+    step: &ModelStepSpec,
+    (period, start): (f64, f64),
+    field: &str,
+) -> Result<Option<Amplitude>, SpecError> {
+    let offset = match a.time {
+        AmplitudeTime::Step => 0.0,
+        AmplitudeTime::Total => start,
+    };
+    let scale = match step {
+        ModelStepSpec::Static { .. } => period,
+        ModelStepSpec::Dynamic { .. } => 1.0,
+    };
+    if offset == 0.0 && scale == 1.0 {
+        return Ok(None);
+    }
+    let points = a
+        .amplitude
+        .points()
+        .iter()
+        .map(|&(t, v)| ((t - offset) / scale, v))
+        .collect();
+    Amplitude::new(points).map(Some).map_err(|e| SpecError {
+        field: field.into(),
+        message: format!("the amplitude read in this step: {e}"),
+    })
+}
+
+/// How a load with `amplitude` and `step_factors` (`field`) varies over `steps` (see
+/// [`ModelSpec::loads`]): with factors `c_k`, `c_k A(t)` with an amplitude `A` (read as
+/// [`in_step`] says); without one the ramp from `c_{k-1}` (`c_{-1} = 0`) to `c_k` over a static
+/// step and `c_k` throughout a dynamic one. Without factors, the amplitude in every step, or
+/// the default ramp.
+pub(super) fn variation(
+    amplitude: Option<TimedAmplitude>,
+    step_factors: Option<&[f64]>,
+    steps: &[ModelStepSpec],
+    field: &str,
+) -> Result<Variation, SpecError> {
+    let periods = step_periods(steps)?;
+    let read = |a: &TimedAmplitude| -> Result<Vec<Option<Amplitude>>, SpecError> {
+        steps
+            .iter()
+            .zip(&periods)
+            .map(|(step, &p)| in_step(a, step, p, field))
+            .collect()
+    };
+    let Some(factors) = step_factors else {
+        return Ok(match amplitude {
+            None => Variation::Ramp,
+            Some(a) => {
+                let per_step = read(&a)?;
+                if per_step.iter().all(Option::is_none) {
+                    Variation::Amplitude(a.amplitude)
+                } else {
+                    Variation::PerStep(
+                        per_step
+                            .into_iter()
+                            .map(|read| StepVariation::Amplitude {
+                                amplitude: read.unwrap_or_else(|| a.amplitude.clone()),
+                                scale: 1.0,
+                            })
+                            .collect(),
+                    )
+                }
+            }
+        });
+    };
+    if factors.len() != steps.len() {
+        return fail(
+            field,
+            format!(
+                "expected one factor per step ({} steps), got {}",
+                steps.len(),
+                factors.len()
+            ),
+        );
+    }
+    if let Some(k) = factors.iter().position(|c| !c.is_finite()) {
+        return fail(
+            format!("{field}[{k}]"),
+            format!("expected a finite number, got {}", factors[k]),
+        );
+    }
+    let read = amplitude.as_ref().map(read).transpose()?;
+    let mut previous = 0.0;
+    let per_step = factors
+        .iter()
+        .zip(steps)
+        .enumerate()
+        .map(|(k, (&c, step))| {
+            let from = match step {
+                ModelStepSpec::Static { .. } => previous,
+                ModelStepSpec::Dynamic { .. } => c,
+            };
+            previous = c;
+            match (&amplitude, &read) {
+                (Some(a), Some(read)) => StepVariation::Amplitude {
+                    amplitude: read[k].clone().unwrap_or_else(|| a.amplitude.clone()),
+                    scale: c,
+                },
+                _ => StepVariation::Ramp { from, to: c },
+            }
+        })
+        .collect();
+    Ok(Variation::PerStep(per_step))
+}
+
 /// Every load of `spec`, resolved and checked, given the model's amplitudes by name.
 ///
 /// # Errors
@@ -166,7 +274,7 @@ pub(super) fn loads<const D: usize>(
     spec: &ModelSpec,
     mesh: &SolidMesh<D>,
     bodies: &[RigidBody<D>],
-    named: &BTreeMap<&str, Amplitude>,
+    named: &BTreeMap<&str, TimedAmplitude>,
     body_of: &impl Fn(&str, &str) -> Result<usize, SpecError>,
 ) -> Result<Loads<D>, SpecError> {
     let mut loads = Loads::default();

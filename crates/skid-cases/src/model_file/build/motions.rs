@@ -6,9 +6,9 @@ use std::collections::BTreeMap;
 
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
-use skid_integrator::{Amplitude, BodyMotion, MotionTarget, PrescribedMotion};
+use skid_integrator::{BodyMotion, MotionTarget, PrescribedMotion};
 
-use super::loads::{amplitude_named, variation};
+use super::loads::{TimedAmplitude, amplitude_named, variation};
 use super::{SpecError, fail};
 use crate::model_spec::ModelSpec;
 
@@ -24,7 +24,7 @@ pub(super) fn prescribed_motions<const D: usize>(
     spec: &ModelSpec,
     mesh: &SolidMesh<D>,
     bodies: &[RigidBody<D>],
-    amplitudes: &BTreeMap<&str, Amplitude>,
+    amplitudes: &BTreeMap<&str, TimedAmplitude>,
     body_of: &impl Fn(&str, &str) -> Result<usize, SpecError>,
 ) -> Result<Vec<(usize, Vec<PrescribedMotion>)>, SpecError> {
     let mut motions = Vec::new();
