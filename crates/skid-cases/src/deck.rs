@@ -16,7 +16,7 @@
 //! `*CONTACT` with `*CONTACT INCLUSIONS, ALL EXTERIOR` and `*CONTACT PROPERTY ASSIGNMENT`,
 //! `*BOUNDARY` (OP=MOD/NEW and, on rigid bodies and part nodes, magnitudes with AMPLITUDE= in
 //! steps: see `assemble::motions`), `*INITIAL CONDITIONS` (VELOCITY, ROTATING VELOCITY),
-//! `*AMPLITUDE` (TABULAR, step or total time), `*STEP` (NLGEOM), `*STATIC` and `*DYNAMIC` (DIRECT,
+//! `*AMPLITUDE` (TABULAR, step or total time), `*STEP` (NLGEOM, AMPLITUDE=RAMP|STEP), `*STATIC` and `*DYNAMIC` (DIRECT,
 //! ALPHA), `*CLOAD`, `*DSLOAD` / `*DLOAD` pressures and `*DLOAD` gravity (`GRAV`), each with
 //! `AMPLITUDE=`, `*OUTPUT`, `*NODE OUTPUT`, `*CONTACT OUTPUT`,
 //! `*END STEP`, `*INCLUDE`. Anything else is an error at its line.
@@ -28,7 +28,8 @@
 //! - a load given in a step stays in force in later steps until a line at its place changes it
 //!   (`OP=MOD`) or `OP=NEW` removes it; without amplitude it goes linearly over a static step
 //!   from its value at the end of the previous step to the new one (from 0 in the first step;
-//!   a removed load to 0), and takes the new value at once in a dynamic step; with one, it is
+//!   a removed load to 0), and takes the new value at once in a dynamic step (the
+//!   procedures' defaults; `*STEP, AMPLITUDE=` turns either way round); with one, it is
 //!   its value in the step times the amplitude at the step or total time (a static step's step
 //!   time runs from 0 to the period of its `*STATIC` line). A load or motion carried into a
 //!   later step with a step-time amplitude that does not hold its end value there is refused:

@@ -201,6 +201,7 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
                 increments: *increments,
                 regularization_time: *regularization_time,
                 time_period: None,
+                default_amplitude: None,
                 boundary: hold(held),
             },
             StepSpec::Dynamic {
@@ -217,6 +218,7 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
                 alpha: *alpha,
                 boundary: hold(held),
                 adaptive: *adaptive,
+                default_amplitude: None,
             },
         })
         .collect();

@@ -529,6 +529,10 @@ pub enum ModelStepSpec {
         /// to end, and the total time advances by it.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         time_period: Option<f64>,
+        /// How loads and prescribed motions without an amplitude vary over the step (absent:
+        /// `ramp`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        default_amplitude: Option<DefaultAmplitude>,
         /// Rigid-body degrees of freedom held during the step (absent `dofs`: all).
         #[serde(default)]
         boundary: Vec<StepBoundarySpec>,
@@ -550,7 +554,48 @@ pub enum ModelStepSpec {
         /// Error-controlled increments (absent: `dt` throughout).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         adaptive: Option<AdaptiveSpec>,
+        /// How loads and prescribed motions without an amplitude vary over the step (absent:
+        /// `step`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        default_amplitude: Option<DefaultAmplitude>,
     },
+}
+
+impl ModelStepSpec {
+    /// Whether loads and prescribed motions without an amplitude go linearly over the step from
+    /// their value at the end of the previous one (a ramp), rather than take their value at
+    /// once (a step): `default_amplitude`, or by default a ramp in a static step and a step in
+    /// a dynamic one.
+    pub fn ramps(&self) -> bool {
+        match self {
+            Self::Static {
+                default_amplitude, ..
+            } => *default_amplitude != Some(DefaultAmplitude::Step),
+            Self::Dynamic {
+                default_amplitude, ..
+            } => *default_amplitude == Some(DefaultAmplitude::Ramp),
+        }
+    }
+
+    /// Whether the step sets `default_amplitude` to something other than its procedure's
+    /// default.
+    pub fn departs_from_default_amplitude(&self) -> bool {
+        match self {
+            Self::Static { .. } => !self.ramps(),
+            Self::Dynamic { .. } => self.ramps(),
+        }
+    }
+}
+
+/// How loads and prescribed motions without an amplitude vary over a step.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, JsonSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum DefaultAmplitude {
+    /// Linearly over the step, from the value at the end of the previous step (0 before the
+    /// first) to the step's.
+    Ramp,
+    /// The step's value at once, from the step's start.
+    Step,
 }
 
 /// Degrees of freedom of a rigid body held at their value at the start of a step.

@@ -18,7 +18,7 @@ use skid_cases::deck::write::write_deck;
 use skid_cases::model_file::{self, parse_model};
 use skid_cases::model_spec::{AmplitudeTime, ModelSpec, ModelStepSpec};
 use skid_integrator::stepper::{IncrementReport, Observer, run};
-use skid_integrator::{Model, State};
+use skid_integrator::{LoadInstant, Model, State};
 
 fn dragged_block(overrides: &[&str]) -> ModelSpec {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -203,4 +203,57 @@ fn a_step_time_amplitude_carried_into_a_later_step_is_refused_at_its_line() {
         &plate_motion(&shipped),
         "the press ramped by a total-time amplitude",
     );
+}
+
+/// A step's default amplitude: the drag step with `default_amplitude` `step` moves the plate
+/// the whole 1 mm in its first increment and holds it there (its step factor 1 at once),
+/// while the press, which still ramps, is unchanged; a deck says so with `*STEP,
+/// AMPLITUDE=STEP`, which reads to the same model, and the writer writes it back.
+#[test]
+fn a_step_that_applies_its_loads_at_once_moves_the_plate_in_its_first_increment() {
+    let ramped = plate_motion(&dragged_block(&[]));
+    let at_once = dragged_block(&["steps[1].default_amplitude=\"step\""]);
+    let motion = plate_motion(&at_once);
+    assert_eq!(motion.len(), ramped.len());
+    // the initial state and the 4 increments of the press, then the drag
+    for (k, ((x, _), (x_ramped, _))) in motion.iter().zip(&ramped).enumerate() {
+        if k <= 4 {
+            assert_eq!(x, x_ramped, "increment {k}: the press is unchanged");
+        } else {
+            assert_eq!(*x, 1e-3, "increment {k}: the drag applied at once");
+        }
+    }
+    let deck = dragged_block(&[
+        "steps[1].default_amplitude=\"step\"",
+        "part.section.quasi_static=false",
+    ]);
+    let text = write_deck(&deck, &Default::default()).expect("the writer writes it");
+    assert!(
+        text.contains("*STEP, NAME=drag, NLGEOM=YES, AMPLITUDE=STEP\n"),
+        "{text}"
+    );
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("at-once.inp");
+    std::fs::write(&path, &text).expect("write deck");
+    let read = read_model(&path).expect("the written deck reads").model;
+    assert_eq!(read.steps, deck.steps);
+}
+
+/// A dynamic step takes its loads and motions at once by default; with `default_amplitude`
+/// `ramp` they go linearly over it from their value at the end of the previous step.
+#[test]
+fn a_dynamic_step_with_a_ramp_takes_its_motions_linearly() {
+    let drag = r#"steps[1]={"type": "dynamic", "name": "drag", "duration": 0.01, "dt": 0.001}"#;
+    let ramp = r#"steps[1]={"type": "dynamic", "name": "drag", "duration": 0.01, "dt": 0.001, "default_amplitude": "ramp"}"#;
+    let halfway = LoadInstant {
+        ramp: 1.0,
+        step_time: 0.005,
+        step: 1,
+        fraction: 0.5,
+    };
+    for (set, expected) in [(drag, 1e-3), (ramp, 0.5e-3)] {
+        let scene = model_file::build::<2>(&dragged_block(&[set])).expect("scene builds");
+        let (_, motion) = &scene.model.prescribed()[0];
+        assert_eq!(motion.at(&halfway), expected, "{set}");
+    }
 }

@@ -209,7 +209,7 @@ fn variant(from: &str, to: &str) -> Result<skid_cases::deck::DeckModel, String> 
 
 #[test]
 fn keywords_parameters_and_values_outside_the_subset_are_errors_at_their_line() {
-    let cases: [(&str, &str, &[&str]); 18] = [
+    let cases: [(&str, &str, &[&str]); 19] = [
         (
             "*Density\n",
             "*Plastic\n 1.\n*Density\n",
@@ -270,6 +270,11 @@ fn keywords_parameters_and_values_outside_the_subset_are_errors_at_their_line() 
             "*Step, name=preload",
             "*Amplitude, name=ramp\n0., 0., 1., 1., 0.5, 2.\n*Step, name=preload",
             &["*AMPLITUDE", "time 0.5 after 1: the times must increase"],
+        ),
+        (
+            "*Step, name=preload",
+            "*Step, amplitude=smooth, name=preload",
+            &["*STEP", "AMPLITUDE=smooth: expected RAMP or STEP"],
         ),
         (
             "*Step, name=preload",

@@ -11,6 +11,7 @@ use super::keywords::{Block, DeckError, Location};
 use super::loads::{AmplitudeDef, LoadChange, defined_amplitude, read_amplitude, read_load_block};
 use super::mesh::Mesh;
 use super::rigid::{AnalyticalKind, AnalyticalSurface, read_analytical};
+use crate::model_spec::DefaultAmplitude;
 use crate::schema::MaterialSpec;
 
 /// A face of an element-based surface.
@@ -192,6 +193,8 @@ pub struct StepDef {
     pub loads: Vec<LoadChange>,
     /// `NLGEOM` as given (`None`: absent).
     pub nlgeom: Option<bool>,
+    /// `AMPLITUDE=RAMP|STEP` as given (`None`: absent, the procedure's default).
+    pub default_amplitude: Option<DefaultAmplitude>,
     /// The step's `*OUTPUT, FIELD` requests that give an interval.
     pub field_output: Vec<FieldRequest>,
 }
@@ -940,13 +943,14 @@ fn read_initial(defs: &mut Definitions, block: &Block) -> Result<(), DeckError> 
 
 fn start_step(defs: &Definitions, block: &Block) -> Result<StepDef, DeckError> {
     allow_parameters(block, &["NAME", "NLGEOM", "INC", "AMPLITUDE"])?;
-    if let Some(amplitude) = valued(block, "AMPLITUDE")? {
-        return Err(block.error(format!(
-            "AMPLITUDE={amplitude}: skid ramps the loads without amplitude over a static step \
-             and applies them at once in a dynamic one; remove the parameter, or give the loads \
-             an AMPLITUDE"
-        )));
-    }
+    let default_amplitude = match valued(block, "AMPLITUDE")? {
+        None => None,
+        Some(a) if a.eq_ignore_ascii_case("RAMP") => Some(DefaultAmplitude::Ramp),
+        Some(a) if a.eq_ignore_ascii_case("STEP") => Some(DefaultAmplitude::Step),
+        Some(a) => {
+            return Err(block.error(format!("AMPLITUDE={a}: expected RAMP or STEP")));
+        }
+    };
     if let Some(inc) = valued(block, "INC")?
         && super::fields::parse_label(inc).is_none()
     {
@@ -965,6 +969,7 @@ fn start_step(defs: &Definitions, block: &Block) -> Result<StepDef, DeckError> {
         boundary: Vec::new(),
         loads: Vec::new(),
         nlgeom,
+        default_amplitude,
         field_output: Vec::new(),
     })
 }

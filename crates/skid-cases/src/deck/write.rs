@@ -21,8 +21,8 @@ use skid_fem::tetra::TetMesh;
 
 use super::mesh::ElementKind;
 use crate::model_spec::{
-    AmplitudeTime, BoundarySpec, Dof, LoadSpec, ModelSpec, ModelStepSpec, RigidBodySpec,
-    RigidSurfaceSpec, SlaveSpec,
+    AmplitudeTime, BoundarySpec, DefaultAmplitude, Dof, LoadSpec, ModelSpec, ModelStepSpec,
+    RigidBodySpec, RigidSurfaceSpec, SlaveSpec,
 };
 use crate::schema::{MaterialSpec, default_regularization_time};
 
@@ -322,7 +322,19 @@ pub fn write_deck(
             ModelStepSpec::Static { name, boundary, .. }
             | ModelStepSpec::Dynamic { name, boundary, .. } => (name, boundary),
         };
-        let _ = writeln!(out, "**\n*STEP, NAME={name}, NLGEOM=YES");
+        let default = match step {
+            ModelStepSpec::Static {
+                default_amplitude, ..
+            }
+            | ModelStepSpec::Dynamic {
+                default_amplitude, ..
+            } => match default_amplitude {
+                None => "",
+                Some(DefaultAmplitude::Ramp) => ", AMPLITUDE=RAMP",
+                Some(DefaultAmplitude::Step) => ", AMPLITUDE=STEP",
+            },
+        };
+        let _ = writeln!(out, "**\n*STEP, NAME={name}, NLGEOM=YES{default}");
         match step {
             ModelStepSpec::Static {
                 increments,

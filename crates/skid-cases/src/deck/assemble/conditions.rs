@@ -4,7 +4,7 @@
 use super::loads::{Given, InForce, amplitude_name, amplitude_spec, apply_loads, model_loads};
 use super::motions::{Held, HeldInStep, Holder, prescribed_motions};
 use super::*;
-use crate::model_spec::{AmplitudeSpec, AmplitudeTime};
+use crate::model_spec::{AmplitudeSpec, AmplitudeTime, DefaultAmplitude};
 
 pub(super) fn apply_model_boundary(
     defs: &Definitions,
@@ -405,6 +405,9 @@ pub(super) fn step_spec(
                 increments: increments as usize,
                 regularization_time: default_regularization_time(),
                 time_period: (*period != 1.0).then_some(*period),
+                default_amplitude: step
+                    .default_amplitude
+                    .filter(|&a| a == DefaultAmplitude::Step),
                 boundary,
             }
         }
@@ -415,6 +418,9 @@ pub(super) fn step_spec(
             alpha: *alpha,
             boundary,
             adaptive: None,
+            default_amplitude: step
+                .default_amplitude
+                .filter(|&a| a == DefaultAmplitude::Ramp),
         },
     })
 }

@@ -188,9 +188,10 @@ fn in_step(
 
 /// How a load with `amplitude` and `step_factors` (`field`) varies over `steps` (see
 /// [`ModelSpec::loads`]): with factors `c_k`, `c_k A(t)` with an amplitude `A` (read as
-/// [`in_step`] says); without one the ramp from `c_{k-1}` (`c_{-1} = 0`) to `c_k` over a static
-/// step and `c_k` throughout a dynamic one. Without factors, the amplitude in every step, or
-/// the default ramp.
+/// [`in_step`] says); without one the ramp from `c_{k-1}` (`c_{-1} = 0`) to `c_k` over a step
+/// that ramps ([`ModelStepSpec::ramps`]: by default a static one) and `c_k` throughout any
+/// other. Without factors, the amplitude in every step, or the default ramp (factors of 1 in
+/// every step if a step departs from its procedure's default amplitude).
 pub(super) fn variation(
     amplitude: Option<TimedAmplitude>,
     step_factors: Option<&[f64]>,
@@ -204,6 +205,20 @@ pub(super) fn variation(
             .zip(&periods)
             .map(|(step, &p)| in_step(a, step, p, field))
             .collect()
+    };
+    // without factors or amplitude, a step that departs from its procedure's default
+    // amplitude makes the default ramp a factor of 1 in every step, varied step by step
+    let unit_factors;
+    let step_factors = match step_factors {
+        None if amplitude.is_none()
+            && steps
+                .iter()
+                .any(ModelStepSpec::departs_from_default_amplitude) =>
+        {
+            unit_factors = vec![1.0; steps.len()];
+            Some(unit_factors.as_slice())
+        }
+        given => given,
     };
     let Some(factors) = step_factors else {
         return Ok(match amplitude {
@@ -249,10 +264,7 @@ pub(super) fn variation(
         .zip(steps)
         .enumerate()
         .map(|(k, (&c, step))| {
-            let from = match step {
-                ModelStepSpec::Static { .. } => previous,
-                ModelStepSpec::Dynamic { .. } => c,
-            };
+            let from = if step.ramps() { previous } else { c };
             previous = c;
             match (&amplitude, &read) {
                 (Some(a), Some(read)) => StepVariation::Amplitude {
