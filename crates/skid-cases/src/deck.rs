@@ -32,8 +32,8 @@
 //!   procedures' defaults; `*STEP, AMPLITUDE=` turns either way round); with one, it is
 //!   its value in the step times the amplitude at the step or total time (a static step's step
 //!   time runs from 0 to the period of its `*STATIC` line). A load or motion carried into a
-//!   later step with a step-time amplitude that does not hold its end value there is refused:
-//!   Abaqus holds it at that value, the model would restart the amplitude. The model's loads
+//!   later step with a step-time amplitude holds there the value the amplitude reached, as in
+//!   Abaqus (a total-time amplitude of its own, see `assemble::carried`). The model's loads
 //!   carry their factor in each step (see [`assemble`] and [`loads`] for gravity's direction
 //!   and `OP=NEW`);
 //! - `*DYNAMIC` without `ALPHA` takes the keyword's default `-0.05`;

@@ -10,13 +10,17 @@
 //!   (the press, of period 1, reads it from 0 to 1, where it is 0; the drag from 1 to 3);
 //! - the deck of that model, `*AMPLITUDE, TIME=TOTAL TIME` and `*STATIC` with period 2, which
 //!   reads to the same model and is what the deck writer writes of it.
+//!
+//! A deck's load or motion carried into a later step with a step-time amplitude holds there
+//! the value the amplitude reached, as Abaqus holds it; and a step may apply its loads at once
+//! or ramp them (`default_amplitude`, `*STEP, AMPLITUDE=`).
 
 use std::path::{Path, PathBuf};
 
 use skid_cases::deck::read_model;
 use skid_cases::deck::write::write_deck;
 use skid_cases::model_file::{self, parse_model};
-use skid_cases::model_spec::{AmplitudeTime, ModelSpec, ModelStepSpec};
+use skid_cases::model_spec::{AmplitudeSpec, AmplitudeTime, ModelSpec, ModelStepSpec};
 use skid_integrator::stepper::{IncrementReport, Observer, run};
 use skid_integrator::{LoadInstant, Model, State};
 
@@ -179,30 +183,75 @@ fn ramped_press_deck(time: &str) -> Result<ModelSpec, String> {
 }
 
 /// A load ramped by a step-time amplitude over the press and carried into the drag: Abaqus
-/// holds it at the amplitude's end value, which the model cannot say of a step-time amplitude
-/// (it reads the amplitude afresh in each step), so the deck is refused at the load's line; with
-/// `TIME=TOTAL TIME` the amplitude runs on at 1 through the drag, and the run is the shipped
-/// deck's, whose press is ramped by default and held.
+/// holds it at the amplitude's end value, so the deck reader gives it a total-time amplitude of
+/// its own, `ramp@1`, the press's table held after it; the run is that of the shipped deck,
+/// whose press is ramped by default and held, and that of the same deck with `TIME=TOTAL TIME`.
 #[test]
-fn a_step_time_amplitude_carried_into_a_later_step_is_refused_at_its_line() {
-    let refused = ramped_press_deck("").expect_err("a carried step-time ramp");
-    assert!(
-        // line 70: the first line of the *CLOAD block, two lines of *AMPLITUDE above it
-        refused.contains("deck.inp:70: this load follows AMPLITUDE=ramp")
-            && refused.contains("carried into step 2 (drag)")
-            && refused.contains("TIME=TOTAL TIME"),
-        "{refused}"
-    );
+fn a_step_time_amplitude_carried_into_a_later_step_holds_its_end_value() {
+    let carried = ramped_press_deck("").expect("a carried step-time ramp reads");
+    let frozen = AmplitudeSpec {
+        name: "ramp@1".into(),
+        points: vec![[0.0, 0.0], [1.0, 1.0]],
+        time: AmplitudeTime::Total,
+    };
+    assert_eq!(carried.amplitudes, [frozen]);
     let total = ramped_press_deck(", TIME=TOTAL TIME").expect("a total-time ramp reads");
     assert_eq!(total.amplitudes[0].time, AmplitudeTime::Total);
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../cases/verification/2d-block-dragged-on-flat-deck.inp");
-    let shipped = read_model(&path).expect("deck reads").model;
-    assert_same_motion(
-        &plate_motion(&total),
-        &plate_motion(&shipped),
-        "the press ramped by a total-time amplitude",
+    let shipped = plate_motion(&read_model(&path).expect("deck reads").model);
+    for (what, spec) in [("carried", &carried), ("total time", &total)] {
+        assert_same_motion(&plate_motion(spec), &shipped, what);
+    }
+    // the generated amplitude writes and reads back as it is
+    let text = write_deck(&carried, &Default::default()).expect("the writer writes it");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("written.inp");
+    std::fs::write(&path, &text).expect("write deck");
+    let again = read_model(&path).expect("the written deck reads").model;
+    assert_eq!(again.amplitudes, carried.amplitudes);
+    assert_eq!(again.loads, carried.loads);
+}
+
+/// A motion given in the second step with a step-time amplitude that ends short of its value
+/// (`(0, 0), (2, 1)` over a static step of period 1 reaches 0.5) and carried into a third
+/// step: held at half the travel there, through the amplitude `drag@2` = `(1, 0), (2, 0.5)`
+/// in the total time.
+#[test]
+fn a_motion_carried_into_a_third_step_holds_where_its_amplitude_left_it() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../cases/verification/2d-block-dragged-on-flat-deck.inp");
+    let text = std::fs::read_to_string(&path)
+        .expect("read deck")
+        .replacen(
+            "*STEP",
+            "*AMPLITUDE, NAME=drag\n0.0, 0.0, 2.0, 1.0\n*STEP",
+            1,
+        )
+        .replace(
+            "*BOUNDARY\nplate, 1, 1, 0.001",
+            "*BOUNDARY, AMPLITUDE=drag\nplate, 1, 1, 0.001",
+        )
+        + "**\n*STEP, NAME=hold, NLGEOM=YES\n*STATIC, DIRECT\n0.25, 1.0\n*END STEP\n";
+    let dir = tempfile::tempdir().expect("tempdir");
+    let deck = dir.path().join("deck.inp");
+    std::fs::write(&deck, &text).expect("write deck");
+    let spec = read_model(&deck).expect("deck reads").model;
+    assert_eq!(
+        spec.amplitudes,
+        [AmplitudeSpec {
+            name: "drag@2".into(),
+            points: vec![[1.0, 0.0], [2.0, 0.5]],
+            time: AmplitudeTime::Total,
+        }]
     );
+    let motion = plate_motion(&spec);
+    // the initial state, 4 increments of press, 20 of drag, 4 of hold
+    assert_eq!(motion.len(), 29);
+    assert!((motion[24].0 - 0.5e-3).abs() <= 1e-18, "{:?}", motion[24]);
+    for (x, _) in &motion[25..] {
+        assert_eq!(*x, motion[24].0, "held where the drag left it");
+    }
 }
 
 /// A step's default amplitude: the drag step with `default_amplitude` `step` moves the plate

@@ -25,6 +25,7 @@ use crate::model_spec::{
 use crate::schema::{OutputSpec, SolverSpec, default_regularization_time};
 
 mod bodies;
+mod carried;
 mod conditions;
 mod loads;
 mod motions;

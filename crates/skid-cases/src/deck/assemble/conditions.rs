@@ -1,10 +1,11 @@
 //! Boundary conditions of a deck (model data on bodies and part nodes, changes per step) and
 //! its steps with their loads.
 
+use super::carried::Frozen;
 use super::loads::{Given, InForce, amplitude_name, amplitude_spec, apply_loads, model_loads};
 use super::motions::{Held, HeldInStep, Holder, prescribed_motions};
 use super::*;
-use crate::model_spec::{AmplitudeSpec, AmplitudeTime, DefaultAmplitude};
+use crate::model_spec::{AmplitudeSpec, DefaultAmplitude};
 
 pub(super) fn apply_model_boundary(
     defs: &Definitions,
@@ -156,8 +157,9 @@ pub(super) fn steps(
     }
     let mut held = HeldInStep::new();
     let mut loads_in_force: Vec<Given> = Vec::new();
-    let mut per_step = Vec::new();
+    let mut given_per_step = Vec::new();
     let mut held_per_step = Vec::new();
+    let mut frozen = Frozen::default();
     for (i, step) in defs.steps.iter().enumerate() {
         if step.nlgeom == Some(false) || (i == 0 && step.nlgeom.is_none()) {
             return Err(error(
@@ -179,23 +181,40 @@ pub(super) fn steps(
         }
         for given in &loads_in_force {
             if let Some(name) = given.load.amplitude() {
-                check_carried(defs, name, (given.step, i), "load", &given.location)?;
+                frozen.note(defs, name, (given.step, i), &given.location);
             }
         }
         for dofs in held.values() {
             for h in dofs.values() {
                 if let Some(name) = &h.amplitude {
-                    check_carried(defs, name, (h.step, i), "prescribed motion", &h.location)?;
+                    frozen.note(defs, name, (h.step, i), &h.location);
                 }
             }
         }
-        per_step.push(
-            loads_in_force
-                .iter()
-                .map(|g| g.load.clone())
-                .collect::<Vec<InForce>>(),
-        );
+        given_per_step.push(loads_in_force.clone());
         held_per_step.push(held.clone());
+    }
+    // the carried loads and motions that follow a generated amplitude, in every step
+    let per_step: Vec<Vec<InForce>> = given_per_step
+        .into_iter()
+        .map(|loads| {
+            loads
+                .into_iter()
+                .map(|mut g| {
+                    if let Some(name) = frozen.of(g.step, &g.location) {
+                        g.load.set_amplitude(name.clone());
+                    }
+                    g.load
+                })
+                .collect()
+        })
+        .collect();
+    for held in &mut held_per_step {
+        for h in held.values_mut().flat_map(|dofs| dofs.values_mut()) {
+            if let Some(name) = frozen.of(h.step, &h.location) {
+                h.amplitude = Some(name.clone());
+            }
+        }
     }
     let prescribed = prescribed_motions(
         defs,
@@ -241,7 +260,12 @@ pub(super) fn steps(
     );
     for name in named {
         if !amplitudes.iter().any(|a| a.name == name) {
-            amplitudes.push(amplitude_spec(defs, name));
+            let generated = frozen.amplitudes.iter().find(|a| a.name == name);
+            amplitudes.push(
+                generated
+                    .cloned()
+                    .unwrap_or_else(|| amplitude_spec(defs, name)),
+            );
         }
     }
     Ok(StepsAndLoads {
@@ -305,73 +329,6 @@ pub(super) fn apply_step_boundary(
         }
     }
     Ok(())
-}
-
-/// The time period of step `k` of the deck (that of its procedure line; 1 without one, which
-/// is refused elsewhere).
-fn step_period(defs: &Definitions, k: usize) -> f64 {
-    match defs.steps[k].procedure {
-        Some((Procedure::Static { period, .. } | Procedure::Dynamic { period, .. }, _)) => period,
-        None => 1.0,
-    }
-}
-
-/// Refuses a load or prescribed motion (`what`, at `location`) that follows the amplitude
-/// `name` read against the step time, was given in step `given` and is carried into step
-/// `step` without being given there, unless the amplitude holds its value at the end of step
-/// `given` over the whole of step `step`. Abaqus holds such a load at that value; the model
-/// reads every amplitude afresh in each step, so the two differ unless the amplitude is
-/// constant there. A total-time amplitude runs on and needs no check.
-fn check_carried(
-    defs: &Definitions,
-    name: &str,
-    (given, step): (usize, usize),
-    what: &str,
-    location: &Location,
-) -> Result<(), DeckError> {
-    let Some(amplitude) = defs.amplitudes.get(&key(name)) else {
-        return Ok(());
-    };
-    if given == step || amplitude.value.time == AmplitudeTime::Total {
-        return Ok(());
-    }
-    let points = &amplitude.value.points;
-    let at = |t: f64| {
-        let after = points.partition_point(|&(tk, _)| tk <= t);
-        match (after.checked_sub(1), points.get(after)) {
-            (None, _) => points[0].1,
-            (Some(k), None) => points[k].1,
-            (Some(k), Some(&(t1, a1))) => {
-                let (t0, a0) = points[k];
-                a0 + (a1 - a0) * (t - t0) / (t1 - t0)
-            }
-        }
-    };
-    let held = at(step_period(defs, given));
-    let period = step_period(defs, step);
-    let holds = at(0.0) == held
-        && at(period) == held
-        && points
-            .iter()
-            .filter(|&&(t, _)| t > 0.0 && t < period)
-            .all(|&(_, a)| a == held);
-    if holds {
-        return Ok(());
-    }
-    Err(error(
-        location,
-        format!(
-            "this {what} follows AMPLITUDE={name}, read against the step time, and is carried \
-             into step {} ({}) without being given there: Abaqus holds it at its value at the \
-             end of step {} ({}), which skid's model cannot express; define {name} with \
-             TIME=TOTAL TIME, or give the {what} again in step {}",
-            step + 1,
-            defs.steps[step].name,
-            given + 1,
-            defs.steps[given].name,
-            step + 1
-        ),
-    ))
 }
 
 pub(super) fn step_spec(

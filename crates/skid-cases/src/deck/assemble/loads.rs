@@ -47,6 +47,15 @@ impl InForce {
         }
     }
 
+    /// Makes it follow the amplitude `name`.
+    pub fn set_amplitude(&mut self, name: String) {
+        match self {
+            Self::Pressure { amplitude, .. }
+            | Self::Concentrated { amplitude, .. }
+            | Self::Gravity { amplitude, .. } => *amplitude = Some(name),
+        }
+    }
+
     fn keyword(&self) -> &'static str {
         match self {
             Self::Pressure { keyword, .. } => keyword,
