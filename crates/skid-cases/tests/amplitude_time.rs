@@ -32,6 +32,22 @@ fn dragged_block(overrides: &[&str]) -> ModelSpec {
     parse_model(&text, &path, &overrides).expect("scene parses")
 }
 
+/// The dragged block's deck, `cases/verification/2d-block-dragged-on-flat-deck.inp`.
+fn dragged_deck() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../cases/verification/2d-block-dragged-on-flat-deck.inp")
+}
+
+/// The model of the deck `text`, written to a temporary file and read.
+fn read_deck_text(text: &str) -> Result<ModelSpec, String> {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("deck.inp");
+    std::fs::write(&path, text).expect("write deck");
+    read_model(&path)
+        .map(|d| d.model)
+        .map_err(|e| e.to_string())
+}
+
 /// Every converged state.
 struct Record(Vec<State>);
 
@@ -123,10 +139,7 @@ fn decks_read_and_write_total_time_amplitudes_and_static_periods() {
         "{text}"
     );
     assert!(text.contains("*STATIC, DIRECT\n0.1, 2.0\n"), "{text}");
-    let dir = tempfile::tempdir().expect("tempdir");
-    let path: PathBuf = dir.path().join("total-time.inp");
-    std::fs::write(&path, &text).expect("write deck");
-    let deck = read_model(&path).expect("the written deck reads").model;
+    let deck = read_deck_text(&text).expect("the written deck reads");
     assert_eq!(deck.amplitudes, spec.amplitudes);
     assert_eq!(deck.steps, spec.steps);
     let motions = |m: &ModelSpec| {
@@ -164,9 +177,7 @@ fn a_time_period_that_is_not_positive_is_refused_with_its_field() {
 /// The deck of the dragged block with its press ramped by `*AMPLITUDE, NAME=ramp` (`time`:
 /// the parameter added to the keyword line, if any), written to a temporary file and read.
 fn ramped_press_deck(time: &str) -> Result<ModelSpec, String> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../cases/verification/2d-block-dragged-on-flat-deck.inp");
-    let text = std::fs::read_to_string(&path)
+    let text = std::fs::read_to_string(dragged_deck())
         .expect("read deck")
         .replacen(
             "*STEP",
@@ -174,12 +185,7 @@ fn ramped_press_deck(time: &str) -> Result<ModelSpec, String> {
             1,
         )
         .replacen("*CLOAD\n", "*CLOAD, AMPLITUDE=ramp\n", 1);
-    let dir = tempfile::tempdir().expect("tempdir");
-    let deck = dir.path().join("deck.inp");
-    std::fs::write(&deck, &text).expect("write deck");
-    read_model(&deck)
-        .map(|d| d.model)
-        .map_err(|e| e.to_string())
+    read_deck_text(&text)
 }
 
 /// A load ramped by a step-time amplitude over the press and carried into the drag: Abaqus
@@ -197,18 +203,13 @@ fn a_step_time_amplitude_carried_into_a_later_step_holds_its_end_value() {
     assert_eq!(carried.amplitudes, [frozen]);
     let total = ramped_press_deck(", TIME=TOTAL TIME").expect("a total-time ramp reads");
     assert_eq!(total.amplitudes[0].time, AmplitudeTime::Total);
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../cases/verification/2d-block-dragged-on-flat-deck.inp");
-    let shipped = plate_motion(&read_model(&path).expect("deck reads").model);
+    let shipped = plate_motion(&read_model(&dragged_deck()).expect("deck reads").model);
     for (what, spec) in [("carried", &carried), ("total time", &total)] {
         assert_same_motion(&plate_motion(spec), &shipped, what);
     }
     // the generated amplitude writes and reads back as it is
     let text = write_deck(&carried, &Default::default()).expect("the writer writes it");
-    let dir = tempfile::tempdir().expect("tempdir");
-    let path = dir.path().join("written.inp");
-    std::fs::write(&path, &text).expect("write deck");
-    let again = read_model(&path).expect("the written deck reads").model;
+    let again = read_deck_text(&text).expect("the written deck reads");
     assert_eq!(again.amplitudes, carried.amplitudes);
     assert_eq!(again.loads, carried.loads);
 }
@@ -219,9 +220,7 @@ fn a_step_time_amplitude_carried_into_a_later_step_holds_its_end_value() {
 /// in the total time.
 #[test]
 fn a_motion_carried_into_a_third_step_holds_where_its_amplitude_left_it() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../cases/verification/2d-block-dragged-on-flat-deck.inp");
-    let text = std::fs::read_to_string(&path)
+    let text = std::fs::read_to_string(dragged_deck())
         .expect("read deck")
         .replacen(
             "*STEP",
@@ -233,10 +232,7 @@ fn a_motion_carried_into_a_third_step_holds_where_its_amplitude_left_it() {
             "*BOUNDARY, AMPLITUDE=drag\nplate, 1, 1, 0.001",
         )
         + "**\n*STEP, NAME=hold, NLGEOM=YES\n*STATIC, DIRECT\n0.25, 1.0\n*END STEP\n";
-    let dir = tempfile::tempdir().expect("tempdir");
-    let deck = dir.path().join("deck.inp");
-    std::fs::write(&deck, &text).expect("write deck");
-    let spec = read_model(&deck).expect("deck reads").model;
+    let spec = read_deck_text(&text).expect("deck reads");
     assert_eq!(
         spec.amplitudes,
         [AmplitudeSpec {
@@ -281,10 +277,7 @@ fn a_step_that_applies_its_loads_at_once_moves_the_plate_in_its_first_increment(
         text.contains("*STEP, NAME=drag, NLGEOM=YES, AMPLITUDE=STEP\n"),
         "{text}"
     );
-    let dir = tempfile::tempdir().expect("tempdir");
-    let path = dir.path().join("at-once.inp");
-    std::fs::write(&path, &text).expect("write deck");
-    let read = read_model(&path).expect("the written deck reads").model;
+    let read = read_deck_text(&text).expect("the written deck reads");
     assert_eq!(read.steps, deck.steps);
 }
 

@@ -18,7 +18,9 @@
 //! is judged in the second half of the hold, from `t_hold + (t_end - t_hold) / 2` on.
 
 use skid_cases::model_file::build::build;
-use skid_cases::model_spec::{Dof, LoadSpec, ModelSpec, ModelStepSpec, RigidSurfaceSpec};
+use skid_cases::model_spec::{
+    ContactPairSpec, Dof, LoadSpec, ModelSpec, ModelStepSpec, RigidBodySpec, RigidSurfaceSpec,
+};
 
 /// A block on a fixed flat: what the stick or slip of its held loads needs.
 #[derive(Clone, Debug, PartialEq)]
@@ -47,13 +49,7 @@ impl BlockOnFlat {
     /// flat.
     pub fn recognise(spec: &ModelSpec) -> Option<Self> {
         let dim = spec.dimension;
-        let [pair] = spec.contact.as_slice() else {
-            return None;
-        };
-        let flat = spec.rigid_bodies.iter().find(|b| b.name == pair.master)?;
-        let Some(RigidSurfaceSpec::Plane { normal, .. }) = flat.surface else {
-            return None;
-        };
+        let (pair, flat, n) = flat_pair(spec)?;
         let [
             ModelStepSpec::Dynamic {
                 duration, boundary, ..
@@ -138,13 +134,8 @@ impl BlockOnFlat {
                 }
             }
         }
-        let length = normal.iter().map(|c| c * c).sum::<f64>().sqrt();
-        let n = normal.map(|c| c / length);
         let along: f64 = resultant.iter().zip(&n).map(|(r, n)| r * n).sum();
-        let tangential = (0..3)
-            .map(|k| (resultant[k] - along * n[k]).powi(2))
-            .sum::<f64>()
-            .sqrt();
+        let tangential = along_plane(&resultant, &n);
         (-along > 0.0 && hold_time < *duration).then(|| Self {
             pair: pair.name.clone(),
             mu: pair.mu,
@@ -169,6 +160,35 @@ impl BlockOnFlat {
     pub fn settled_from(&self) -> f64 {
         self.hold_time + 0.5 * (self.end_time - self.hold_time)
     }
+}
+
+/// The scene's one contact pair, if its master is a rigid plane: the pair, the plane's body
+/// and its unit normal.
+pub(crate) fn flat_pair(spec: &ModelSpec) -> Option<(&ContactPairSpec, &RigidBodySpec, [f64; 3])> {
+    let [pair] = spec.contact.as_slice() else {
+        return None;
+    };
+    let flat = spec.rigid_bodies.iter().find(|b| b.name == pair.master)?;
+    let Some(RigidSurfaceSpec::Plane { normal, .. }) = flat.surface else {
+        return None;
+    };
+    Some((pair, flat, unit(normal)))
+}
+
+/// `v / |v|`.
+fn unit(v: [f64; 3]) -> [f64; 3] {
+    let length = v.iter().map(|c| c * c).sum::<f64>().sqrt();
+    v.map(|c| c / length)
+}
+
+/// `|v - (v . n) n|`, the size of the component of `v` (its first components, the others 0)
+/// in the plane of unit normal `n`.
+pub(crate) fn along_plane(v: &[f64], n: &[f64; 3]) -> f64 {
+    let across: f64 = v.iter().zip(n).map(|(a, b)| a * b).sum();
+    (0..3)
+        .map(|k| (v.get(k).copied().unwrap_or(0.0) - across * n[k]).powi(2))
+        .sum::<f64>()
+        .sqrt()
 }
 
 /// The mass that gravity pulls onto the flat: the part's, `sum_e rho_e V_e` over its elements
@@ -202,18 +222,19 @@ fn part_mass<const D: usize>(spec: &ModelSpec) -> Option<f64> {
     Some(mass)
 }
 
+/// The shipped verification scene `file` (a model file of `cases/verification`), for tests.
+#[cfg(test)]
+pub(crate) fn scene(file: &str) -> ModelSpec {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../cases/verification")
+        .join(file);
+    let text = std::fs::read_to_string(&path).expect("scene");
+    serde_json::from_str(&text).expect("model file")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::Path;
-
-    fn scene(file: &str) -> ModelSpec {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../cases/verification")
-            .join(file);
-        let text = std::fs::read_to_string(&path).expect("scene");
-        serde_json::from_str(&text).expect("model file")
-    }
 
     /// The pushed block: N = 20 N down, F = 9 N sideways (1.5 mu N), held from 25 ms.
     #[test]

@@ -12,7 +12,8 @@
 //! reactions has a component along the flat, `R_t = R - (R . n) n`, as large as the friction
 //! resultant `|T|`, and, while every contact slides, as large as `mu N`.
 
-use skid_cases::model_spec::{Dof, LoadSpec, ModelSpec, ModelStepSpec, RigidSurfaceSpec};
+use crate::block_on_flat::{along_plane, flat_pair};
+use skid_cases::model_spec::{Dof, LoadSpec, ModelSpec, ModelStepSpec};
 
 /// A block moved over a fixed flat: what the balance of its reactions needs.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,24 +33,8 @@ impl MovedBlock {
     /// The scene of `spec`, if it is one (see the module documentation).
     pub fn recognise(spec: &ModelSpec) -> Option<Self> {
         let dim = spec.dimension;
-        let [pair] = spec.contact.as_slice() else {
-            return None;
-        };
-        let flat = spec.rigid_bodies.iter().find(|b| b.name == pair.master)?;
-        let Some(RigidSurfaceSpec::Plane { normal, .. }) = flat.surface else {
-            return None;
-        };
-        let length = normal.iter().map(|c| c * c).sum::<f64>().sqrt();
-        let n = normal.map(|c| c / length);
-        // the component of a vector along the flat
-        let along_flat = |v: &[f64]| {
-            let across: f64 = v.iter().zip(&n).map(|(a, b)| a * b).sum();
-            v.iter()
-                .zip(&n)
-                .map(|(a, b)| (a - across * b).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        };
+        let (pair, flat, n) = flat_pair(spec)?;
+        let along_flat = |v: &[f64]| along_plane(v, &n);
         let axis_along_flat = |axis: usize| {
             let mut e = [0.0; 3];
             e[axis] = 1.0;
@@ -114,28 +99,14 @@ impl MovedBlock {
     /// `|R_t|`, the size of the component along the flat of the resultant whose components
     /// along the axes are `resultant`.
     pub fn along_flat(&self, resultant: &[f64; 3]) -> f64 {
-        let across: f64 = resultant.iter().zip(&self.normal).map(|(a, b)| a * b).sum();
-        resultant
-            .iter()
-            .zip(&self.normal)
-            .map(|(a, b)| (a - across * b).powi(2))
-            .sum::<f64>()
-            .sqrt()
+        along_plane(resultant, &self.normal)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::Path;
-
-    fn scene(file: &str) -> ModelSpec {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../cases/verification")
-            .join(file);
-        let text = std::fs::read_to_string(&path).expect("scene");
-        serde_json::from_str(&text).expect("model file")
-    }
+    use crate::block_on_flat::scene;
 
     /// The dragged block: the plate's x reaction moves it along the flat y = 0.
     #[test]

@@ -6,6 +6,8 @@
 //! the giving step, shifted to the total time at that step's start, and held at its end value
 //! after, which is exactly Abaqus's history of it.
 
+use skid_integrator::Amplitude;
+
 use super::*;
 use crate::model_spec::{AmplitudeSpec, AmplitudeTime};
 
@@ -15,19 +17,6 @@ fn step_period(defs: &Definitions, k: usize) -> f64 {
     match defs.steps[k].procedure {
         Some((Procedure::Static { period, .. } | Procedure::Dynamic { period, .. }, _)) => period,
         None => 1.0,
-    }
-}
-
-/// `a(t)` of the piecewise-linear table `points`, held at its end values.
-fn at(points: &[(f64, f64)], t: f64) -> f64 {
-    let after = points.partition_point(|&(tk, _)| tk <= t);
-    match (after.checked_sub(1), points.get(after)) {
-        (None, _) => points[0].1,
-        (Some(k), None) => points[k].1,
-        (Some(k), Some(&(t1, a1))) => {
-            let (t0, a0) = points[k];
-            a0 + (a1 - a0) * (t - t0) / (t1 - t0)
-        }
     }
 }
 
@@ -64,11 +53,15 @@ impl Frozen {
             return;
         }
         let points = &amplitude.value.points;
+        // the reader checked the table (times from 0, increasing, finite numbers)
+        let Ok(table) = Amplitude::new(points.clone()) else {
+            return;
+        };
         let end = step_period(defs, given);
-        let held = at(points, end);
+        let held = table.at(end);
         let period = step_period(defs, step);
-        let holds = at(points, 0.0) == held
-            && at(points, period) == held
+        let holds = table.at(0.0) == held
+            && table.at(period) == held
             && points
                 .iter()
                 .filter(|&&(t, _)| t > 0.0 && t < period)
