@@ -23,8 +23,8 @@
 //!
 //! How skid reads what the keywords leave open, or what it models differently:
 //! - model-data boundary conditions hold throughout; in a step, zero-valued conditions on a
-//!   reference node hold that degree of freedom for the step (at its value at the step's start;
-//!   `OP=NEW` drops those of earlier steps);
+//!   reference node or on part nodes hold that degree of freedom for the step (at its value at
+//!   the step's start; `OP=NEW` drops those of earlier steps);
 //! - a load given in a step stays in force in later steps until a line at its place changes it
 //!   (`OP=MOD`) or `OP=NEW` removes it; without amplitude it goes linearly over a static step
 //!   from its value at the end of the previous step to the new one (from 0 in the first step;

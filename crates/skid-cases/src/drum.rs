@@ -182,7 +182,8 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
     let hold = |hold: &[String]| {
         hold.iter()
             .map(|body| StepBoundarySpec {
-                body: body.clone(),
+                body: Some(body.clone()),
+                node_set: None,
                 dofs: None,
             })
             .collect()

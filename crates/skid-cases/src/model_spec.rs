@@ -598,13 +598,18 @@ pub enum DefaultAmplitude {
     Step,
 }
 
-/// Degrees of freedom of a rigid body held at their value at the start of a step.
+/// Degrees of freedom of a rigid body, or of every node of a node set, held at their value at
+/// the start of a step.
 #[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct StepBoundarySpec {
-    /// Rigid body.
-    pub body: String,
-    /// Degrees of freedom held (absent: every free one).
+    /// Rigid body (exactly one of `body` and `node_set`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<String>,
+    /// Node set of the part (not tied to a rigid body).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub node_set: Option<String>,
+    /// Degrees of freedom held (absent: every free one; translations only on nodes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dofs: Option<Vec<Dof>>,
 }

@@ -284,6 +284,22 @@ fn prescribed_motions_the_model_cannot_take_are_refused_with_their_field() {
             "boundary[2]",
             "exactly one of body and node_set",
         ),
+        // a step's holds of node sets
+        (
+            r#"steps[0].boundary=[{"node_set": "top", "dofs": ["x"]}]"#,
+            "steps[0].boundary[0].node_set",
+            "tied to rigid body 'plate'",
+        ),
+        (
+            r#"steps[0].boundary=[{"node_set": "bottom", "dofs": ["rz"]}]"#,
+            "steps[0].boundary[0].dofs",
+            "no rotation",
+        ),
+        (
+            r#"steps[0].boundary=[{"node_set": "bottom", "body": "plate"}]"#,
+            "steps[0].boundary[0]",
+            "exactly one of body and node_set",
+        ),
     ] {
         let error = model_file::build::<2>(&dragged_block(&[set])).expect_err(set);
         assert_eq!(error.field, field, "{set}: {error:?}");

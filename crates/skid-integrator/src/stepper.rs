@@ -233,33 +233,48 @@ pub struct Step {
     pub name: String,
     /// What the step does.
     pub kind: StepKind,
-    /// Rigid-body motions held at their value at the start of the step.
+    /// Motions held at their value at the start of the step.
     pub held: Vec<HeldMotion>,
 }
 
-/// A rigid-body motion held during a step: one motion, or every free motion of the body.
-/// Holding a motion that the model already fixes changes nothing.
+/// A motion held during a step at its value at the step's start: one motion of a rigid body
+/// or every free motion of it, or one displacement of a node of the solid. Holding a motion
+/// that the model already fixes changes nothing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct HeldMotion {
-    /// Index of the rigid body.
-    pub body: usize,
-    /// The motion held; `None`: all the body's free motions.
-    pub motion: Option<BodyMotion>,
+pub enum HeldMotion {
+    /// A motion of a rigid body's reference node.
+    Body {
+        /// Index of the rigid body.
+        body: usize,
+        /// The motion held; `None`: all the body's free motions.
+        motion: Option<BodyMotion>,
+    },
+    /// The displacement of a node of the solid along a global axis.
+    Node {
+        /// Index of the node.
+        node: usize,
+        /// Global axis.
+        axis: usize,
+    },
 }
 
 impl HeldMotion {
     /// Holds every free motion of `body`.
     pub fn body(body: usize) -> Self {
-        Self { body, motion: None }
+        Self::Body { body, motion: None }
     }
 
     /// Equations this hold fixes (none for a motion the model already fixes).
     fn equations<const D: usize>(&self, model: &Model<D>) -> Vec<usize> {
-        match self.motion {
-            None => model.dofs().body_equations(self.body),
-            Some(motion) => body_equation(model.dofs(), self.body, motion)
+        match *self {
+            Self::Body { body, motion: None } => model.dofs().body_equations(body),
+            Self::Body {
+                body,
+                motion: Some(motion),
+            } => body_equation(model.dofs(), body, motion)
                 .into_iter()
                 .collect(),
+            Self::Node { node, axis } => model.dofs().node(node)[axis].into_iter().collect(),
         }
     }
 }
@@ -657,13 +672,31 @@ fn validate_steps<const D: usize>(model: &Model<D>, steps: &[Step]) -> Result<()
     }
     for s in steps {
         for hold in &s.held {
-            if hold.body >= model.bodies().len() {
-                return bad(s, format!("held body {} does not exist", hold.body));
-            }
-            if let Some(BodyMotion::Translation(i)) = hold.motion
-                && i >= D
-            {
-                return bad(s, format!("held translation along axis {i} in {D}D"));
+            match *hold {
+                HeldMotion::Body { body, motion } => {
+                    if body >= model.bodies().len() {
+                        return bad(s, format!("held body {body} does not exist"));
+                    }
+                    if let Some(BodyMotion::Translation(i)) = motion
+                        && i >= D
+                    {
+                        return bad(s, format!("held translation along axis {i} in {D}D"));
+                    }
+                }
+                HeldMotion::Node { node, axis } => {
+                    if node >= model.part().mesh.nodes.len() || axis >= D {
+                        return bad(
+                            s,
+                            format!("held node {node} along axis {axis}: no such node or axis"),
+                        );
+                    }
+                    if model.ties().iter().any(|t| t.nodes.contains(&node)) {
+                        return bad(
+                            s,
+                            format!("held node {node} is tied to a rigid body: hold the body"),
+                        );
+                    }
+                }
             }
         }
         match s.kind {

@@ -49,7 +49,7 @@ impl MovedBlock {
         });
         let static_steps = spec.steps.iter().all(|step| match step {
             ModelStepSpec::Static { boundary, .. } => boundary.iter().all(|b| {
-                b.body == flat.name
+                b.body.as_deref() == Some(flat.name.as_str())
                     || b.dofs.as_ref().is_some_and(|dofs| {
                         dofs.iter()
                             .all(|d| d.translation_axis().is_none_or(|a| !axis_along_flat(a)))

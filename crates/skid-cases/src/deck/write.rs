@@ -382,18 +382,31 @@ pub fn write_deck(
             }
         );
         for hold in boundary {
-            let held = fixed(&hold.body);
+            let (target, held) = match (&hold.body, &hold.node_set) {
+                (Some(body), _) => (body, fixed(body)),
+                (None, Some(set)) => (set, Vec::new()),
+                (None, None) => {
+                    return Err(format!(
+                        "steps[{i}].boundary: expected a body or a node set"
+                    ));
+                }
+            };
             let dofs: Vec<Dof> = match &hold.dofs {
                 Some(d) => d.clone(),
-                None => Dof::all(dim)
+                None if hold.body.is_some() => Dof::all(dim)
                     .iter()
                     .copied()
                     .filter(|d| !held.contains(d))
                     .collect(),
+                None => Dof::all(dim)
+                    .iter()
+                    .copied()
+                    .filter(|d| d.translation_axis().is_some())
+                    .collect(),
             };
             for dof in dofs {
                 let k = dof_number(dof);
-                let _ = writeln!(out, "{}, {k}, {k}", hold.body);
+                let _ = writeln!(out, "{target}, {k}, {k}");
             }
         }
         write_motions(&mut out, &prescribed, i);

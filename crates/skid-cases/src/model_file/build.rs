@@ -249,13 +249,33 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         });
     }
 
+    // the nodes a step holds: a node set without nodes tied to a body
+    let step_nodes = |field: &str, name: &str| -> Result<Vec<usize>, SpecError> {
+        let nodes = node_set(field, name)?.clone();
+        let tied = spec.ties.iter().find(|t| {
+            mesh.node_sets
+                .get(&t.node_set)
+                .is_some_and(|set| set.iter().any(|n| nodes.contains(n)))
+        });
+        match tied {
+            Some(t) => fail(
+                field,
+                format!(
+                    "node set '{name}' holds nodes tied to rigid body '{}' (they move with it): \
+                     hold the body",
+                    t.body
+                ),
+            ),
+            None => Ok(nodes),
+        }
+    };
     let named = loads::amplitudes(&spec.amplitudes)?;
     let loads = loads::loads::<D>(spec, &mesh, &bodies, &named, &body_of)?;
     let steps = spec
         .steps
         .iter()
         .enumerate()
-        .map(|(i, s)| step::<D>(i, s, &body_of))
+        .map(|(i, s)| step::<D>(i, s, (&body_of, &step_nodes)))
         .collect::<Result<Vec<_>, _>>()?;
     if steps.is_empty() {
         return fail("steps", "expected at least one step");
@@ -712,7 +732,10 @@ fn nodes_near<const D: usize>(
 fn step<const D: usize>(
     i: usize,
     spec: &ModelStepSpec,
-    body_of: &impl Fn(&str, &str) -> Result<usize, SpecError>,
+    of: (
+        &impl Fn(&str, &str) -> Result<usize, SpecError>,
+        &impl Fn(&str, &str) -> Result<Vec<usize>, SpecError>,
+    ),
 ) -> Result<Step, SpecError> {
     let f = |name: &str| format!("steps[{i}].{name}");
     let (name, boundary) = match spec {
@@ -722,7 +745,7 @@ fn step<const D: usize>(
     if name.is_empty() {
         return fail(f("name"), "expected a non-empty name");
     }
-    let held = held_motions::<D>(&f("boundary"), boundary, body_of)?;
+    let held = held_motions::<D>(&f("boundary"), boundary, of)?;
     let kind = match spec {
         ModelStepSpec::Static {
             increments,
@@ -813,14 +836,51 @@ pub fn check_dynamic_timing(
     Ok(())
 }
 
+/// The motions a step's `boundary` (`field`) holds: of rigid bodies (`body_of`), or the
+/// translations of every node of a node set (`nodes_of`, which refuses sets with tied nodes).
 fn held_motions<const D: usize>(
     field: &str,
     boundary: &[StepBoundarySpec],
-    body_of: &impl Fn(&str, &str) -> Result<usize, SpecError>,
+    (body_of, nodes_of): (
+        &impl Fn(&str, &str) -> Result<usize, SpecError>,
+        &impl Fn(&str, &str) -> Result<Vec<usize>, SpecError>,
+    ),
 ) -> Result<Vec<HeldMotion>, SpecError> {
     let mut held = Vec::new();
     for (k, bc) in boundary.iter().enumerate() {
-        let body = body_of(&format!("{field}[{k}].body"), &bc.body)?;
+        let f = |name: &str| format!("{field}[{k}].{name}");
+        let body = match (&bc.body, &bc.node_set) {
+            (Some(body), None) => body_of(&f("body"), body)?,
+            (None, Some(set)) => {
+                let nodes = nodes_of(&f("node_set"), set)?;
+                let axes: Vec<usize> = match &bc.dofs {
+                    None => (0..D).collect(),
+                    Some(dofs) => {
+                        check_dofs::<D>(&f("dofs"), dofs)?;
+                        dofs.iter()
+                            .map(|dof| {
+                                dof.translation_axis().ok_or_else(|| SpecError {
+                                    field: f("dofs"),
+                                    message: format!(
+                                        "the nodes of a solid have no rotation {dof:?}"
+                                    ),
+                                })
+                            })
+                            .collect::<Result<_, _>>()?
+                    }
+                };
+                for &node in &nodes {
+                    held.extend(axes.iter().map(|&axis| HeldMotion::Node { node, axis }));
+                }
+                continue;
+            }
+            _ => {
+                return fail(
+                    format!("{field}[{k}]"),
+                    "expected exactly one of body and node_set",
+                );
+            }
+        };
         let Some(dofs) = &bc.dofs else {
             held.push(HeldMotion::body(body));
             continue;
@@ -832,7 +892,7 @@ fn held_motions<const D: usize>(
                 // a body has one rotation equation; holding any rotation holds it
                 _ => BodyMotion::Rotation,
             };
-            held.push(HeldMotion {
+            held.push(HeldMotion::Body {
                 body,
                 motion: Some(motion),
             });

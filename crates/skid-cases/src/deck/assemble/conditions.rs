@@ -225,7 +225,12 @@ pub(super) fn steps(
         &mut part_spec.node_sets,
     )?;
     let mut out = Vec::new();
-    for (step, held) in defs.steps.iter().zip(&held_per_step) {
+    for ((step, held), nodes) in defs
+        .steps
+        .iter()
+        .zip(&held_per_step)
+        .zip(&prescribed.in_steps)
+    {
         let boundary = held
             .iter()
             .filter_map(|(&who, dofs)| {
@@ -239,7 +244,8 @@ pub(super) fn steps(
             })
             .map(|(b, dofs)| {
                 Ok(StepBoundarySpec {
-                    body: bodies[b].def.name.clone(),
+                    body: Some(bodies[b].def.name.clone()),
+                    node_set: None,
                     dofs: Some(
                         dofs.iter()
                             .map(|&k| dof_of(dim, k, &step.location))
@@ -247,6 +253,7 @@ pub(super) fn steps(
                     ),
                 })
             })
+            .chain(nodes.iter().cloned().map(Ok))
             .collect::<Result<Vec<_>, DeckError>>()?;
         out.push(step_spec(step, boundary)?);
     }

@@ -14,7 +14,8 @@
 //! deck that leaves it free in one step (before it is prescribed, or after `OP=NEW` drops it) is
 //! refused, as is one that gives it different amplitudes in different steps. A part node that
 //! steps hold at zero only is held throughout if every step holds it (a `held-N` set), and
-//! refused otherwise: the model's steps change the conditions of rigid bodies only.
+//! otherwise by the steps that hold it, at its value at the step's start, as the reference nodes
+//! of rigid bodies are.
 
 use super::*;
 
@@ -50,6 +51,8 @@ pub(super) struct Prescribed {
     pub boundary: Vec<BoundarySpec>,
     /// The degrees of freedom of rigid bodies they move: (body, degree of freedom 1..=6).
     moved: BTreeSet<(usize, usize)>,
+    /// The holds of part nodes that some steps hold and others leave free, by step.
+    pub in_steps: Vec<Vec<StepBoundarySpec>>,
 }
 
 impl Prescribed {
@@ -113,6 +116,8 @@ pub(super) fn prescribed_motions(
     let mut boundary: Vec<BoundarySpec> = Vec::new();
     let mut moved = BTreeSet::new();
     let mut node_groups: Vec<NodeGroup> = Vec::new();
+    // part nodes held in some steps only: (step, degree of freedom, first line's target, nodes)
+    let mut step_holds: Vec<(usize, usize, &str, Vec<usize>)> = Vec::new();
     for (&(who, k), &(first, prescribed)) in &places {
         let (name, in_model_data) = match who {
             Holder::Body(b) => (
@@ -126,6 +131,25 @@ pub(super) fn prescribed_motions(
         };
         if !prescribed && (in_model_data || matches!(who, Holder::Body(_))) {
             continue;
+        }
+        // a part node held at zero in some steps only: held by those steps
+        if let (Holder::Node(i), false) = (who, prescribed) {
+            let in_steps: Vec<usize> = (0..held.len())
+                .filter(|&s| held[s].get(&who).is_some_and(|dofs| dofs.contains_key(&k)))
+                .collect();
+            if in_steps.len() < held.len() {
+                dof_of(dim, k, &first.location)?;
+                for s in in_steps {
+                    match step_holds
+                        .iter_mut()
+                        .find(|(step, dof, _, _)| (*step, *dof) == (s, k))
+                    {
+                        Some((.., nodes)) => nodes.push(i),
+                        None => step_holds.push((s, k, &first.target, vec![i])),
+                    }
+                }
+                continue;
+            }
         }
         if prescribed && in_model_data && k > 3 {
             return Err(error(
@@ -158,22 +182,12 @@ pub(super) fn prescribed_motions(
                 }
                 None if in_model_data => magnitudes.push(0.0),
                 None => {
-                    let what = if prescribed {
-                        "prescribed here but free"
-                    } else {
-                        "held here but free"
-                    };
-                    let since = if prescribed {
-                        "skid holds a prescribed degree of freedom throughout the run"
-                    } else {
-                        "skid's steps change the conditions of rigid bodies only, so a part node \
-                         is held throughout the run or not at all"
-                    };
                     return Err(error(
                         &first.location,
                         format!(
-                            "*BOUNDARY: degree of freedom {k} of {name} is {what} in step {} \
-                             ({}); {since}: hold it (at zero) in model data or in that step",
+                            "*BOUNDARY: degree of freedom {k} of {name} is prescribed here but \
+                             free in step {} ({}); skid holds a prescribed degree of freedom \
+                             throughout the run: hold it (at zero) in model data or in that step",
                             s + 1,
                             defs.steps[s].name
                         ),
@@ -250,7 +264,33 @@ pub(super) fn prescribed_motions(
             },
         );
     }
-    Ok(Prescribed { boundary, moved })
+    let mut in_steps = vec![Vec::new(); held.len()];
+    for (s, k, target, nodes) in step_holds {
+        let named = defs
+            .mesh
+            .node_sets
+            .get(&key(target))
+            .map(|s| s.name.as_str());
+        let set = node_set_of(node_sets, nodes, named, "held");
+        let dof = dof_of(dim, k, &defs.steps[s].location)?;
+        let holds: &mut Vec<StepBoundarySpec> = &mut in_steps[s];
+        match holds
+            .iter_mut()
+            .find(|h| h.node_set.as_deref() == Some(set.as_str()))
+        {
+            Some(h) => h.dofs.get_or_insert_with(Vec::new).push(dof),
+            None => holds.push(StepBoundarySpec {
+                body: None,
+                node_set: Some(set),
+                dofs: Some(vec![dof]),
+            }),
+        }
+    }
+    Ok(Prescribed {
+        boundary,
+        moved,
+        in_steps,
+    })
 }
 
 /// Adds `entry` to `boundary`, as more degrees of freedom of an entry that holds the same
