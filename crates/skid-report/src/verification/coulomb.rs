@@ -205,10 +205,7 @@ fn pair_checks(
     let mu = pair.mu;
     let label = format!("{} ({})", run.name, pair.name);
     let ratio = |r: &FrictionRow| (r.normal > 0.0).then(|| r.friction() / (mu * r.normal));
-    let worst = rows
-        .iter()
-        .filter_map(ratio)
-        .fold(None, |w: Option<f64>, v| Some(w.map_or(v, |w| w.max(v))));
+    let worst = rows.iter().filter_map(ratio).reduce(f64::max);
     let last_sliding = rows
         .iter()
         .rposition(|r| r.active > 0 && r.sliding == r.active);

@@ -54,21 +54,16 @@ pub(super) fn section(runs: &[MovedRun<'_>], checks: &mut Checks) -> Result<Stri
         }
         let balances = balances(block, run, history, rows)?;
         let limit = |b: &Balance| block.mu * b.normal;
-        let worst = |values: &mut dyn Iterator<Item = f64>| {
-            values.fold(None, |w: Option<f64>, v| Some(w.map_or(v, |w| w.max(v))))
-        };
-        let against_friction = worst(
-            &mut balances
-                .iter()
-                .filter(|b| b.normal > 0.0)
-                .map(|b| (b.along_flat - b.friction).abs() / limit(b)),
-        );
+        let against_friction = balances
+            .iter()
+            .filter(|b| b.normal > 0.0)
+            .map(|b| (b.along_flat - b.friction).abs() / limit(b))
+            .reduce(f64::max);
         let sliding: Vec<&Balance> = balances.iter().filter(|b| b.sliding).collect();
-        let against_mu_n = worst(
-            &mut sliding
-                .iter()
-                .map(|b| (b.along_flat - limit(b)).abs() / limit(b)),
-        );
+        let against_mu_n = sliding
+            .iter()
+            .map(|b| (b.along_flat - limit(b)).abs() / limit(b))
+            .reduce(f64::max);
         let label = format!("{} ({})", run.name, block.pair);
         let _ = writeln!(
             out,

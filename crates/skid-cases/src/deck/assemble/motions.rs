@@ -90,8 +90,7 @@ struct NodeGroup<'a> {
 /// # Errors
 /// At the line of a nonzero magnitude whose degree of freedom is free in some step, that
 /// changes its amplitude between steps, or that rotates a body held in that rotation by model
-/// data (model data fixes which rotation a body has); at the line that holds a part node in a
-/// step if another step leaves it free.
+/// data (model data fixes which rotation a body has).
 pub(super) fn prescribed_motions(
     defs: &Definitions,
     part: &Part,
@@ -245,12 +244,7 @@ pub(super) fn prescribed_motions(
     } in node_groups
     {
         let prefix = if history.is_some() { "motion" } else { "held" };
-        let named = defs
-            .mesh
-            .node_sets
-            .get(&key(target))
-            .map(|s| s.name.as_str());
-        let set = node_set_of(node_sets, nodes, named, prefix);
+        let set = node_set_of(node_sets, nodes, deck_set(defs, target), prefix);
         let dof = dof_of(dim, k, &defs.steps[0].location)?;
         push_merged(
             &mut boundary,
@@ -266,12 +260,7 @@ pub(super) fn prescribed_motions(
     }
     let mut in_steps = vec![Vec::new(); held.len()];
     for (s, k, target, nodes) in step_holds {
-        let named = defs
-            .mesh
-            .node_sets
-            .get(&key(target))
-            .map(|s| s.name.as_str());
-        let set = node_set_of(node_sets, nodes, named, "held");
+        let set = node_set_of(node_sets, nodes, deck_set(defs, target), "held");
         let dof = dof_of(dim, k, &defs.steps[s].location)?;
         let holds: &mut Vec<StepBoundarySpec> = &mut in_steps[s];
         match holds
@@ -310,6 +299,14 @@ fn push_merged(boundary: &mut Vec<BoundarySpec>, entry: BoundarySpec) {
         Some(m) => m.dofs.extend(entry.dofs),
         None => boundary.push(entry),
     }
+}
+
+/// The deck's spelling of `target` if it names a node set (`None` for a node label).
+fn deck_set<'a>(defs: &'a Definitions, target: &str) -> Option<&'a str> {
+    defs.mesh
+        .node_sets
+        .get(&key(target))
+        .map(|s| s.name.as_str())
 }
 
 /// The name of a node set of exactly `nodes` (in increasing order): `named` if it is that set,

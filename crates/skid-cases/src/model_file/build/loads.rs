@@ -199,47 +199,33 @@ pub(super) fn variation(
     field: &str,
 ) -> Result<Variation, SpecError> {
     let periods = step_periods(steps)?;
-    let read = |a: &TimedAmplitude| -> Result<Vec<Option<Amplitude>>, SpecError> {
-        steps
-            .iter()
-            .zip(&periods)
-            .map(|(step, &p)| in_step(a, step, p, field))
-            .collect()
-    };
-    // without factors or amplitude, a step that departs from its procedure's default
-    // amplitude makes the default ramp a factor of 1 in every step, varied step by step
-    let unit_factors;
-    let step_factors = match step_factors {
-        None if amplitude.is_none()
-            && steps
+    // the amplitude as each step reads it (`None`: unchanged)
+    let read = amplitude
+        .as_ref()
+        .map(|a| {
+            steps
                 .iter()
-                .any(ModelStepSpec::departs_from_default_amplitude) =>
-        {
-            unit_factors = vec![1.0; steps.len()];
-            Some(unit_factors.as_slice())
-        }
-        given => given,
+                .zip(&periods)
+                .map(|(step, &p)| in_step(a, step, p, field))
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .transpose()?;
+    // a load without factors varies step by step, with a factor of 1 in each, if a step reads
+    // its amplitude transformed or, without one, departs from its procedure's default amplitude
+    let varies_per_step = match &read {
+        Some(read) => read.iter().any(Option::is_some),
+        None => steps
+            .iter()
+            .any(ModelStepSpec::departs_from_default_amplitude),
     };
-    let Some(factors) = step_factors else {
-        return Ok(match amplitude {
-            None => Variation::Ramp,
-            Some(a) => {
-                let per_step = read(&a)?;
-                if per_step.iter().all(Option::is_none) {
-                    Variation::Amplitude(a.amplitude)
-                } else {
-                    Variation::PerStep(
-                        per_step
-                            .into_iter()
-                            .map(|read| StepVariation::Amplitude {
-                                amplitude: read.unwrap_or_else(|| a.amplitude.clone()),
-                                scale: 1.0,
-                            })
-                            .collect(),
-                    )
-                }
-            }
-        });
+    let unit_factors;
+    let factors = match step_factors {
+        Some(factors) => factors,
+        None if varies_per_step => {
+            unit_factors = vec![1.0; steps.len()];
+            unit_factors.as_slice()
+        }
+        None => return Ok(amplitude.map_or(Variation::Ramp, |a| Variation::Amplitude(a.amplitude))),
     };
     if factors.len() != steps.len() {
         return fail(
@@ -257,7 +243,6 @@ pub(super) fn variation(
             format!("expected a finite number, got {}", factors[k]),
         );
     }
-    let read = amplitude.as_ref().map(read).transpose()?;
     let mut previous = 0.0;
     let per_step = factors
         .iter()
