@@ -17,6 +17,12 @@
 
 use std::path::{Path, PathBuf};
 
+// this test reads decks but checks no refusal
+#[allow(dead_code)]
+#[path = "support/deck_text.rs"]
+mod deck_text;
+use deck_text::read_deck_text;
+
 use skid_cases::deck::read_model;
 use skid_cases::deck::write::write_deck;
 use skid_cases::model_file::{self, parse_model};
@@ -36,16 +42,6 @@ fn dragged_block(overrides: &[&str]) -> ModelSpec {
 fn dragged_deck() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../cases/verification/2d-block-dragged-on-flat-deck.inp")
-}
-
-/// The model of the deck `text`, written to a temporary file and read.
-fn read_deck_text(text: &str) -> Result<ModelSpec, String> {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let path = dir.path().join("deck.inp");
-    std::fs::write(&path, text).expect("write deck");
-    read_model(&path)
-        .map(|d| d.model)
-        .map_err(|e| e.to_string())
 }
 
 /// Every converged state.

@@ -14,10 +14,14 @@
 
 use std::path::{Path, PathBuf};
 
+#[path = "support/deck_text.rs"]
+mod deck_text;
+use deck_text::{assert_refused_at, read_deck_text};
+
 use skid_cases::deck::read_model;
 use skid_cases::deck::write::write_deck;
 use skid_cases::model_file;
-use skid_cases::model_spec::{BoundarySpec, Dof, ModelSpec, ModelStepSpec, StepBoundarySpec};
+use skid_cases::model_spec::{BoundarySpec, Dof, ModelStepSpec, StepBoundarySpec};
 use skid_cases::runner::run_model;
 use skid_integrator::stepper::{IncrementReport, Observer, run};
 use skid_integrator::{Model, State};
@@ -33,18 +37,6 @@ fn deck_path() -> PathBuf {
 
 fn deck_text() -> String {
     std::fs::read_to_string(deck_path()).expect("read deck")
-}
-
-/// The model of the deck `text` (read from a temporary file `deck.inp` in a directory named
-/// after `tag`).
-fn deck_model(text: &str, tag: &str) -> Result<ModelSpec, skid_cases::deck::keywords::DeckError> {
-    let dir = std::env::temp_dir().join(format!("skid-node-motions-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temporary directory");
-    let path = dir.join("deck.inp");
-    std::fs::write(&path, text).expect("write deck");
-    let model = read_model(&path).map(|d| d.model);
-    let _ = std::fs::remove_dir_all(&dir);
-    model
 }
 
 fn motion(set: &str, dof: Dof, value: f64, factors: Option<Vec<f64>>) -> BoundarySpec {
@@ -197,7 +189,7 @@ fn the_deck_writer_writes_node_set_motions_that_read_back_alike() {
     let spec = read_model(&deck_path()).expect("deck reads").model;
     let text = write_deck(&spec, &Default::default()).expect("the writer writes node-set motions");
     assert!(text.contains("top, 1, 1, 0.0\n") && text.contains("top, 2, 2, -0.0001\n"));
-    let again = deck_model(&text, "written").expect("the written deck reads");
+    let again = read_deck_text(&text).expect("the written deck reads");
     assert_eq!(again.boundary, spec.boundary);
     assert_eq!(again.part.node_sets, spec.part.node_sets);
     assert_eq!(again.steps, spec.steps);
@@ -208,7 +200,7 @@ fn the_deck_writer_writes_node_set_motions_that_read_back_alike() {
 #[test]
 fn model_data_holds_give_way_to_the_motions_of_their_nodes() {
     let text = deck_text().replacen("ground, 6, 6\n", "ground, 6, 6\ntop, 1, 2\n", 1);
-    let spec = deck_model(&text, "all").expect("deck reads");
+    let spec = read_deck_text(&text).expect("deck reads");
     let on_top: Vec<&BoundarySpec> = spec
         .boundary
         .iter()
@@ -224,7 +216,7 @@ fn model_data_holds_give_way_to_the_motions_of_their_nodes() {
 
     // node 6 (number 5) alone is pushed down; the rest of the top stays held vertically
     let text = text.replacen("\ntop, 2, 2, -0.0001\n", "\n6, 2, 2, -0.0001\n", 1);
-    let spec = deck_model(&text, "some").expect("deck reads");
+    let spec = read_deck_text(&text).expect("deck reads");
     let held = BoundarySpec {
         body: None,
         node_set: Some("top-held-1".into()),
@@ -256,7 +248,7 @@ fn part_nodes_held_in_one_step_only_are_held_by_that_step() {
             "*STEP, NAME=shear, NLGEOM=YES\n*STATIC, DIRECT\n0.05, 1.0\n*BOUNDARY, OP=NEW\n",
             1,
         );
-    let spec = deck_model(&text, "one-step").expect("deck reads");
+    let spec = read_deck_text(&text).expect("deck reads");
     let hold = StepBoundarySpec {
         body: None,
         node_set: Some("top".into()),
@@ -290,19 +282,13 @@ fn part_nodes_held_in_one_step_only_are_held_by_that_step() {
     }
     // the written deck reads back to the same steps
     let written = write_deck(&spec, &Default::default()).expect("the writer writes it");
-    let again = deck_model(&written, "one-step-written").expect("the written deck reads");
+    let again = read_deck_text(&written).expect("the written deck reads");
     assert_eq!(again.steps, spec.steps);
 }
 
 #[test]
 fn part_node_conditions_the_model_cannot_express_are_refused_at_their_line() {
     let text = deck_text();
-    let line_of = |text: &str, needle: &str| {
-        text.lines()
-            .position(|l| l == needle)
-            .map(|i| i + 1)
-            .expect("line in deck")
-    };
     for (edit, needle, fragment) in [
         // prescribed in the second step only: free in the first
         (
@@ -321,13 +307,6 @@ fn part_node_conditions_the_model_cannot_express_are_refused_at_their_line() {
             "degree of freedom 6 does not exist on the nodes of a 2D solid",
         ),
     ] {
-        let err = deck_model(&edit, "refused")
-            .expect_err(fragment)
-            .to_string();
-        let line = line_of(&edit, needle);
-        assert!(
-            err.contains(&format!("deck.inp:{line}")) && err.contains(fragment),
-            "expected line {line} and '{fragment}', got: {err}"
-        );
+        assert_refused_at(&edit, needle, fragment);
     }
 }

@@ -14,6 +14,10 @@
 
 use std::path::{Path, PathBuf};
 
+#[path = "support/deck_text.rs"]
+mod deck_text;
+use deck_text::{assert_refused_at, read_deck_text};
+
 use skid_cases::deck::read_model;
 use skid_cases::model_file::{self, parse_model};
 use skid_cases::model_spec::{BoundarySpec, ModelSpec};
@@ -83,7 +87,7 @@ fn the_decks_of_the_dragged_block_prescribe_the_same_motion() {
             "*BOUNDARY\nplate, 1, 1, 0.001",
             "*BOUNDARY, AMPLITUDE=drag\nplate, 1, 1, 0.001",
         );
-    let deck = deck_model(&with_amplitude).expect("deck with an amplitude reads");
+    let deck = read_deck_text(&with_amplitude).expect("deck with an amplitude reads");
     let mut expected = motions(&json);
     expected[0].amplitude = Some("Drag".into());
     assert_eq!(motions(&deck), expected);
@@ -99,12 +103,6 @@ fn the_decks_of_the_dragged_block_prescribe_the_same_motion() {
 fn prescribed_motions_a_deck_cannot_express_are_refused_at_their_line() {
     let path = repo("cases/verification/2d-block-dragged-on-flat-deck.inp");
     let text = std::fs::read_to_string(&path).expect("read deck");
-    let line_of = |text: &str, needle: &str| {
-        text.lines()
-            .position(|l| l == needle)
-            .map(|i| i + 1)
-            .expect("line in deck")
-    };
     for (edit, needle, fragment) in [
         // free in the first step: the model would hold it there
         (
@@ -147,24 +145,8 @@ fn prescribed_motions_a_deck_cannot_express_are_refused_at_their_line() {
             "one amplitude for the whole run",
         ),
     ] {
-        let err = deck_model(&edit).expect_err(fragment).to_string();
-        let line = line_of(&edit, needle);
-        assert!(
-            err.contains(&format!("deck.inp:{line}")) && err.contains(fragment),
-            "expected line {line} and '{fragment}', got: {err}"
-        );
+        assert_refused_at(&edit, needle, fragment);
     }
-}
-
-/// The model of the deck `text` (read from a temporary file `deck.inp`).
-fn deck_model(text: &str) -> Result<ModelSpec, skid_cases::deck::keywords::DeckError> {
-    let dir = std::env::temp_dir().join(format!("skid-prescribed-deck-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temporary directory");
-    let path = dir.join("deck.inp");
-    std::fs::write(&path, text).expect("write deck");
-    let model = read_model(&path).map(|d| d.model);
-    let _ = std::fs::remove_dir_all(&dir);
-    model
 }
 
 /// Runs `spec`, the dragged block, and checks that the plate follows its prescription, that
