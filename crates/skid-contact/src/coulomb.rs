@@ -38,7 +38,7 @@ use cone::{project_onto_friction_cone, tangential_norm};
 use conic_program::ConicProgram;
 use newton::newton;
 use polish::{Candidate, polish};
-use validation::{check_forces, check_problem, check_settings, check_shift};
+use validation::{check_forces, check_problem, check_settings, check_shape, check_shift};
 
 /// Tolerances and iteration limits of [`solve_coulomb`].
 #[derive(Clone, Debug)]
@@ -190,7 +190,8 @@ pub fn solve_coulomb(
 
 /// The fixed point of [`solve_coulomb`] from the shift `initial_shift` (length `n_contacts`,
 /// entries `>= 0`; without it `s_i = mu_i ||q_T,i||`, the slip if nothing pushed), with the
-/// refinement (polish and Newton) of each iterate switched by `refining`.
+/// refinement (polish and Newton) of each iterate switched by `refining`. `W`'s entries are
+/// those [`solve_coulomb`] checked: only the rest is checked again here.
 fn solve_fixed_point(
     problem: &FrictionProblem,
     settings: &CoulombSettings,
@@ -198,7 +199,7 @@ fn solve_fixed_point(
     refining: bool,
 ) -> Result<CoulombSolution, ContactError> {
     check_settings(settings)?;
-    let n_contacts = check_problem(problem)?;
+    let n_contacts = check_shape(problem)?;
     if let Some(shift) = initial_shift {
         check_shift(shift, n_contacts)?;
     }
@@ -289,10 +290,11 @@ fn solve_fixed_point(
 /// inverse mean compliance of contact `i`, so that `rho ∘ û` is a force. `e = 0` exactly when
 /// `(r, u)` satisfies the Coulomb law; it is relative to the force scale `max(||r||, ||rho ∘ q||)`
 /// (the second term is the force that would cancel `q` on decoupled contacts), and absolute if
-/// both vanish. Returns `f64::INFINITY` for an invalid problem (see [`solve_coulomb`]) or `r`, `u`
-/// of the wrong length or with non-finite entries.
+/// both vanish. Only the diagonal of `W` is read. Returns `f64::INFINITY` for a problem with
+/// invalid sizes, friction coefficients, `q` or diagonal of `W` (as [`solve_coulomb`] checks
+/// them), or `r`, `u` of the wrong length or with non-finite entries.
 pub fn natural_map_error(problem: &FrictionProblem, r: &DVector<f64>, u: &DVector<f64>) -> f64 {
-    let valid = check_problem(problem).is_ok()
+    let valid = check_shape(problem).is_ok()
         && r.len() == problem.q.len()
         && u.len() == problem.q.len()
         && r.iter().chain(u.iter()).all(|v| v.is_finite());
@@ -369,7 +371,7 @@ pub fn natural_map_length_error(
     r: &DVector<f64>,
     u: &DVector<f64>,
 ) -> f64 {
-    let valid = check_problem(problem).is_ok()
+    let valid = check_shape(problem).is_ok()
         && r.len() == problem.q.len()
         && u.len() == problem.q.len()
         && r.iter().chain(u.iter()).all(|v| v.is_finite());

@@ -12,11 +12,28 @@ fn invalid(message: String) -> Result<(), ContactError> {
     Err(ContactError::InvalidProblem(message))
 }
 
-/// Check sizes, finiteness, `dim ∈ {2, 3}`, `mu_i >= 0`, `W` square, symmetric (to
+/// Check sizes, finiteness, `dim ∈ {2, 3}`, `mu_i >= 0`, `W` square, finite and symmetric (to
 /// [`SYMMETRY_TOLERANCE`]) with a positive normal diagonal and a non-negative tangential one (a
 /// zero tangential compliance is legitimate: a node on a facet vertex whose slip the forces
 /// cannot change). Returns the number of contacts.
 pub(crate) fn check_problem(problem: &FrictionProblem) -> Result<usize, ContactError> {
+    let n_contacts = check_sizes(problem)?;
+    check_delassus(problem.w)?;
+    check_diagonal(problem.w, problem.dim)?;
+    Ok(n_contacts)
+}
+
+/// The checks of [`check_problem`] that read `W` only on its diagonal (`O(m)` against the
+/// `O(m^2)` of its finiteness and symmetry): what a measure of a candidate's error needs, which
+/// weighs each contact by its diagonal compliance. Returns the number of contacts.
+pub(crate) fn check_shape(problem: &FrictionProblem) -> Result<usize, ContactError> {
+    let n_contacts = check_sizes(problem)?;
+    check_diagonal(problem.w, problem.dim)?;
+    Ok(n_contacts)
+}
+
+/// Sizes, `dim`, `mu` and `q` (everything but `W`'s entries).
+fn check_sizes(problem: &FrictionProblem) -> Result<usize, ContactError> {
     let dim = problem.dim;
     if dim != 2 && dim != 3 {
         invalid(format!("contact dimension must be 2 or 3, got {dim}"))?;
@@ -49,20 +66,30 @@ pub(crate) fn check_problem(problem: &FrictionProblem) -> Result<usize, ContactE
     if !problem.q.iter().all(|v| v.is_finite()) {
         invalid("q has non-finite entries".into())?;
     }
-    check_delassus(problem.w, dim)?;
     Ok(n_contacts)
 }
 
-fn check_delassus(w: &DMatrix<f64>, dim: usize) -> Result<(), ContactError> {
-    if !w.iter().all(|v| v.is_finite()) {
-        invalid("W has non-finite entries".into())?;
-    }
-    if let Some(i) = (0..w.nrows()).find(|&i| w[(i, i)] < 0.0 || (i % dim == 0 && w[(i, i)] <= 0.0))
-    {
+/// `W` has a finite diagonal, positive on normal rows (every `dim`-th) and non-negative on
+/// tangential ones.
+fn check_diagonal(w: &DMatrix<f64>, dim: usize) -> Result<(), ContactError> {
+    let admissible = |i: usize| {
+        let d = w[(i, i)];
+        d.is_finite() && d >= 0.0 && (i % dim != 0 || d > 0.0)
+    };
+    if let Some(i) = (0..w.nrows()).find(|&i| !admissible(i)) {
         invalid(format!(
-            "W must have a positive normal and non-negative tangential diagonal, W[{i},{i}] = {}",
+            "W must have a finite diagonal, positive on normal rows and non-negative on \
+             tangential ones, W[{i},{i}] = {}",
             w[(i, i)]
         ))?;
+    }
+    Ok(())
+}
+
+/// `W` is finite and symmetric to [`SYMMETRY_TOLERANCE`] of its largest entry.
+fn check_delassus(w: &DMatrix<f64>) -> Result<(), ContactError> {
+    if !w.iter().all(|v| v.is_finite()) {
+        invalid("W has non-finite entries".into())?;
     }
     let magnitude = w.amax();
     let asymmetry = (0..w.ncols())
