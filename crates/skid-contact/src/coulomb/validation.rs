@@ -74,7 +74,7 @@ fn check_sizes(problem: &FrictionProblem) -> Result<usize, ContactError> {
 fn check_diagonal(w: &DMatrix<f64>, dim: usize) -> Result<(), ContactError> {
     let admissible = |i: usize| {
         let d = w[(i, i)];
-        d.is_finite() && d >= 0.0 && (i % dim != 0 || d > 0.0)
+        d.is_finite() && d >= 0.0 && (!i.is_multiple_of(dim) || d > 0.0)
     };
     if let Some(i) = (0..w.nrows()).find(|&i| !admissible(i)) {
         invalid(format!(
