@@ -402,8 +402,13 @@ impl GlobalContactSolver {
         let n = residual.len();
         let d = rows.components;
         let m = rows.rows.len();
-        let mut pairs: Vec<Pair<usize, usize>> = Vec::new();
-        let mut values: Vec<f64> = Vec::new();
+        // entries: both triangles of `k`, and per contact row its coefficients twice (its
+        // column and its row) and its `dim` force columns
+        let lower = k.compute_nnz();
+        let coefficients: usize = rows.rows.iter().map(Vec::len).sum();
+        let capacity = 2 * lower + 2 * coefficients + m * d;
+        let mut pairs: Vec<Pair<usize, usize>> = Vec::with_capacity(capacity);
+        let mut values: Vec<f64> = Vec::with_capacity(capacity);
         let mut push = |i: usize, j: usize, v: f64| {
             pairs.push(Pair::new(i, j));
             values.push(v);
@@ -411,8 +416,13 @@ impl GlobalContactSolver {
         // the symmetric approximation S (lower triangle) of the preconditioner, for systems
         // large enough to use it
         let symmetric = n + m >= self.quasi_definite_from;
-        let mut s_pairs: Vec<Pair<usize, usize>> = Vec::new();
-        let mut s_values: Vec<f64> = Vec::new();
+        let s_capacity = if symmetric {
+            lower + coefficients + m * d
+        } else {
+            0
+        };
+        let mut s_pairs: Vec<Pair<usize, usize>> = Vec::with_capacity(s_capacity);
+        let mut s_values: Vec<f64> = Vec::with_capacity(s_capacity);
         let mut s_push = |i: usize, j: usize, v: f64| {
             if symmetric {
                 s_pairs.push(Pair::new(i, j));
