@@ -28,8 +28,34 @@ const PARALLEL_ELEMENT_THRESHOLD: usize = 256;
 struct ElementScatter {
     /// Global equation of each local component (node-major), `None` if fixed.
     eqs: Vec<Option<usize>>,
-    /// (local row, local column, value slot) for every stored lower-triangle contribution.
-    entries: Vec<(usize, usize, usize)>,
+    /// The value slot of the first stored lower-triangle contribution; the others follow it.
+    first_slot: usize,
+    /// For every stored contribution, in slot order, its position `p + q n` in the column-major
+    /// `n x n` element matrix (local row `p`, column `q`).
+    entries: Vec<u32>,
+}
+
+impl ElementScatter {
+    /// Adds `c k` (the element matrix, column-major `n x n`, read at the stored positions) to
+    /// the element's slots of `values`.
+    fn add(&self, values: &mut [f64], c: f64, k: &[f64]) {
+        debug_assert_eq!(
+            k.len(),
+            self.eqs.len() * self.eqs.len(),
+            "element matrix size"
+        );
+        let slots = &mut values[self.first_slot..self.first_slot + self.entries.len()];
+        for (value, &position) in slots.iter_mut().zip(&self.entries) {
+            *value += c * k[position as usize];
+        }
+    }
+}
+
+/// The value slots whose entries lie in the row or column of an equation of `held`.
+#[derive(Debug)]
+struct HeldSlots {
+    held: Vec<bool>,
+    slots: Vec<usize>,
 }
 
 /// Internal forces and energies of the solid at one configuration.
@@ -53,6 +79,9 @@ pub struct Assembler {
     contact_scatter: Vec<ElementScatter>,
     diagonal: Vec<usize>,
     slot_position: Vec<(usize, usize)>,
+    /// The slots of entries in the rows or columns of held equations, for the held set of the
+    /// last [`Self::hold`] call (a step's held set stays the same over its increments).
+    held_slots: Option<HeldSlots>,
     values: Vec<f64>,
     /// Element pressures of the mixed tangent between Newton iterates.
     mixed: MixedPressures,
@@ -73,18 +102,27 @@ impl Assembler {
             slot_position.push((i.max(j), i.min(j)));
             builder.push(i, j)
         };
-        let mut scatter_of = |eqs: Vec<Option<usize>>| {
+        let mut scatter_of = |eqs: Vec<Option<usize>>| -> Result<ElementScatter, ModelError> {
+            let n = eqs.len();
+            let too_large = || ModelError::Invalid(format!("an element with {n} components"));
             let mut entries = Vec::new();
+            let mut first_slot = None;
             for (p, ep) in eqs.iter().enumerate() {
                 for (q, eq) in eqs.iter().enumerate() {
                     if let (Some(i), Some(j)) = (ep, eq)
                         && i >= j
                     {
-                        entries.push((p, q, push(&mut builder, *i, *j)));
+                        let slot = push(&mut builder, *i, *j);
+                        first_slot.get_or_insert(slot);
+                        entries.push(u32::try_from(p + q * n).map_err(|_| too_large())?);
                     }
                 }
             }
-            ElementScatter { eqs, entries }
+            Ok(ElementScatter {
+                eqs,
+                first_slot: first_slot.unwrap_or_default(),
+                entries,
+            })
         };
         let scatter = model
             .part()
@@ -92,14 +130,14 @@ impl Assembler {
             .elements
             .iter()
             .map(|conn| scatter_of(conn.iter().flat_map(|&n| *model.dofs().node(n)).collect()))
-            .collect();
+            .collect::<Result<_, _>>()?;
         let contact_scatter = model
             .contacts()
             .iter()
             .enumerate()
             .flat_map(|(p, pair)| pair.nodes.iter().map(move |&node| (p, node)))
             .map(|(p, node)| scatter_of(contact_coordinates(model, p, node)))
-            .collect();
+            .collect::<Result<_, _>>()?;
         let n = model.dofs().len();
         let diagonal = (0..n).map(|i| push(&mut builder, i, i)).collect();
         let pattern = SparsePattern::new(n, builder, &[]).map_err(ModelError::Invalid)?;
@@ -110,6 +148,7 @@ impl Assembler {
             contact_scatter,
             diagonal,
             slot_position,
+            held_slots: None,
             values,
             mixed: MixedPressures::new(model.elements().len()),
             factorizations: 0,
@@ -183,9 +222,7 @@ impl Assembler {
                 }
             }
             if let (Some(c), Some(k)) = (tangent_factor, &response.stiffness) {
-                for &(p, q, slot) in &scatter.entries {
-                    self.values[slot] += c * k[(p, q)];
-                }
+                scatter.add(&mut self.values, c, k.as_slice());
             }
         }
         Ok(state)
@@ -222,9 +259,7 @@ impl Assembler {
             let Some(k) = rows.curvature_stiffness(c, r) else {
                 continue;
             };
-            for &(p, q, slot) in &scatter.entries {
-                self.values[slot] += k[(p, q)];
-            }
+            scatter.add(&mut self.values, 1.0, k.as_slice());
         }
     }
 
@@ -238,10 +273,18 @@ impl Assembler {
     /// Replaces the rows and columns of `held` equations by those of the identity, so that their
     /// increments come out as zero for a zero right-hand side.
     pub fn hold(&mut self, held: &[bool]) {
-        for (slot, &(i, j)) in self.slot_position.iter().enumerate() {
-            if held[i] || held[j] {
-                self.values[slot] = 0.0;
-            }
+        if self.held_slots.as_ref().is_none_or(|h| h.held != held) {
+            let slots = (self.slot_position.iter().enumerate())
+                .filter(|(_, (i, j))| held[*i] || held[*j])
+                .map(|(slot, _)| slot)
+                .collect();
+            self.held_slots = Some(HeldSlots {
+                held: held.to_vec(),
+                slots,
+            });
+        }
+        for &slot in self.held_slots.iter().flat_map(|h| &h.slots) {
+            self.values[slot] = 0.0;
         }
         for (i, &slot) in self.diagonal.iter().enumerate() {
             if held[i] {
