@@ -1,7 +1,7 @@
 //! One-point (reduced-integration) solid element with Flanagan-Belytschko hourglass stiffness:
 //! the CPE4R role in 2D plane strain (D = 2) and the C3D8R role in 3D (D = 3), one code path.
 
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix6xX, SVector, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6x3, SVector, Vector3};
 
 use crate::cell::{
     ReferenceGeometry, corner_count, corners, embed, hourglass_base_vectors, hourglass_mode_axes,
@@ -303,11 +303,18 @@ impl<const D: usize> OnePointSolid<D> {
         }
 
         let stiffness = tangent.map(|(tau_k, c)| {
-            let b = strain_displacement::<D>(&g);
-            let mut k = (b.transpose() * c.0 * &b) * self.volume;
-            for (a, g_a) in g.iter().enumerate() {
-                for (bn, g_b) in g.iter().enumerate() {
+            let b: Vec<Matrix6x3<f64>> = g.iter().map(node_strain_displacement::<D>).collect();
+            let cb: Vec<Matrix6x3<f64>> = b.iter().map(|b_n| c.0 * b_n).collect();
+            let mut k = DMatrix::zeros(dofs, dofs);
+            for (a, (g_a, b_a)) in g.iter().zip(&b).enumerate() {
+                for (bn, (g_b, cb_b)) in g.iter().zip(&cb).enumerate() {
+                    let material = b_a.tr_mul(cb_b) * self.volume;
                     let geometric = self.volume * g_a.dot(&(tau_k * g_b));
+                    for i in 0..D {
+                        for l in 0..D {
+                            k[(a * D + i, bn * D + l)] = material[(i, l)];
+                        }
+                    }
                     for (i, h) in self.hourglass_matrices.iter().enumerate() {
                         k[(a * D + i, bn * D + i)] += geometric + h[(a, bn)];
                     }
@@ -351,21 +358,19 @@ fn check_parameter(
     }
 }
 
-/// Strain-displacement matrix: column `a*D + i` is the engineering Voigt vector of
-/// `sym(e_i (x) g_a)`, so that `sum_jl g_aj c_ijkl g_bl = (B^T c B)_(ai)(bk)` for a Voigt
-/// tangent `c` with tensor components.
-fn strain_displacement<const D: usize>(g: &[Vector3<f64>]) -> Matrix6xX<f64> {
-    let mut b = Matrix6xX::zeros(D * g.len());
-    for (a, g_a) in g.iter().enumerate() {
-        for i in 0..D {
-            for (row, &(p, q)) in VOIGT_PAIRS.iter().enumerate() {
-                let delta = |m: usize| if m == i { 1.0 } else { 0.0 };
-                b[(row, a * D + i)] = if p == q {
-                    delta(p) * g_a[p]
-                } else {
-                    delta(p) * g_a[q] + delta(q) * g_a[p]
-                };
-            }
+/// Strain-displacement block of one node with spatial gradient `g_a`: column `i` (`i < D`; the
+/// others zero) is the engineering Voigt vector of `sym(e_i (x) g_a)`, so that
+/// `sum_jl g_aj c_ijkl g_bl = (B_a^T c B_b)_ik` for a Voigt tangent `c` with tensor components.
+fn node_strain_displacement<const D: usize>(g_a: &Vector3<f64>) -> Matrix6x3<f64> {
+    let mut b = Matrix6x3::zeros();
+    for i in 0..D {
+        for (row, &(p, q)) in VOIGT_PAIRS.iter().enumerate() {
+            let delta = |m: usize| if m == i { 1.0 } else { 0.0 };
+            b[(row, i)] = if p == q {
+                delta(p) * g_a[p]
+            } else {
+                delta(p) * g_a[q] + delta(q) * g_a[p]
+            };
         }
     }
     b
