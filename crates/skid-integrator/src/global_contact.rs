@@ -37,7 +37,8 @@
 //! - by GMRES on the LU factors of an earlier system, while they serve;
 //! - from [`QUASI_DEFINITE_FROM`] equations, by GMRES preconditioned with the `L D L^T`
 //!   factors of the quasi-definite approximation `S` of [`crate::quasi_definite`] (in the
-//!   nested-dissection order of [`crate::ordering`]): first those of an earlier system, where
+//!   nested-dissection order of [`crate::ordering`]; single-precision factors, see
+//!   [`crate::quasi_definite::Precision`]): first those of an earlier system, where
 //!   that is expected to cost fewer iterations than a factorization of this one's (the
 //!   tangent changes little from one iteration or increment to the next, but every candidate
 //!   that changed branch since adds iterations, see [`GlobalContactSolver::reuse_budget`]),
@@ -55,31 +56,35 @@
 //! pivoting compares like with like. `rho_c` is the inverse of the diagonal approximation
 //! `sum_j H_kj^2 / K_jj` of the candidate's compliance (averaged over its rows).
 //!
-//! The pattern only depends on which equations each candidate involves, so its symbolic
-//! analysis (column ordering and elimination structure) is computed once and reused for as
-//! long as that does not change.
+//! GMRES applies the matrix as an operator ([`system`]: `K` from its lower triangle, each
+//! candidate's rows from its own block), so that the explicit matrix is formed only for an LU
+//! factorization. The pattern of the explicit matrix and of `S` only depends on which
+//! equations each candidate involves, so their symbolic analyses (ordering and elimination
+//! structure) are computed once and reused for as long as that does not change.
 
 use std::sync::Arc;
 
+use faer::Conj;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::lu::{
     LuRef, LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu,
 };
-use faer::sparse::linalg::matmul::sparse_dense_matmul;
 use faer::sparse::{Argsort, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat};
-use faer::{Accum, Conj, MatRef};
 use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 use skid_contact::coulomb::alart_curnier::{LocalBranch, LocalLaw};
 
-use crate::contact_rows::{ContactRows, contact_coordinates};
+use crate::contact_rows::ContactRows;
 use crate::cost::SolveCounts;
 use crate::error::{IncrementFailure, LinearFailure};
 use crate::krylov::gmres;
+use system::{Approximation, LinearSystem};
+
+mod system;
 use crate::model::Model;
 use crate::ordering::global_system_order;
-use crate::quasi_definite::{CONSTRAINT_REGULARIZATION, QuasiDefinite};
+use crate::quasi_definite::{Precision, QuasiDefinite};
 use crate::sparse::column_mut;
 
 /// The system this module's failures name.
@@ -132,15 +137,6 @@ const REUSE_SHARE: f64 = 0.8;
 /// The most GMRES iterations earlier factors get.
 const REUSE_MAX_ITERATIONS: usize = 60;
 
-/// The quasi-definite approximation `S` of one system: its lower-triangle entries (`i >= j`)
-/// and their values, and the branch of every candidate it was built for (see
-/// [`branch_code`]).
-struct Approximation {
-    pairs: Vec<Pair<usize, usize>>,
-    values: Vec<f64>,
-    branches: Vec<u8>,
-}
-
 /// A candidate's branch of the Alart–Curnier function as a number: 0 open, 1 frictionless,
 /// 2 stick, 3 slide.
 fn branch_code(branch: LocalBranch) -> u8 {
@@ -169,6 +165,11 @@ struct Factors {
 }
 
 impl Factors {
+    /// The dimension of the factorized matrix.
+    fn dim(&self) -> usize {
+        self.symbolic.nrows()
+    }
+
     /// Writes `A^{-1} b` into `out`.
     fn solve(&self, b: &DVector<f64>, out: &mut DVector<f64>) {
         let par = faer::get_global_parallelism();
@@ -188,35 +189,22 @@ impl Factors {
 /// `tolerance ||rhs||` (GMRES's own estimate is not trusted alone). The iterations taken (all
 /// `max_iterations` if it fails) are added to `count`.
 fn checked_gmres(
-    matrix: SparseColMatRef<'_, usize, f64>,
+    system: &LinearSystem<'_>,
     rhs: &DVector<f64>,
     m_inv: impl FnMut(&DVector<f64>, &mut DVector<f64>),
     (tolerance, max_iterations): (f64, usize),
     count: &mut usize,
 ) -> Option<(DVector<f64>, usize)> {
-    let apply = |x: &DVector<f64>, out: &mut DVector<f64>| sparse_times(matrix, x, out);
+    let apply = |x: &DVector<f64>, out: &mut DVector<f64>| system.apply(x, out);
     let Some((z, iterations)) = gmres(apply, m_inv, rhs, 0.1 * tolerance, max_iterations) else {
         *count += max_iterations;
         return None;
     };
     *count += iterations;
     let mut residual = DVector::zeros(rhs.len());
-    sparse_times(matrix, &z, &mut residual);
+    system.apply(&z, &mut residual);
     residual -= rhs;
     (residual.norm() <= tolerance * rhs.norm()).then_some((z, iterations))
-}
-
-/// `out = A x` for a sparse `A`.
-fn sparse_times(a: SparseColMatRef<'_, usize, f64>, x: &DVector<f64>, out: &mut DVector<f64>) {
-    let n = x.len();
-    sparse_dense_matmul(
-        column_mut(out),
-        Accum::Replace,
-        a,
-        MatRef::from_column_major_slice(x.as_slice(), n, 1),
-        1.0,
-        faer::get_global_parallelism(),
-    );
 }
 
 /// The global contact step, with what it reuses across Newton iterations and increments: the
@@ -239,6 +227,11 @@ pub struct GlobalContactSolver {
     factors_stale: bool,
     /// The quasi-definite preconditioner, factorized for an earlier system or this one.
     quasi_definite: QuasiDefinite,
+    /// The pattern of the quasi-definite approximations, kept while systems share it.
+    approximation: Approximation,
+    /// The precision of the quasi-definite factors (see
+    /// [`GlobalContactSolver::iterate_quasi_definite`]).
+    precision: Precision,
     /// The candidates' branches (see [`branch_code`]) of the `S` that `quasi_definite`
     /// factorizes, if it serves as a preconditioner.
     preconditioner_branches: Option<Vec<u8>>,
@@ -264,6 +257,8 @@ impl Default for GlobalContactSolver {
             factored_values: None,
             factors_stale: false,
             quasi_definite: QuasiDefinite::default(),
+            approximation: Approximation::default(),
+            precision: Precision::Single,
             preconditioner_branches: None,
             fresh_iterations: 0,
             order: None,
@@ -402,171 +397,16 @@ impl GlobalContactSolver {
         let n = residual.len();
         let d = rows.components;
         let m = rows.rows.len();
-        // entries: both triangles of `k`, and per contact row its coefficients twice (its
-        // column and its row) and its `dim` force columns
-        let lower = k.compute_nnz();
-        let coefficients: usize = rows.rows.iter().map(Vec::len).sum();
-        let capacity = 2 * lower + 2 * coefficients + m * d;
-        let mut pairs: Vec<Pair<usize, usize>> = Vec::with_capacity(capacity);
-        let mut values: Vec<f64> = Vec::with_capacity(capacity);
-        let mut push = |i: usize, j: usize, v: f64| {
-            pairs.push(Pair::new(i, j));
-            values.push(v);
-        };
-        // the symmetric approximation S (lower triangle) of the preconditioner, for systems
-        // large enough to use it
-        let symmetric = n + m >= self.quasi_definite_from;
-        let s_capacity = if symmetric {
-            lower + coefficients + m * d
-        } else {
-            0
-        };
-        let mut s_pairs: Vec<Pair<usize, usize>> = Vec::with_capacity(s_capacity);
-        let mut s_values: Vec<f64> = Vec::with_capacity(s_capacity);
-        let mut s_push = |i: usize, j: usize, v: f64| {
-            if symmetric {
-                s_pairs.push(Pair::new(i, j));
-                s_values.push(v);
-            }
-        };
-        for j in 0..n {
-            for (&i, &v) in k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
-                push(i, j, v);
-                s_push(i, j, v);
-                if i != j {
-                    push(j, i, v);
-                }
-            }
-        }
-        let mut rhs = DVector::<f64>::zeros(n + m);
-        for i in 0..n {
-            rhs[i] = -residual[i];
-        }
-        let candidates = model
-            .contacts()
-            .iter()
-            .enumerate()
-            .flat_map(|(p, pair)| pair.nodes.iter().map(move |&node| (p, node)));
-        let mut open = vec![false; rows.len()];
-        let mut branches = Vec::with_capacity(rows.len());
-        let mut sliding = Vec::new();
-        for (c, (pair, node)) in candidates.enumerate().take(rows.len()) {
-            let equations: Vec<usize> = contact_coordinates(model, pair, node)
-                .into_iter()
-                .flatten()
-                .filter(|&eq| !held[eq])
-                .collect();
-            let coefficient = |row: usize, eq: usize| -> f64 {
-                rows.rows[row]
-                    .iter()
-                    .filter(|&&(e, _)| e == eq)
-                    .map(|&(_, v)| v)
-                    .sum()
-            };
-            let block = c * d..(c + 1) * d;
-            // a candidate exactly at the kink (touching, no force yet) is taken as closing:
-            // as open, the step would let it pass through the surface unresisted
-            let law = LocalLaw::evaluate_at_kink(
-                d,
-                rows.mu[c],
-                rho[c],
-                &r.as_slice()[block.clone()],
-                &rows.u.as_slice()[block.clone()],
-                LocalBranch::Frictionless,
-            )
-            .with_balanced_slide_rows(d);
-            open[c] = law.branch == LocalBranch::Open;
-            branches.push(branch_code(law.branch));
-            if law.branch == LocalBranch::Slide {
-                sliding.push((c, law));
-            }
-            // the block of S on the candidate's tangential rows (see `crate::quasi_definite`):
-            // across a sliding direction the softened constraint of the balanced rows
-            let slide = law.slide.filter(|_| d == 3);
-            let projector = |t: usize, s: usize| match slide {
-                Some(frame) => f64::from(u8::from(s == t)) - frame.d[t - 1] * frame.d[s - 1],
-                None => 0.0,
-            };
-            for t in 0..d {
-                let row = n + c * d + t;
-                let constraint = match law.branch {
-                    LocalBranch::Open => false,
-                    LocalBranch::Stick => true,
-                    LocalBranch::Frictionless | LocalBranch::Slide => t == 0,
-                };
-                for &eq in &equations {
-                    let h = coefficient(c * d + t, eq);
-                    push(eq, row, -rho[c] * h);
-                    let coupling = if constraint {
-                        -rho[c] * h
-                    } else if t > 0 && slide.is_some() {
-                        -rho[c]
-                            * (1..d)
-                                .map(|s| projector(t, s) * coefficient(c * d + s, eq))
-                                .sum::<f64>()
-                    } else {
-                        0.0
-                    };
-                    s_push(row, eq, coupling);
-                    let du: f64 = (0..d)
-                        .map(|s| law.d_u[t][s] * coefficient(c * d + s, eq))
-                        .sum();
-                    push(row, eq, du);
-                }
-                if t > 0 && d == 3 {
-                    // lower triangle of the 2 x 2 tangential block: d d^T + (c + eps) P
-                    for s in 1..=t {
-                        let value = slide.map_or(0.0, |frame| {
-                            let along = frame.d[t - 1] * frame.d[s - 1];
-                            let c_soft = (1.0 - frame.f) / frame.f + CONSTRAINT_REGULARIZATION;
-                            along + c_soft * projector(t, s)
-                        });
-                        let diagonal = if s == t && slide.is_none() {
-                            if constraint {
-                                CONSTRAINT_REGULARIZATION
-                            } else {
-                                1.0
-                            }
-                        } else {
-                            value
-                        };
-                        s_push(row, n + c * d + s, -diagonal * rho[c]);
-                    }
-                } else {
-                    let weight = if constraint {
-                        CONSTRAINT_REGULARIZATION
-                    } else {
-                        1.0
-                    };
-                    s_push(row, row, -weight * rho[c]);
-                }
-                for s in 0..d {
-                    push(row, n + c * d + s, law.d_r[t][s] * rho[c]);
-                }
-                rhs[row] = -law.phi[t];
-                // the equilibrium rows' residual with the current forces, `-(R - H^T r)`
-                for &eq in &equations {
-                    rhs[eq] += coefficient(c * d + t, eq) * r[c * d + t];
-                }
-            }
-        }
-        let matrix = self.assemble(n + m, pairs, &values)?;
-        if symmetric {
-            self.order_for(model, n + m);
-        }
-        let s = symmetric.then_some(Approximation {
-            pairs: s_pairs,
-            values: s_values,
-            branches,
-        });
-        let mut solution = self.solve_system(matrix.as_ref(), &rhs, n, s)?;
-        for (c, law) in &sliding {
-            exact_friction_rows(law, rows, rho[*c], *c, n, &mut solution);
+        let system = LinearSystem::new(model, k, rows, r, rho, held);
+        let rhs = system.right_hand_side(residual, r);
+        let mut solution = self.solve_system(model, &system, &rhs)?;
+        for (c, law) in system.sliding() {
+            exact_friction_rows(law, rows, rho[c], c, n, &mut solution);
         }
         let dx = DVector::from_fn(n, |i, _| solution[i]);
         // An open candidate's rows say `r' = 0`: exactly zero, not the linear solve's round-off.
         let forces = DVector::from_fn(m, |k, _| {
-            if open[k / d] {
+            if system.branch(k / d) == LocalBranch::Open {
                 0.0
             } else {
                 r[k] + rho[k / d] * solution[n + k]
@@ -578,29 +418,33 @@ impl GlobalContactSolver {
         Ok(GlobalStep { dx, r: forces })
     }
 
-    /// Solves `matrix z = rhs`: by GMRES on the last LU factors while they serve; then, if
-    /// `symmetric` gives this system's quasi-definite approximation `S` (first `unknowns` rows
-    /// positive), by GMRES on the factors of an earlier `S` where that is expected to be
+    /// Solves `system z = rhs`: by GMRES on the last LU factors while they serve; then, for
+    /// systems of [`GlobalContactSolver::quasi_definite_from`] unknowns or more, by GMRES on
+    /// the factors of an earlier quasi-definite approximation `S` where that is expected to be
     /// cheaper than a factorization (see [`GlobalContactSolver::reuse_budget`]), or else on the
-    /// factors of this `S`; else by a new LU factorization.
+    /// factors of this system's `S`; else by a new LU factorization.
     ///
     /// # Errors
-    /// [`IncrementFailure::LinearSolve`] if the LU factorization fails.
-    fn solve_system(
+    /// [`IncrementFailure::LinearSolve`] if the LU factorization fails, or the system is too
+    /// large for one and GMRES did not solve it.
+    fn solve_system<const D: usize>(
         &mut self,
-        matrix: SparseColMatRef<'_, usize, f64>,
+        model: &Model<D>,
+        system: &LinearSystem<'_>,
         rhs: &DVector<f64>,
-        unknowns: usize,
-        symmetric: Option<Approximation>,
     ) -> Result<DVector<f64>, IncrementFailure> {
-        if let Some(z) = self.iterate(matrix, rhs) {
+        if let Some(z) = self.iterate(system, rhs) {
             return Ok(z);
         }
-        if let Some(approximation) = symmetric {
-            if let Some(budget) = self.reuse_budget(rhs.len(), &approximation.branches) {
+        let dim = system.dim();
+        if dim >= self.quasi_definite_from {
+            let branches: Vec<u8> = (0..system.candidates())
+                .map(|c| branch_code(system.branch(c)))
+                .collect();
+            if let Some(budget) = self.reuse_budget(dim, &branches) {
                 let preconditioner = &self.quasi_definite;
                 if let Some((z, _)) = checked_gmres(
-                    matrix,
+                    system,
                     rhs,
                     |x, out| preconditioner.precondition(x, out),
                     (INEXACT_TOLERANCE, budget),
@@ -609,10 +453,10 @@ impl GlobalContactSolver {
                     return Ok(z);
                 }
             }
-            if let Some(z) = self.iterate_quasi_definite(matrix, rhs, unknowns, approximation) {
+            if let Some(z) = self.iterate_quasi_definite(model, system, rhs, branches) {
                 return Ok(z);
             }
-            if rhs.len() >= self.lu_until {
+            if dim >= self.lu_until {
                 return Err(IncrementFailure::linear(
                     SYSTEM,
                     LinearFailure::Solver(format!(
@@ -625,7 +469,9 @@ impl GlobalContactSolver {
             }
         }
         self.counts.lu_factorizations += 1;
-        self.factorize(matrix)?;
+        let (pairs, values) = system.entries();
+        let matrix = self.assemble(dim, pairs, &values)?;
+        self.factorize(matrix.as_ref())?;
         let factors = self.factors.as_ref().ok_or_else(|| {
             IncrementFailure::linear(SYSTEM, LinearFailure::Structure("not factorized".into()))
         })?;
@@ -634,21 +480,18 @@ impl GlobalContactSolver {
         Ok(z)
     }
 
-    /// GMRES on `matrix z = rhs`, right-preconditioned by the last LU factors unless they are
-    /// stale; `Some(z)` if its true relative residual reaches [`KRYLOV_TOLERANCE`] within
-    /// [`KRYLOV_MAX_ITERATIONS`]. A failure marks the factors stale: once they no longer serve,
-    /// they are not tried again until the next factorization.
-    fn iterate(
-        &mut self,
-        matrix: SparseColMatRef<'_, usize, f64>,
-        rhs: &DVector<f64>,
-    ) -> Option<DVector<f64>> {
+    /// GMRES on `system z = rhs`, right-preconditioned by the last LU factors unless they are
+    /// stale or of another dimension; `Some(z)` if its true relative residual reaches
+    /// [`KRYLOV_TOLERANCE`] within [`KRYLOV_MAX_ITERATIONS`]. A failure marks the factors
+    /// stale: once they no longer serve, they are not tried again until the next
+    /// factorization.
+    fn iterate(&mut self, system: &LinearSystem<'_>, rhs: &DVector<f64>) -> Option<DVector<f64>> {
         if self.factors_stale {
             return None;
         }
-        let factors = self.factors.as_ref()?;
+        let factors = self.factors.as_ref().filter(|f| f.dim() == rhs.len())?;
         let solution = checked_gmres(
-            matrix,
+            system,
             rhs,
             |x, out| factors.solve(x, out),
             (KRYLOV_TOLERANCE, KRYLOV_MAX_ITERATIONS),
@@ -658,45 +501,58 @@ impl GlobalContactSolver {
         solution.map(|(z, _)| z)
     }
 
-    /// GMRES on `matrix z = rhs` preconditioned by the `L D L^T` factorization of its
-    /// symmetric quasi-definite approximation `S` (lower-triangle entries `pairs` with
-    /// `values`; see [`crate::quasi_definite`]); `Some(z)` if its true relative residual
-    /// reaches [`INEXACT_TOLERANCE`] within [`QUASI_DEFINITE_MAX_ITERATIONS`] (or
-    /// [`WITHOUT_LU_MAX_ITERATIONS`] from [`GlobalContactSolver::lu_until`] unknowns).
-    fn iterate_quasi_definite(
+    /// GMRES on `system z = rhs` preconditioned by the `L D L^T` factorization of its
+    /// symmetric quasi-definite approximation `S` (see [`crate::quasi_definite`]); `Some(z)`
+    /// if its true relative residual reaches [`INEXACT_TOLERANCE`] within
+    /// [`QUASI_DEFINITE_MAX_ITERATIONS`] (or [`WITHOUT_LU_MAX_ITERATIONS`] from
+    /// [`GlobalContactSolver::lu_until`] unknowns). The factors are single-precision until
+    /// they once fail where double-precision ones serve; from then on, double.
+    fn iterate_quasi_definite<const D: usize>(
         &mut self,
-        matrix: SparseColMatRef<'_, usize, f64>,
+        model: &Model<D>,
+        system: &LinearSystem<'_>,
         rhs: &DVector<f64>,
-        unknowns: usize,
-        approximation: Approximation,
+        branches: Vec<u8>,
     ) -> Option<DVector<f64>> {
         // factors that fail to factorize or to precondition do not serve a later system
         self.preconditioner_branches = None;
-        let Approximation {
-            pairs,
-            values,
-            branches,
-        } = approximation;
-        self.counts.preconditioner_factorizations += 1;
-        self.quasi_definite
-            .factorize(rhs.len(), unknowns, pairs, &values, self.order.as_deref())
-            .ok()?;
-        let preconditioner = &self.quasi_definite;
-        let budget = if rhs.len() >= self.lu_until {
+        let dim = rhs.len();
+        let budget = if dim >= self.lu_until {
             WITHOUT_LU_MAX_ITERATIONS
         } else {
             QUASI_DEFINITE_MAX_ITERATIONS
         };
-        let (z, iterations) = checked_gmres(
-            matrix,
-            rhs,
-            |x, out| preconditioner.precondition(x, out),
-            (INEXACT_TOLERANCE, budget),
-            &mut self.counts.krylov_iterations,
-        )?;
-        self.preconditioner_branches = Some(branches);
-        self.fresh_iterations = iterations;
-        Some(z)
+        self.order_for(model, dim);
+        let order = self.order.as_deref();
+        let (symbolic, values) = self.approximation.of(system);
+        let precisions: &[Precision] = match self.precision {
+            Precision::Single => &[Precision::Single, Precision::Double],
+            Precision::Double => &[Precision::Double],
+        };
+        for &precision in precisions {
+            self.counts.preconditioner_factorizations += 1;
+            if self
+                .quasi_definite
+                .factorize(symbolic, &values, system.equations(), order, precision)
+                .is_err()
+            {
+                continue;
+            }
+            let preconditioner = &self.quasi_definite;
+            if let Some((z, iterations)) = checked_gmres(
+                system,
+                rhs,
+                |x, out| preconditioner.precondition(x, out),
+                (INEXACT_TOLERANCE, budget),
+                &mut self.counts.krylov_iterations,
+            ) {
+                self.precision = precision;
+                self.preconditioner_branches = Some(branches);
+                self.fresh_iterations = iterations;
+                return Some(z);
+            }
+        }
+        None
     }
 
     /// The GMRES iterations to give the quasi-definite factors of an earlier system on a
@@ -944,39 +800,32 @@ mod tests {
     use crate::contact_rows::contact_rows;
     use crate::cost::Timings;
     use crate::coupling::contact_step;
+    use crate::model::Model;
+    use crate::quasi_definite::CONSTRAINT_REGULARIZATION;
+    use crate::sparse::symmetric_times;
     use crate::test_support::block_on_drum;
-    use nalgebra::Vector2;
+    use nalgebra::{DMatrix, Vector2};
     use skid_contact::coulomb::CoulombSettings;
 
     /// `K v` from the lower triangle of a symmetric `K`.
-    fn symmetric_times(k: SparseColMatRef<'_, usize, f64>, v: &DVector<f64>) -> DVector<f64> {
+    fn symmetric_product(k: SparseColMatRef<'_, usize, f64>, v: &DVector<f64>) -> DVector<f64> {
         let mut out = DVector::zeros(v.len());
-        for j in 0..k.ncols() {
-            for (&i, &a) in k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
-                out[i] += a * v[j];
-                if i != j {
-                    out[j] += a * v[i];
-                }
-            }
-        }
+        symmetric_times(k, v.as_slice(), out.as_mut_slice());
         out
     }
 
-    /// On one linearisation (`K`, `H` fixed), semismooth Newton on the global system converges
-    /// to the solution of the reduced (Delassus) path: the same forces to 1e-8 relative and the
-    /// same step, with open, sticking and sliding candidates among them. Its last steps
-    /// converge quadratically.
-    fn global_iteration_solves_the_reduced_problem<const D: usize>(
-        quasi_definite_from: usize,
-        lu_until: usize,
-    ) {
+    /// One linearisation of the block pressed on the drum (held, as in a preload): the
+    /// assembler holding the tangent, the contact rows, and a residual that pushes the pad
+    /// down into the drum, less towards x = -0.05 (where it may stay open), and sideways, more
+    /// towards x = -0.05 (where it slides; it sticks towards x = +0.05).
+    fn pressed_block<const D: usize>() -> (Model<D>, Assembler, ContactRows, DVector<f64>, Vec<bool>)
+    {
         let model = block_on_drum::<D>();
         let n = model.dofs().len();
         let x = DVector::zeros(n);
         let mut assembler = Assembler::new(&model).expect("assembler");
         assembler.internal(&model, &x, Some(1.0)).expect("internal");
         assembler.add_diagonal(&(model.mass() * 1e8));
-        // the drum held, as in a preload
         let mut held = vec![false; n];
         for eq in model.dofs().body_equations(0) {
             held[eq] = true;
@@ -988,8 +837,6 @@ mod tests {
             .expect("rows")
             .coords;
         let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
-        // push the pad down into the drum, less towards x = -0.05 (where it may stay open),
-        // and sideways, more towards x = -0.05 (where it slides; it sticks towards x = +0.05)
         let mut residual = DVector::zeros(n);
         for (node, p) in model.part().mesh.nodes.iter().enumerate() {
             let [Some(ex), Some(ey)] = [model.dofs().node(node)[0], model.dofs().node(node)[1]]
@@ -1000,6 +847,19 @@ mod tests {
             residual[ey] = 1e-2 * scale * (0.5 + 10.0 * p[0]).max(0.0);
             residual[ex] = -2e-4 * scale * (1.0 - 18.0 * p[0]);
         }
+        (model, assembler, rows, residual, held)
+    }
+
+    /// On one linearisation (`K`, `H` fixed), semismooth Newton on the global system converges
+    /// to the solution of the reduced (Delassus) path: the same forces to 1e-8 relative and the
+    /// same step, with open, sticking and sliding candidates among them. Its last steps
+    /// converge quadratically.
+    fn global_iteration_solves_the_reduced_problem<const D: usize>(
+        quasi_definite_from: usize,
+        lu_until: usize,
+    ) {
+        let (model, mut assembler, rows, residual, held) = pressed_block::<D>();
+        let n = model.dofs().len();
         let settings = CoulombSettings::default();
         let mut timings = Timings::default();
         let warm = DVector::zeros(rows.rows.len());
@@ -1028,7 +888,7 @@ mod tests {
         for _ in 0..30 {
             let mut linear = rows.clone();
             linear.u = &rows.u + rows.times(&dx);
-            let linear_residual = &residual + symmetric_times(k.as_ref(), &dx);
+            let linear_residual = &residual + symmetric_product(k.as_ref(), &dx);
             let step = solver
                 .step(
                     &model,
@@ -1117,6 +977,104 @@ mod tests {
             global_iteration_solves_the_reduced_problem::<2>(0, lu_until);
             global_iteration_solves_the_reduced_problem::<3>(0, lu_until);
         }
+    }
+
+    /// The operator `A v` and the explicit entries of `A` agree; the quasi-definite
+    /// approximation `S` built on its pattern holds `K` and, flipped (`diag(I, -I) S`), equals
+    /// `A` on the rows and columns of every candidate that does not slide, but for the
+    /// constraint rows' regularisation `-eps rho`; `S` on a second system of the same pattern
+    /// reuses it.
+    fn operator_entries_and_approximation_agree<const D: usize>() {
+        let (model, assembler, rows, _, held) = pressed_block::<D>();
+        let n = model.dofs().len();
+        let k = assembler.lower_triangle().expect("lower");
+        let rho = contact_weights(k.as_ref(), &rows);
+        // forces that open every fourth candidate, and of the others make one in three slide
+        // (twice the friction the cone holds) and the rest stick (half of it)
+        let mut r = DVector::zeros(rows.rows.len());
+        for c in 0..rows.len() {
+            let tau = if c % 4 == 3 { -50.0 } else { 100.0 };
+            r[c * D] = rho[c] * rows.u[c * D] + tau;
+            let share = if c % 3 == 0 { 2.0 } else { 0.5 };
+            r[c * D + 1] = rho[c] * rows.u[c * D + 1] + share * rows.mu[c] * tau;
+        }
+        let system = LinearSystem::new(&model, k.as_ref(), &rows, &r, &rho, &held);
+        let dim = system.dim();
+        let (pairs, values) = system.entries();
+        let mut a = DMatrix::<f64>::zeros(dim, dim);
+        for (p, v) in pairs.iter().zip(&values) {
+            a[(p.row, p.col)] += v;
+        }
+        let v = DVector::from_fn(dim, |i, _| (0.3 * i as f64).sin());
+        let mut av = DVector::zeros(dim);
+        system.apply(&v, &mut av);
+        assert!((&a * &v - &av).amax() <= 1e-12 * av.amax(), "{D}D");
+
+        let mut approximation = Approximation::default();
+        let (symbolic, values) = approximation.of(&system);
+        let pattern = Arc::clone(symbolic);
+        let mut s = DMatrix::<f64>::zeros(dim, dim);
+        for j in 0..dim {
+            let range = pattern.col_ptr()[j]..pattern.col_ptr()[j + 1];
+            for (&i, &value) in pattern.row_idx()[range.clone()].iter().zip(&values[range]) {
+                assert!(i >= j, "{D}D: ({i}, {j}) above the diagonal");
+                s[(i, j)] += value;
+                if i != j {
+                    s[(j, i)] += value;
+                }
+            }
+        }
+        let k_dense = DMatrix::from_fn(n, n, |i, j| a[(i, j)]);
+        assert_eq!(s.view((0, 0), (n, n)), k_dense, "{D}D");
+        let mut kinds = Vec::new();
+        for (c, &rho_c) in rho.iter().enumerate().take(system.candidates()) {
+            let branch = system.branch(c);
+            kinds.push(branch);
+            if branch == LocalBranch::Slide {
+                continue;
+            }
+            for t in 0..D {
+                let row = n + c * D + t;
+                let constraint = match branch {
+                    LocalBranch::Open => false,
+                    LocalBranch::Stick => true,
+                    LocalBranch::Frictionless | LocalBranch::Slide => t == 0,
+                };
+                for j in 0..dim {
+                    let regularisation = if j == row && constraint {
+                        CONSTRAINT_REGULARIZATION * rho_c
+                    } else {
+                        0.0
+                    };
+                    assert!(
+                        (-s[(row, j)] - a[(row, j)] - regularisation).abs() <= 1e-12 * rho_c,
+                        "{D}D: candidate {c} ({branch:?}) row {t}, column {j}: {} vs {}",
+                        -s[(row, j)],
+                        a[(row, j)]
+                    );
+                }
+                // a constraint row's force acts on the equations; any other's is decoupled
+                for j in 0..n {
+                    let expected = if constraint { a[(j, row)] } else { 0.0 };
+                    assert!((s[(j, row)] - expected).abs() <= 1e-12 * rho_c, "{D}D");
+                }
+            }
+        }
+        for wanted in [LocalBranch::Open, LocalBranch::Stick, LocalBranch::Slide] {
+            assert!(kinds.contains(&wanted), "{D}D: {kinds:?}");
+        }
+        let (again, _) = approximation.of(&system);
+        assert!(Arc::ptr_eq(again, &pattern), "{D}D: the pattern is kept");
+    }
+
+    #[test]
+    fn operator_entries_and_approximation_agree_2d() {
+        operator_entries_and_approximation_agree::<2>();
+    }
+
+    #[test]
+    fn operator_entries_and_approximation_agree_3d() {
+        operator_entries_and_approximation_agree::<3>();
     }
 
     /// Earlier factors are reused where the iterations they are expected to add cost less

@@ -22,7 +22,9 @@ use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
     factorize_symbolic_cholesky,
 };
-use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat, SymbolicSparseColMatRef};
+use faer::sparse::{
+    Argsort, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef,
+};
 use faer::{Conj, Mat, MatMut, Side};
 use nalgebra::{DMatrix, DVector};
 
@@ -36,6 +38,22 @@ const TANGENT: &str = "effective tangent";
 pub(crate) fn column_mut(v: &mut DVector<f64>) -> MatMut<'_, f64> {
     let n = v.len();
     MatMut::from_column_major_slice_mut(v.as_mut_slice(), n, 1)
+}
+
+/// `out = K x` for a symmetric `K` given by its lower triangle `lower` (an entry above the
+/// diagonal would be counted twice, so there must be none).
+pub(crate) fn symmetric_times(lower: SparseColMatRef<'_, usize, f64>, x: &[f64], out: &mut [f64]) {
+    out.fill(0.0);
+    for (j, &x_j) in x.iter().enumerate().take(lower.ncols()) {
+        let mut column_sum = 0.0;
+        for (&i, &a) in lower.row_idx_of_col_raw(j).iter().zip(lower.val_of_col(j)) {
+            out[i] += a * x_j;
+            if i != j {
+                column_sum += a * x[i];
+            }
+        }
+        out[j] += column_sum;
+    }
 }
 
 /// Collects the (row, column) positions of the lower triangle in the order values will be
