@@ -10,6 +10,9 @@ use crate::error::FemError;
 /// Voigt order of the symmetric index pairs: `[11, 22, 33, 12, 23, 13]` (zero-based).
 pub const VOIGT_PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2)];
 
+/// Position `VOIGT_INDEX[i][j]` of the symmetric index pair `(i, j)` in [`VOIGT_PAIRS`].
+pub const VOIGT_INDEX: [[usize; 3]; 3] = [[0, 3, 5], [3, 1, 4], [5, 4, 2]];
+
 /// A hyperelastic material described by its strain energy per unit reference volume `W(F)`.
 pub trait Hyperelastic: Send + Sync + std::fmt::Debug {
     /// Strain energy per unit reference volume W(F).
@@ -65,7 +68,7 @@ impl SpatialTangent {
     /// # Panics
     /// If any index exceeds 2 (a programming error, like out-of-bounds indexing).
     pub fn get(&self, i: usize, j: usize, k: usize, l: usize) -> f64 {
-        self.0[(voigt_index(i, j), voigt_index(k, l))]
+        self.0[(VOIGT_INDEX[i][j], VOIGT_INDEX[k][l])]
     }
 
     /// Double contraction `(c : a)_ij = c_ijkl a_kl`; by minor symmetry only `sym(a)` enters.
@@ -80,20 +83,7 @@ impl SpatialTangent {
             }
         });
         let result = self.0 * engineering;
-        Matrix3::from_fn(|i, j| result[voigt_index(i, j)])
-    }
-}
-
-/// Position of the symmetric pair `(i, j)` in [`VOIGT_PAIRS`].
-fn voigt_index(i: usize, j: usize) -> usize {
-    match (i.min(j), i.max(j)) {
-        (0, 0) => 0,
-        (1, 1) => 1,
-        (2, 2) => 2,
-        (0, 1) => 3,
-        (1, 2) => 4,
-        (0, 2) => 5,
-        _ => panic!("tensor index pair ({i}, {j}) out of range 0..3"),
+        Matrix3::from_fn(|i, j| result[VOIGT_INDEX[i][j]])
     }
 }
 
@@ -323,6 +313,13 @@ mod tests {
 
     fn relative_error(a: &Matrix3<f64>, b: &Matrix3<f64>, scale: f64) -> f64 {
         (a - b).norm() / scale
+    }
+
+    #[test]
+    fn voigt_index_inverts_the_voigt_pairs() {
+        for (r, &(i, j)) in VOIGT_PAIRS.iter().enumerate() {
+            assert_eq!((VOIGT_INDEX[i][j], VOIGT_INDEX[j][i]), (r, r));
+        }
     }
 
     #[test]

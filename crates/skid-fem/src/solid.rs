@@ -1,14 +1,24 @@
 //! One-point (reduced-integration) solid element with Flanagan-Belytschko hourglass stiffness:
 //! the CPE4R role in 2D plane strain (D = 2) and the C3D8R role in 3D (D = 3), one code path.
+//!
+//! An evaluation allocates nothing: its results live in fixed arrays sized for the largest
+//! element (3D), and the tangent goes into a buffer of the caller's.
 
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix6x3, SVector, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, SMatrix, SVector, Vector3};
 
 use crate::cell::{
     ReferenceGeometry, corner_count, corners, embed, hourglass_base_vectors, hourglass_mode_axes,
     jacobian, restrict, shape_gradients,
 };
 use crate::error::FemError;
-use crate::material::{Hyperelastic, VOIGT_PAIRS};
+use crate::material::{Hyperelastic, VOIGT_INDEX};
+
+/// Most nodes of an element: `2^D` for D <= 3.
+pub const MAX_NODES: usize = 8;
+
+/// Most displacement components of an element: `D 2^D` for D <= 3. An element stiffness has
+/// at most its square entries.
+pub const MAX_COMPONENTS: usize = 3 * MAX_NODES;
 
 /// A reduced-integration solid element: reference volume, mean gradients and hourglass data.
 #[derive(Clone, Debug)]
@@ -17,25 +27,28 @@ pub struct OnePointSolid<const D: usize> {
     volume: f64,
     /// Mean gradients `b_I = (1/V0) int dN_I/dX dV`.
     mean_gradients: Vec<SVector<f64, D>>,
-    /// Hourglass shape vectors `gamma_alpha` as the rows of a (modes x nodes) matrix.
-    hourglass_vectors: DMatrix<f64>,
-    /// Hourglass stiffness `k_{alpha i}` (modes x displacement directions).
-    hourglass_stiffness: DMatrix<f64>,
+    /// Hourglass shape vectors `gamma_alpha`, one per mode (node values; the first `2^D` used).
+    hourglass_vectors: Vec<[f64; MAX_NODES]>,
+    /// Hourglass stiffness `k_{alpha i}`, one vector over the displacement directions i per mode.
+    hourglass_stiffness: Vec<SVector<f64, D>>,
     /// Per displacement direction i, the constant stabilisation stiffness on the nodes'
-    /// i-components: `Gamma^T diag(k_{. i}) Gamma`.
-    hourglass_matrices: Vec<DMatrix<f64>>,
+    /// i-components: `[i][I][J] = sum_alpha k_{alpha i} gamma_{alpha I} gamma_{alpha J}`.
+    hourglass_matrices: [[[f64; MAX_NODES]; MAX_NODES]; D],
     /// Per corner of the cell, the reference gradients `grad_X N_I` there, for the corner check
     /// of [`Self::respond`].
     corner_gradients: Vec<Vec<SVector<f64, D>>>,
 }
 
-/// Response of one element at a given displacement.
-#[derive(Clone, Debug)]
+/// Response of one element at a given displacement. Vectors are node-major (index `a * D + i`)
+/// with `D * 2^D` components.
+#[derive(Clone, Copy, Debug, Default)]
 pub struct ElementResponse {
-    /// Internal nodal forces, length `D * 2^D`, node-major (index `a * D + i`).
-    pub force: DVector<f64>,
-    /// Tangent `d force / d u` (symmetric), same ordering, if requested.
-    pub stiffness: Option<DMatrix<f64>>,
+    /// `D * 2^D`, the length of [`Self::force`] and [`Self::volume_ratio_gradient`].
+    components: usize,
+    /// Internal nodal forces in the first `components` entries.
+    force: [f64; MAX_COMPONENTS],
+    /// `dJ/du` in the first `components` entries.
+    volume_ratio_gradient: [f64; MAX_COMPONENTS],
     /// Material strain energy `V0 W(F)`.
     pub strain_energy: f64,
     /// Hourglass stabilisation energy.
@@ -44,15 +57,23 @@ pub struct ElementResponse {
     pub cauchy_stress: Matrix3<f64>,
     /// Volume ratio `J = det F`.
     pub volume_ratio: f64,
-    /// `dJ/du`, same ordering as the force: `J g_a` for node `a` (`g_a = F^{-T} b_a`).
-    pub volume_ratio_gradient: DVector<f64>,
 }
 
-/// Which tangent stiffness an element evaluation returns.
+impl ElementResponse {
+    /// Internal nodal forces, length `D * 2^D`, node-major (index `a * D + i`).
+    pub fn force(&self) -> &[f64] {
+        &self.force[..self.components]
+    }
+
+    /// `dJ/du`, same ordering as the force: `J g_a` for node `a` (`g_a = F^{-T} b_a`).
+    pub fn volume_ratio_gradient(&self) -> &[f64] {
+        &self.volume_ratio_gradient[..self.components]
+    }
+}
+
+/// Which tangent stiffness [`OnePointSolid::respond_with_tangent`] returns.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Tangent {
-    /// None: forces and energies only.
-    None,
     /// The consistent tangent `d force / d u` of the displacement formulation.
     Consistent,
     /// The tangent of the condensed one-point mixed (u-p) formulation at the element pressure
@@ -135,27 +156,34 @@ impl<const D: usize> OnePointSolid<D> {
         let gradients: Vec<DVector<f64>> = (0..D)
             .map(|j| DVector::from_iterator(n, b.iter().map(|g| g[j])))
             .collect();
-        let bases = hourglass_base_vectors::<D>()?;
-        let mut hourglass_vectors = DMatrix::zeros(bases.len(), n);
-        for (alpha, h) in bases.iter().enumerate() {
-            let mut gamma = h.clone();
-            for (x_j, b_j) in coordinates.iter().zip(&gradients) {
-                gamma.axpy(-h.dot(x_j), b_j, 1.0);
-            }
-            hourglass_vectors.set_row(alpha, &(gamma / n as f64).transpose());
-        }
+        let hourglass_vectors: Vec<[f64; MAX_NODES]> = hourglass_base_vectors::<D>()?
+            .iter()
+            .map(|h| {
+                let mut gamma = h.clone();
+                for (x_j, b_j) in coordinates.iter().zip(&gradients) {
+                    gamma.axpy(-h.dot(x_j), b_j, 1.0);
+                }
+                let mut values = [0.0; MAX_NODES];
+                for (value, gamma_a) in values.iter_mut().zip(gamma.iter()) {
+                    *value = gamma_a / n as f64;
+                }
+                values
+            })
+            .collect();
         let hourglass_stiffness = hourglass_stiffness::<D>(
             &geometry_gradients(x_ref)?,
             hourglass_scale * shear_modulus * volume,
         )?;
-        let hourglass_matrices = (0..D)
-            .map(|i| {
-                let weighted = DMatrix::from_fn(bases.len(), n, |alpha, a| {
-                    hourglass_stiffness[(alpha, i)] * hourglass_vectors[(alpha, a)]
-                });
-                hourglass_vectors.tr_mul(&weighted)
-            })
-            .collect();
+        let mut hourglass_matrices = [[[0.0; MAX_NODES]; MAX_NODES]; D];
+        for (i, h) in hourglass_matrices.iter_mut().enumerate() {
+            for (gamma, k) in hourglass_vectors.iter().zip(&hourglass_stiffness) {
+                for (h_a, gamma_a) in h.iter_mut().zip(gamma).take(n) {
+                    for (h_ab, gamma_b) in h_a.iter_mut().zip(gamma).take(n) {
+                        *h_ab += k[i] * gamma_a * gamma_b;
+                    }
+                }
+            }
+        }
         Ok(Self {
             volume,
             mean_gradients: b,
@@ -182,43 +210,18 @@ impl<const D: usize> OnePointSolid<D> {
     /// F = I + sum_I u_I (x) b_I, embedded in 3D (plane strain: F33 = 1,
     /// F13 = F23 = F31 = F32 = 0).
     ///
-    /// `u` must hold one displacement per node; [`Self::evaluate`] checks this.
+    /// `u` must hold one displacement per node; [`Self::respond`] checks this.
     pub fn deformation_gradient(&self, u: &[SVector<f64, D>]) -> Matrix3<f64> {
         gradient_of(&self.mean_gradients, u)
     }
 
-    /// Internal force, optional consistent tangent, energies and stress at displacement u
-    /// (node-major ordering: index a*D + i); see [`Self::respond`].
-    ///
-    /// # Errors
-    /// As [`Self::respond`].
-    pub fn evaluate(
-        &self,
-        material: &dyn Hyperelastic,
-        u: &[SVector<f64, D>],
-        with_tangent: bool,
-    ) -> Result<ElementResponse, FemError> {
-        let tangent = if with_tangent {
-            Tangent::Consistent
-        } else {
-            Tangent::None
-        };
-        self.respond(material, u, tangent)
-    }
-
-    /// Internal force, the requested tangent, energies and stress at displacement u (node-major
+    /// Internal force, energies, stress and volume ratio at displacement u (node-major
     /// ordering: index a*D + i).
     ///
     /// With `g_a = F^{-T} b_a` (the spatial gradient of `N_a`) and the Kirchhoff stress `tau`:
-    /// material force `f_a = V0 tau g_a`; tangent
-    /// `K_ab,ik = V0 [sum_jl g_aj c^tau_ijkl g_bl + (g_a . tau g_b) delta_ik]` (material +
-    /// geometric), with only in-plane `i, k` in 2D. Hourglass: `q_{i alpha} = gamma_alpha . u_i`,
-    /// `E_hg = 1/2 sum_i k_i sum_alpha q_{i alpha}^2`,
-    /// `f_{iI} = k_i sum_alpha q_{i alpha} gamma_{alpha I}`, constant stiffness
-    /// `k_i sum_alpha gamma_{alpha I} gamma_{alpha J}`.
-    ///
-    /// With [`Tangent::Mixed`] the stress `tau` of the geometric term and the tangent `c^tau`
-    /// are those of the mixed formulation at the given pressure.
+    /// material force `f_a = V0 tau g_a`. Hourglass: `q_{i alpha} = gamma_alpha . u_i`,
+    /// `E_hg = 1/2 sum_i sum_alpha k_{alpha i} q_{i alpha}^2`,
+    /// `f_{iI} = sum_alpha k_{alpha i} q_{i alpha} gamma_{alpha I}`.
     ///
     /// The single integration point does not see an element folded by its hourglass modes (the
     /// mean `F` stays that of the affine part), so `J` is also checked at every corner of the
@@ -233,14 +236,58 @@ impl<const D: usize> OnePointSolid<D> {
         &self,
         material: &dyn Hyperelastic,
         u: &[SVector<f64, D>],
+    ) -> Result<ElementResponse, FemError> {
+        self.evaluate(material, u, None)
+    }
+
+    /// As [`Self::respond`], and the requested tangent `d force / d u` into `stiffness`: the
+    /// symmetric `n x n` matrix (`n = D 2^D`, node-major), all of its entries (column-major,
+    /// which for a symmetric matrix is also row-major).
+    ///
+    /// `K_ab,ik = V0 [sum_jl g_aj c^tau_ijkl g_bl + (g_a . tau g_b) delta_ik]` (material +
+    /// geometric), with only in-plane `i, k` in 2D, plus the constant hourglass stiffness
+    /// `delta_ik sum_alpha k_{alpha i} gamma_{alpha a} gamma_{alpha b}`. By the major symmetry of
+    /// `c^tau`, `K_ba = K_ab^T`: each node pair is evaluated once.
+    ///
+    /// With [`Tangent::Mixed`] the stress `tau` of the geometric term and the tangent `c^tau`
+    /// are those of the mixed formulation at the given pressure.
+    ///
+    /// # Errors
+    /// As [`Self::respond`]; [`FemError::LengthMismatch`] if `stiffness` does not hold `n^2`
+    /// entries.
+    pub fn respond_with_tangent(
+        &self,
+        material: &dyn Hyperelastic,
+        u: &[SVector<f64, D>],
         tangent: Tangent,
+        stiffness: &mut [f64],
+    ) -> Result<ElementResponse, FemError> {
+        self.evaluate(material, u, Some((tangent, stiffness)))
+    }
+
+    /// [`Self::respond`], and [`Self::respond_with_tangent`] if a tangent is requested.
+    fn evaluate(
+        &self,
+        material: &dyn Hyperelastic,
+        u: &[SVector<f64, D>],
+        tangent: Option<(Tangent, &mut [f64])>,
     ) -> Result<ElementResponse, FemError> {
         let n = self.node_count();
+        let components = D * n;
         if u.len() != n {
             return Err(FemError::LengthMismatch {
                 what: "nodal displacements",
                 expected: n,
                 found: u.len(),
+            });
+        }
+        if let Some((_, k)) = &tangent
+            && k.len() != components * components
+        {
+            return Err(FemError::LengthMismatch {
+                what: "element stiffness entries",
+                expected: components * components,
+                found: k.len(),
             });
         }
         if u.iter().any(|v| !v.iter().all(|c| c.is_finite())) {
@@ -268,70 +315,94 @@ impl<const D: usize> OnePointSolid<D> {
         }
         let f_inv_t = f.try_inverse().ok_or(inverted)?.transpose();
         let tau = material.kirchhoff_stress(&f);
-        let tangent = match tangent {
-            Tangent::None => None,
-            Tangent::Consistent => Some(material.stress_and_tangent(&f)),
-            Tangent::Mixed { pressure } => Some(material.mixed_stress_and_tangent(&f, pressure)),
-        };
-        let g: Vec<Vector3<f64>> = self
-            .mean_gradients
-            .iter()
-            .map(|b| f_inv_t * embed(b))
-            .collect();
+        let mut g = [Vector3::zeros(); MAX_NODES];
+        for (g_a, b_a) in g.iter_mut().zip(&self.mean_gradients) {
+            *g_a = f_inv_t * embed(b_a);
+        }
+        let g = &g[..n];
 
-        let dofs = D * n;
-        let mut force = DVector::zeros(dofs);
+        let mut response = ElementResponse {
+            components,
+            strain_energy: self.volume * material.strain_energy(&f),
+            cauchy_stress: tau / det_f,
+            volume_ratio: det_f,
+            ..ElementResponse::default()
+        };
         for (a, g_a) in g.iter().enumerate() {
             let f_a = tau * g_a * self.volume;
             for i in 0..D {
-                force[a * D + i] = f_a[i];
+                response.force[a * D + i] = f_a[i];
+                response.volume_ratio_gradient[a * D + i] = det_f * g_a[i];
             }
         }
-
-        let u_by_direction = DMatrix::from_fn(n, D, |a, i| u[a][i]);
-        let q = &self.hourglass_vectors * u_by_direction;
-        let mut hourglass_energy = 0.0;
         for i in 0..D {
-            let generalized = q
-                .column(i)
-                .component_mul(&self.hourglass_stiffness.column(i));
-            hourglass_energy += 0.5 * generalized.dot(&q.column(i));
-            let f_i = self.hourglass_vectors.tr_mul(&generalized);
-            for a in 0..n {
-                force[a * D + i] += f_i[a];
-            }
-        }
-
-        let stiffness = tangent.map(|(tau_k, c)| {
-            let b: Vec<Matrix6x3<f64>> = g.iter().map(node_strain_displacement::<D>).collect();
-            let cb: Vec<Matrix6x3<f64>> = b.iter().map(|b_n| c.0 * b_n).collect();
-            let mut k = DMatrix::zeros(dofs, dofs);
-            for (a, (g_a, b_a)) in g.iter().zip(&b).enumerate() {
-                for (bn, (g_b, cb_b)) in g.iter().zip(&cb).enumerate() {
-                    let material = b_a.tr_mul(cb_b) * self.volume;
-                    let geometric = self.volume * g_a.dot(&(tau_k * g_b));
-                    for i in 0..D {
-                        for l in 0..D {
-                            k[(a * D + i, bn * D + l)] = material[(i, l)];
-                        }
-                    }
-                    for (i, h) in self.hourglass_matrices.iter().enumerate() {
-                        k[(a * D + i, bn * D + i)] += geometric + h[(a, bn)];
-                    }
+            let mut f_i = [0.0; MAX_NODES];
+            for (gamma, k) in self.hourglass_vectors.iter().zip(&self.hourglass_stiffness) {
+                let q: f64 = gamma
+                    .iter()
+                    .zip(u)
+                    .map(|(gamma_a, u_a)| gamma_a * u_a[i])
+                    .sum();
+                let generalized = k[i] * q;
+                response.hourglass_energy += 0.5 * generalized * q;
+                for (f_ia, gamma_a) in f_i.iter_mut().zip(gamma) {
+                    *f_ia += generalized * gamma_a;
                 }
             }
-            k
-        });
+            for (a, f_ia) in f_i.iter().enumerate().take(n) {
+                response.force[a * D + i] += f_ia;
+            }
+        }
 
-        Ok(ElementResponse {
-            force,
-            stiffness,
-            strain_energy: self.volume * material.strain_energy(&f),
-            hourglass_energy,
-            cauchy_stress: tau / det_f,
-            volume_ratio: det_f,
-            volume_ratio_gradient: DVector::from_fn(dofs, |r, _| det_f * g[r / D][r % D]),
-        })
+        if let Some((tangent, k)) = tangent {
+            let (tau_k, c) = match tangent {
+                Tangent::Consistent => material.stress_and_tangent(&f),
+                Tangent::Mixed { pressure } => material.mixed_stress_and_tangent(&f, pressure),
+            };
+            self.stiffness(g, &(tau_k * self.volume), &(c.0 * self.volume), k);
+        }
+        Ok(response)
+    }
+
+    /// The tangent of [`Self::respond_with_tangent`] for the spatial gradients `g` from the
+    /// volume-scaled stress `tau = V0 tau` and tangent `c = V0 c^tau` (Voigt, tensor
+    /// components): `K_ab,ik = sum_j g_aj (sum_l c_ijkl g_bl) + delta_ik [g_a . (tau g_b)
+    /// + sum_alpha k_{alpha i} gamma_{alpha a} gamma_{alpha b}]`, for `b >= a`, written to both
+    /// `K_ab` and `K_ba = K_ab^T` of the column-major `k`.
+    fn stiffness(&self, g: &[Vector3<f64>], tau: &Matrix3<f64>, c: &Matrix6<f64>, k: &mut [f64]) {
+        let components = D * g.len();
+        // per node b: c B_b, the Voigt tangent times the Voigt vectors of sym(e_m (x) g_b)
+        // (entries g_bl at the rows of the pairs (m, l)): `[b][R][m] = sum_l c_{R (ml)} g_bl`;
+        // and tau g_b
+        let mut c_b = [[[0.0; 3]; 6]; MAX_NODES];
+        let mut tau_g = [Vector3::zeros(); MAX_NODES];
+        for ((c_b, tau_g_b), g_b) in c_b.iter_mut().zip(&mut tau_g).zip(g) {
+            *tau_g_b = tau * g_b;
+            for (r, row) in c_b.iter_mut().enumerate() {
+                for (m, value) in row.iter_mut().enumerate().take(D) {
+                    *value = (0..D).map(|l| c[(r, VOIGT_INDEX[m][l])] * g_b[l]).sum();
+                }
+            }
+        }
+        for (a, g_a) in g.iter().enumerate() {
+            for (b, (c_b, tau_g_b)) in c_b.iter().zip(&tau_g).enumerate().take(g.len()).skip(a) {
+                let geometric = g_a.dot(tau_g_b);
+                let block = SMatrix::<f64, D, D>::from_fn(|i, m| {
+                    let material: f64 = (0..D).map(|j| g_a[j] * c_b[VOIGT_INDEX[i][j]][m]).sum();
+                    if i == m {
+                        material + geometric + self.hourglass_matrices[i][a][b]
+                    } else {
+                        material
+                    }
+                });
+                // column-major: entry (i, m) of the block at index i + m D
+                for (index, &value) in block.iter().enumerate() {
+                    let (row, column) = (a * D + index % D, b * D + index / D);
+                    k[row + column * components] = value;
+                    k[column + row * components] = value;
+                }
+            }
+        }
     }
 
     /// Lumped (row-sum) mass per node: rho V0 / 2^D.
@@ -356,24 +427,6 @@ fn check_parameter(
             expected,
         })
     }
-}
-
-/// Strain-displacement block of one node with spatial gradient `g_a`: column `i` (`i < D`; the
-/// others zero) is the engineering Voigt vector of `sym(e_i (x) g_a)`, so that
-/// `sum_jl g_aj c_ijkl g_bl = (B_a^T c B_b)_ik` for a Voigt tangent `c` with tensor components.
-fn node_strain_displacement<const D: usize>(g_a: &Vector3<f64>) -> Matrix6x3<f64> {
-    let mut b = Matrix6x3::zeros();
-    for i in 0..D {
-        for (row, &(p, q)) in VOIGT_PAIRS.iter().enumerate() {
-            let delta = |m: usize| if m == i { 1.0 } else { 0.0 };
-            b[(row, i)] = if p == q {
-                delta(p) * g_a[p]
-            } else {
-                delta(p) * g_a[q] + delta(q) * g_a[p]
-            };
-        }
-    }
-    b
 }
 
 /// `F = I + sum_I u_I (x) g_I` for the shape-function gradients `g_I` at one point, embedded in
@@ -441,28 +494,27 @@ fn geometry_gradients<const D: usize>(
 fn hourglass_stiffness<const D: usize>(
     g: &[SVector<f64, D>],
     c: f64,
-) -> Result<DMatrix<f64>, FemError> {
-    let modes = hourglass_mode_axes::<D>()?;
-    let mut k = DMatrix::zeros(modes.len(), D);
+) -> Result<Vec<SVector<f64, D>>, FemError> {
     // w_mi = (g_m . e_i)^2 / |g_m|^2, normalised over m
     let weights = DMatrix::from_fn(D, D, |m, i| g[m][i] * g[m][i] / g[m].norm_squared());
-    for (alpha, axes) in modes.iter().enumerate() {
-        // <(dh/dxi_l)^2> = (1/3)^(|S| - 1) for every l in S
-        let mean_square = (1.0_f64 / 3.0).powi(axes.len() as i32 - 1);
-        let along_axis = |m: usize| {
-            if axes.contains(&m) {
-                2.0 * g[m].norm_squared() * mean_square
-            } else {
-                axes.iter().map(|&l| g[l].norm_squared()).sum::<f64>() * mean_square
-            }
-        };
-        for i in 0..D {
-            let column = weights.column(i);
-            k[(alpha, i)] =
-                c * (0..D).map(|m| column[m] * along_axis(m)).sum::<f64>() / column.sum();
-        }
-    }
-    Ok(k)
+    Ok(hourglass_mode_axes::<D>()?
+        .iter()
+        .map(|axes| {
+            // <(dh/dxi_l)^2> = (1/3)^(|S| - 1) for every l in S
+            let mean_square = (1.0_f64 / 3.0).powi(axes.len() as i32 - 1);
+            let along_axis = |m: usize| {
+                if axes.contains(&m) {
+                    2.0 * g[m].norm_squared() * mean_square
+                } else {
+                    axes.iter().map(|&l| g[l].norm_squared()).sum::<f64>() * mean_square
+                }
+            };
+            SVector::from_fn(|i, _| {
+                let column = weights.column(i);
+                c * (0..D).map(|m| column[m] * along_axis(m)).sum::<f64>() / column.sum()
+            })
+        })
+        .collect())
 }
 
 #[cfg(test)]
@@ -530,6 +582,23 @@ mod tests {
             .collect()
     }
 
+    /// The response with the consistent (or mixed) tangent, the tangent as a dense matrix.
+    fn tangent<const D: usize>(
+        element: &OnePointSolid<D>,
+        m: &dyn Hyperelastic,
+        u: &[SVector<f64, D>],
+        tangent: Tangent,
+    ) -> Result<(ElementResponse, DMatrix<f64>), FemError> {
+        let n = D * element.node_count();
+        let mut k = vec![f64::NAN; n * n];
+        let r = element.respond_with_tangent(m, u, tangent, &mut k)?;
+        Ok((r, DMatrix::from_vec(n, n, k)))
+    }
+
+    fn force(r: &ElementResponse) -> DVector<f64> {
+        DVector::from_column_slice(r.force())
+    }
+
     fn perturb<const D: usize>(u: &[SVector<f64, D>], dof: usize, h: f64) -> Vec<SVector<f64, D>> {
         let mut u = u.to_vec();
         u[dof / D][dof % D] += h;
@@ -541,24 +610,22 @@ mod tests {
         let x = distorted::<D>();
         let element = OnePointSolid::new(&x, 0.7, m.initial_shear_modulus(), 1.0)?;
         let u = general_u(&x);
-        let r = element.evaluate(&m, &u, true)?;
+        let (r, k) = tangent(&element, &m, &u, Tangent::Consistent)?;
         assert!(r.hourglass_energy > 0.0 && (r.volume_ratio - 1.0).abs() > 1e-2);
-        let k = r
-            .stiffness
-            .ok_or(FemError::InvalidMesh("no stiffness".into()))?;
+        assert!(k.iter().all(|v| v.is_finite()));
         assert!((&k - k.transpose()).amax() < 1e-10 * k.amax());
-        let without = element.evaluate(&m, &u, false)?;
-        assert!((&without.force - &r.force).amax() == 0.0 && without.stiffness.is_none());
+        let without = element.respond(&m, &u)?;
+        assert_eq!(without.force(), r.force());
         let h = 1e-6;
         for dof in 0..D * element.node_count() {
-            let plus = element.evaluate(&m, &perturb(&u, dof, h), false)?;
-            let minus = element.evaluate(&m, &perturb(&u, dof, -h), false)?;
-            let fd_column = (&plus.force - &minus.force) / (2.0 * h);
+            let plus = element.respond(&m, &perturb(&u, dof, h))?;
+            let minus = element.respond(&m, &perturb(&u, dof, -h))?;
+            let fd_column = (force(&plus) - force(&minus)) / (2.0 * h);
             let err = (fd_column - k.column(dof)).amax() / k.amax();
             assert!(err < 1e-6, "D = {D}, dof {dof}: tangent error {err}");
             let energy = |r: &ElementResponse| r.strain_energy + r.hourglass_energy;
             let fd_force = (energy(&plus) - energy(&minus)) / (2.0 * h);
-            let err = (fd_force - r.force[dof]).abs() / r.force.amax();
+            let err = (fd_force - r.force()[dof]).abs() / force(&r).amax();
             assert!(err < 1e-6, "D = {D}, dof {dof}: force error {err}");
         }
         Ok(())
@@ -570,6 +637,63 @@ mod tests {
         check_tangent_and_energy::<3>()
     }
 
+    /// The tangent, each node pair evaluated once, is the definition entry by entry:
+    /// `K_ab,ik = V0 [sum_jl g_aj c_ijkl g_bl + (g_a . tau g_b) delta_ik]
+    /// + delta_ik sum_alpha k_{alpha i} gamma_{alpha a} gamma_{alpha b}` (here the mixed one).
+    fn check_tangent_against_definition<const D: usize>() -> Result<(), FemError> {
+        let m = material()?;
+        let x = distorted::<D>();
+        let element = OnePointSolid::new(&x, 0.7, m.initial_shear_modulus(), 1.0)?;
+        let u = general_u(&x);
+        let pressure = 3.0e5;
+        let (_, k) = tangent(&element, &m, &u, Tangent::Mixed { pressure })?;
+        let f = element.deformation_gradient(&u);
+        let (tau, c) = m.mixed_stress_and_tangent(&f, pressure);
+        let f_inv_t = f
+            .try_inverse()
+            .ok_or(FemError::InvalidMesh("singular F".into()))?
+            .transpose();
+        let g: Vec<V3<f64>> = (element.mean_gradients.iter())
+            .map(|b| f_inv_t * embed(b))
+            .collect();
+        let v0 = element.volume();
+        let expected = DMatrix::from_fn(k.nrows(), k.ncols(), |r, s| {
+            let (a, i, b, l) = (r / D, r % D, s / D, s % D);
+            let mut material = 0.0;
+            for j in 0..D {
+                for m in 0..D {
+                    material += g[a][j] * c.get(i, j, l, m) * g[b][m];
+                }
+            }
+            if i != l {
+                return v0 * material;
+            }
+            let hourglass: f64 = (element.hourglass_vectors.iter())
+                .zip(&element.hourglass_stiffness)
+                .map(|(gamma, k_alpha)| k_alpha[i] * gamma[a] * gamma[b])
+                .sum();
+            v0 * (material + g[a].dot(&(tau * g[b]))) + hourglass
+        });
+        let err = (&k - &expected).amax() / expected.amax();
+        assert!(
+            err < 1e-13,
+            "D = {D}: tangent differs from its definition by {err}"
+        );
+        assert_eq!(k, k.transpose());
+        let mut short = vec![0.0; k.len() - 1];
+        assert!(matches!(
+            element.respond_with_tangent(&m, &u, Tangent::Consistent, &mut short),
+            Err(FemError::LengthMismatch { .. })
+        ));
+        Ok(())
+    }
+
+    #[test]
+    fn tangent_is_its_definition() -> Result<(), FemError> {
+        check_tangent_against_definition::<2>()?;
+        check_tangent_against_definition::<3>()
+    }
+
     /// The mixed tangent differs from the consistent one by the pressure difference times the
     /// Hessian of the volume: `K_m - K = V0 (p_m - U'(J)) d^2 J / du^2` (the force `V0 J p g_a` at
     /// fixed pressure), and `volume_ratio_gradient` is `dJ/du`.
@@ -578,22 +702,20 @@ mod tests {
         let x = distorted::<D>();
         let element = OnePointSolid::new(&x, 0.7, m.initial_shear_modulus(), 1.0)?;
         let u = general_u(&x);
-        let consistent = element.respond(&m, &u, Tangent::Consistent)?;
+        let (consistent, k) = tangent(&element, &m, &u, Tangent::Consistent)?;
         let p_m = m.volumetric_pressure(consistent.volume_ratio) - 4.0e6;
-        let mixed = element.respond(&m, &u, Tangent::Mixed { pressure: p_m })?;
-        assert_eq!(mixed.force, consistent.force);
-        let missing = || FemError::InvalidMesh("no stiffness".into());
-        let k = consistent.stiffness.ok_or_else(missing)?;
-        let k_m = mixed.stiffness.ok_or_else(missing)?;
+        let (mixed, k_m) = tangent(&element, &m, &u, Tangent::Mixed { pressure: p_m })?;
+        assert_eq!(mixed.force(), consistent.force());
         let shift = element.volume() * (p_m - m.volumetric_pressure(consistent.volume_ratio));
         let h = 1e-6;
         for dof in 0..D * element.node_count() {
-            let plus = element.evaluate(&m, &perturb(&u, dof, h), false)?;
-            let minus = element.evaluate(&m, &perturb(&u, dof, -h), false)?;
+            let plus = element.respond(&m, &perturb(&u, dof, h))?;
+            let minus = element.respond(&m, &perturb(&u, dof, -h))?;
             let dj = (plus.volume_ratio - minus.volume_ratio) / (2.0 * h);
-            assert!((dj - consistent.volume_ratio_gradient[dof]).abs() < 1e-8);
-            let hessian_column =
-                (&plus.volume_ratio_gradient - &minus.volume_ratio_gradient) / (2.0 * h);
+            assert!((dj - consistent.volume_ratio_gradient()[dof]).abs() < 1e-8);
+            let hessian_column = (DVector::from_column_slice(plus.volume_ratio_gradient())
+                - DVector::from_column_slice(minus.volume_ratio_gradient()))
+                / (2.0 * h);
             let expected = k.column(dof) + hessian_column * shift;
             let err = (expected - k_m.column(dof)).amax() / k.amax();
             assert!(err < 1e-7, "D = {D}, dof {dof}: mixed tangent error {err}");
@@ -646,13 +768,10 @@ mod tests {
             );
             for (element, nodes) in elements.iter().zip(&mesh.elements) {
                 let u_e: Vec<_> = nodes.iter().map(|&id| u[id]).collect();
-                let r = element.evaluate(&m, &u_e, true)?;
-                let k = r
-                    .stiffness
-                    .ok_or(FemError::InvalidMesh("no stiffness".into()))?;
+                let (r, k) = tangent(element, &m, &u_e, Tangent::Consistent)?;
                 for (a, &na) in nodes.iter().enumerate() {
                     for i in 0..D {
-                        force[na * D + i] += r.force[a * D + i];
+                        force[na * D + i] += r.force()[a * D + i];
                         for (b, &nb) in nodes.iter().enumerate() {
                             for j in 0..D {
                                 stiffness[(na * D + i, nb * D + j)] += k[(a * D + i, b * D + j)];
@@ -683,7 +802,7 @@ mod tests {
         let sigma = m.kirchhoff_stress(&f) / f.determinant();
         for (element, nodes) in elements.iter().zip(&mesh.elements) {
             let u_e: Vec<_> = nodes.iter().map(|&id| u[id]).collect();
-            let r = element.evaluate(&m, &u_e, false)?;
+            let r = element.respond(&m, &u_e)?;
             assert!((r.cauchy_stress - sigma).norm() < 1e-8 * sigma.norm());
             assert!(r.hourglass_energy < 1e-12 * r.strain_energy);
         }
@@ -701,11 +820,11 @@ mod tests {
         let x = distorted::<D>();
         let element = OnePointSolid::new(&x, 1.0, m.initial_shear_modulus(), 1.0)?;
         let u = affine(&rotation, &x);
-        let r = element.evaluate(&m, &u, false)?;
+        let r = element.respond(&m, &u)?;
         let mu = m.initial_shear_modulus();
         assert!((r.volume_ratio - 1.0).abs() < 1e-14);
         assert!(r.cauchy_stress.norm() < 1e-8 * mu, "{}", r.cauchy_stress);
-        assert!(r.force.amax() < 1e-8 * mu * element.volume());
+        assert!(force(&r).amax() < 1e-8 * mu * element.volume());
         assert!(r.hourglass_energy < 1e-20 * mu * element.volume());
         assert!(r.strain_energy.abs() < 1e-12 * mu * element.volume());
         Ok(())
@@ -724,10 +843,7 @@ mod tests {
         let x = distorted::<D>();
         let element = OnePointSolid::new(&x, 1.0, m.initial_shear_modulus(), scale)?;
         let u = vec![SVector::zeros(); element.node_count()];
-        let k = element
-            .evaluate(&m, &u, true)?
-            .stiffness
-            .ok_or(FemError::InvalidMesh("no stiffness".into()))?;
+        let (_, k) = tangent(&element, &m, &u, Tangent::Consistent)?;
         let eigenvalues = SymmetricEigen::new(k).eigenvalues;
         let largest = eigenvalues.amax();
         assert!(eigenvalues.min() > -1e-10 * largest);
@@ -763,7 +879,7 @@ mod tests {
                     .iter()
                     .map(|&v| SVector::from_fn(|k, _| if k == i { q * v } else { 0.0 }))
                     .collect();
-                let r = element.evaluate(&m, &u, false)?;
+                let r = element.respond(&m, &u)?;
                 // The mode has no mean strain, so the one-point material part does not see it...
                 assert!(r.strain_energy.abs() < 1e-20 * mu * v);
                 // ...and the stabilisation energy is mu0 int 2 eps:eps of the mode's strain:
@@ -794,7 +910,7 @@ mod tests {
             let (a, b) = (half[0], half[1]);
             let mean = mu * v * (1.0 / (a * a) + 1.0 / (b * b)) / 3.0;
             for i in 0..D {
-                let k = element.hourglass_stiffness[(0, i)];
+                let k = element.hourglass_stiffness[0][i];
                 assert!((k - mean).abs() < 1e-12 * mean, "{k} vs {mean}");
             }
         }
@@ -831,13 +947,13 @@ mod tests {
         let flip = Matrix3::from_diagonal(&V3::new(-0.5, 1.0, 1.0));
         let u = affine(&flip, &distorted::<2>());
         assert!(
-            matches!(quad.evaluate(&m, &u, true), Err(FemError::InvertedElement { det_f, corner: None }) if det_f < 0.0)
+            matches!(tangent(&quad, &m, &u, Tangent::Consistent), Err(FemError::InvertedElement { det_f, corner: None }) if det_f < 0.0)
         );
         let hex = OnePointSolid::<3>::new(&distorted(), 1.0, 1.0, 1.0)?;
         let flip = Matrix3::from_diagonal(&V3::new(1.0, 1.0, -0.5));
         let u = affine(&flip, &distorted::<3>());
         assert!(matches!(
-            hex.evaluate(&m, &u, false),
+            hex.respond(&m, &u),
             Err(FemError::InvertedElement { .. })
         ));
         // folded by its hourglass mode u_x = q xi eta: F at the centre is the identity, but at
@@ -855,11 +971,11 @@ mod tests {
         };
         assert!((quad.deformation_gradient(&fold(0.6)) - Matrix3::identity()).amax() < 1e-15);
         assert!(matches!(
-            quad.evaluate(&m, &fold(0.6), false),
+            quad.respond(&m, &fold(0.6)),
             Err(FemError::InvertedElement { det_f, corner: Some(_) }) if (det_f + 0.2).abs() < 1e-12
         ));
         let message = quad
-            .evaluate(&m, &fold(0.6), false)
+            .respond(&m, &fold(0.6))
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default();
@@ -867,16 +983,16 @@ mod tests {
             message.contains("corner") && message.contains("folded"),
             "{message}"
         );
-        assert!(quad.evaluate(&m, &fold(0.4), false).is_ok());
+        assert!(quad.respond(&m, &fold(0.4)).is_ok());
         let mut nan = vec![V3::zeros(); 8];
         nan[3].x = f64::NAN;
         // a NaN displacement is not an inverted element
         assert!(matches!(
-            hex.evaluate(&m, &nan, false),
+            hex.respond(&m, &nan),
             Err(FemError::NonFinite { .. })
         ));
         assert!(matches!(
-            hex.evaluate(&m, &nan[..7], false),
+            hex.respond(&m, &nan[..7]),
             Err(FemError::LengthMismatch { .. })
         ));
 

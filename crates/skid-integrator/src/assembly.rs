@@ -10,7 +10,7 @@ use nalgebra::{DVector, SVector};
 use rayon::prelude::*;
 use skid_fem::error::FemError;
 use skid_fem::pressure::pressure_face_forces;
-use skid_fem::solid::{ElementResponse, Tangent};
+use skid_fem::solid::ElementResponse;
 
 use crate::contact_rows::{ContactRows, contact_coordinates};
 use crate::error::{IncrementFailure, LinearFailure, ModelError};
@@ -168,34 +168,37 @@ impl Assembler {
     ) -> Result<InternalState, IncrementFailure> {
         let part = model.part();
         let mixed = &self.mixed;
-        let evaluate = |e: usize| -> Result<ElementResponse, IncrementFailure> {
+        let evaluate = |e: usize| -> Result<(ElementResponse, Vec<f64>), IncrementFailure> {
             let u: Vec<SVector<f64, D>> = part.mesh.elements[e]
                 .iter()
                 .map(|&n| model.dofs().node_displacement(x, n))
                 .collect();
-            let tangent = if tangent_factor.is_some() {
-                mixed.tangent(e)
+            let element = &model.elements()[e];
+            let components = D * element.node_count();
+            if tangent_factor.is_some() {
+                let mut k = vec![0.0; components * components];
+                element
+                    .respond_with_tangent(part.material(e), &u, mixed.tangent(e), &mut k)
+                    .map(|r| (r, k))
             } else {
-                Tangent::None
-            };
-            model.elements()[e]
-                .respond(part.material(e), &u, tangent)
-                .map_err(|err| match err {
-                    FemError::InvertedElement { det_f, corner } => {
-                        IncrementFailure::InvertedElement {
-                            element: e,
-                            det_f,
-                            corner,
-                        }
-                    }
-                    other => IncrementFailure::Element {
-                        element: e,
-                        message: other.to_string(),
-                    },
-                })
+                element
+                    .respond(part.material(e), &u)
+                    .map(|r| (r, Vec::new()))
+            }
+            .map_err(|err| match err {
+                FemError::InvertedElement { det_f, corner } => IncrementFailure::InvertedElement {
+                    element: e,
+                    det_f,
+                    corner,
+                },
+                other => IncrementFailure::Element {
+                    element: e,
+                    message: other.to_string(),
+                },
+            })
         };
         let n_el = model.elements().len();
-        let responses: Vec<ElementResponse> = if n_el >= PARALLEL_ELEMENT_THRESHOLD {
+        let responses: Vec<(ElementResponse, Vec<f64>)> = if n_el >= PARALLEL_ELEMENT_THRESHOLD {
             (0..n_el)
                 .into_par_iter()
                 .map(evaluate)
@@ -204,7 +207,8 @@ impl Assembler {
             (0..n_el).map(evaluate).collect::<Result<_, _>>()?
         };
 
-        self.mixed.record(model, x, &responses);
+        self.mixed
+            .record(model, x, responses.iter().map(|(r, _)| r));
         let mut state = InternalState {
             force: DVector::zeros(model.dofs().len()),
             strain_energy: 0.0,
@@ -213,16 +217,16 @@ impl Assembler {
         if tangent_factor.is_some() {
             self.values.iter_mut().for_each(|v| *v = 0.0);
         }
-        for (response, scatter) in responses.iter().zip(&self.scatter) {
+        for ((response, k), scatter) in responses.iter().zip(&self.scatter) {
             state.strain_energy += response.strain_energy;
             state.hourglass_energy += response.hourglass_energy;
             for (p, eq) in scatter.eqs.iter().enumerate() {
                 if let Some(eq) = eq {
-                    state.force[*eq] += response.force[p];
+                    state.force[*eq] += response.force()[p];
                 }
             }
-            if let (Some(c), Some(k)) = (tangent_factor, &response.stiffness) {
-                scatter.add(&mut self.values, c, k.as_slice());
+            if let Some(c) = tangent_factor {
+                scatter.add(&mut self.values, c, k);
             }
         }
         Ok(state)

@@ -18,19 +18,19 @@
 //! The mixed pressure stays of the order of the applied stresses.
 
 use nalgebra::DVector;
-use skid_fem::solid::{ElementResponse, Tangent};
+use skid_fem::solid::{ElementResponse, MAX_COMPONENTS, Tangent};
 
 use crate::model::Model;
 
 /// The volumetric linearisation of one element at the last evaluated configuration.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 struct Linearisation {
     /// `U'(J)`.
     pressure: f64,
     /// `U''(J)`.
     stiffness: f64,
-    /// `dJ/du`, element ordering.
-    volume_gradient: DVector<f64>,
+    /// `dJ/du`, element ordering, in the element's first `D 2^D` entries.
+    volume_gradient: [f64; MAX_COMPONENTS],
 }
 
 /// Per element: the last linearisation and the mixed pressure predicted for the next iterate.
@@ -67,59 +67,62 @@ impl MixedPressures {
         }
     }
 
-    /// Records each element's volumetric linearisation at the configuration `x` just evaluated.
-    pub fn record<const D: usize>(
+    /// Records each element's volumetric linearisation at the configuration `x` just evaluated
+    /// (`responses` in element order), overwriting the storage of the last one.
+    pub fn record<'a, const D: usize>(
         &mut self,
         model: &Model<D>,
         x: &DVector<f64>,
-        responses: &[ElementResponse],
+        responses: impl IntoIterator<Item = &'a ElementResponse>,
     ) {
         let part = model.part();
-        self.recorded_at = Some(x.clone());
-        self.at = responses
-            .iter()
-            .enumerate()
-            .map(|(e, r)| {
+        match &mut self.recorded_at {
+            Some(recorded) if recorded.len() == x.len() => recorded.copy_from(x),
+            recorded => *recorded = Some(x.clone()),
+        }
+        self.at.clear();
+        self.at
+            .extend(responses.into_iter().enumerate().map(|(e, r)| {
                 let material = part.material(e);
+                let mut volume_gradient = [0.0; MAX_COMPONENTS];
+                volume_gradient[..r.volume_ratio_gradient().len()]
+                    .copy_from_slice(r.volume_ratio_gradient());
                 Some(Linearisation {
                     pressure: material.volumetric_pressure(r.volume_ratio),
                     stiffness: material.volumetric_stiffness(r.volume_ratio),
-                    volume_gradient: r.volume_ratio_gradient.clone(),
+                    volume_gradient,
                 })
-            })
-            .collect();
+            }));
     }
 
     /// Predicts the recorded pressures `U'(J)` unchanged for the next tangent.
     pub fn hold(&mut self) {
-        self.next = self
-            .at
-            .iter()
-            .map(|at| at.as_ref().map(|lin| lin.pressure))
-            .collect();
+        self.next.clear();
+        self.next
+            .extend(self.at.iter().map(|at| at.as_ref().map(|lin| lin.pressure)));
     }
 
     /// Predicts each element's pressure after the step `dx` (per equation) from the recorded
     /// linearisation: `p = U'(J) + U''(J) dJ/du . du_e`.
     pub fn advance<const D: usize>(&mut self, model: &Model<D>, dx: &DVector<f64>) {
         let elements = &model.part().mesh.elements;
-        self.next = self
-            .at
-            .iter()
-            .zip(elements)
-            .map(|(at, nodes)| {
+        self.next.clear();
+        self.next
+            .extend(self.at.iter().zip(elements).map(|(at, nodes)| {
                 at.as_ref().map(|lin| {
                     let dj: f64 = nodes
                         .iter()
                         .enumerate()
                         .map(|(k, &n)| {
                             let du = model.dofs().node_displacement(dx, n);
-                            lin.volume_gradient.fixed_rows::<D>(D * k).dot(&du)
+                            (lin.volume_gradient[D * k..D * (k + 1)].iter())
+                                .zip(du.iter())
+                                .map(|(dj_du, du)| dj_du * du)
+                                .sum::<f64>()
                         })
                         .sum();
                     lin.pressure + lin.stiffness * dj
                 })
-            })
-            .collect();
+            }));
     }
 }

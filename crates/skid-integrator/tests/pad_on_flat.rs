@@ -146,9 +146,7 @@ fn nearly_incompressible_pad_preloads_and_settles_without_cutbacks() {
             .iter()
             .map(|&n| model.dofs().node_displacement(&state.x, n))
             .collect();
-        let r = element
-            .evaluate(part.material(e), &u, false)
-            .expect("element");
+        let r = element.respond(part.material(e), &u).expect("element");
         assert!(
             (r.volume_ratio - 1.0).abs() < 1e-6,
             "J = {}",

@@ -47,7 +47,7 @@ pub(super) fn part_grid<const D: usize>(
     for (e, (element, nodes)) in model.elements().iter().zip(&mesh.elements).enumerate() {
         let u_e: Vec<_> = nodes.iter().map(|&n| u[n]).collect();
         let response = element
-            .evaluate(part.material(e), &u_e, false)
+            .respond(part.material(e), &u_e)
             .map_err(|err| invalid_data(format!("part '{}' element {e}: {err}", part.name)))?;
         let s = response.cauchy_stress;
         stress.extend(STRESS_COMPONENTS.map(|(i, j)| s[(i, j)]));
