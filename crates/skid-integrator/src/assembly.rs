@@ -7,10 +7,9 @@
 
 use faer::sparse::SparseColMat;
 use nalgebra::{DVector, SVector};
-use rayon::prelude::*;
 use skid_fem::error::FemError;
 use skid_fem::pressure::pressure_face_forces;
-use skid_fem::solid::ElementResponse;
+use skid_fem::solid::{ElementResponse, MAX_COMPONENTS, MAX_NODES};
 
 use crate::contact_rows::{ContactRows, contact_coordinates};
 use crate::error::{IncrementFailure, LinearFailure, ModelError};
@@ -23,12 +22,17 @@ use crate::sparse::{Factorization, PatternBuilder, SparsePattern};
 /// save on tiny meshes).
 const PARALLEL_ELEMENT_THRESHOLD: usize = 256;
 
+/// The parallel element loop halves its range until a part has at most this many elements,
+/// which one task evaluates in order.
+const ELEMENTS_PER_TASK: usize = 32;
+
 /// Where one element's matrix entries go.
 #[derive(Debug)]
 struct ElementScatter {
     /// Global equation of each local component (node-major), `None` if fixed.
     eqs: Vec<Option<usize>>,
     /// The value slot of the first stored lower-triangle contribution; the others follow it.
+    /// (Without any, the slot the next scatter starts at.)
     first_slot: usize,
     /// For every stored contribution, in slot order, its position `p + q n` in the column-major
     /// `n x n` element matrix (local row `p`, column `q`).
@@ -48,6 +52,57 @@ impl ElementScatter {
         for (value, &position) in slots.iter_mut().zip(&self.entries) {
             *value += c * k[position as usize];
         }
+    }
+
+    /// Sets the element's own slots, `slots` (the `entries.len()` values from its first slot
+    /// on), to `c k` (the element matrix, column-major `n x n`, read at the stored positions).
+    fn write(&self, slots: &mut [f64], c: f64, k: &[f64]) {
+        debug_assert_eq!(slots.len(), self.entries.len(), "element slots");
+        for (value, &position) in slots.iter_mut().zip(&self.entries) {
+            *value = c * k[position as usize];
+        }
+    }
+}
+
+/// The symmetric pattern being built and the (row, column) of each of its value slots.
+#[derive(Default)]
+struct Slots {
+    builder: PatternBuilder,
+    position: Vec<(usize, usize)>,
+}
+
+impl Slots {
+    /// Registers entry (i, j) of the lower triangle and returns its value slot.
+    fn push(&mut self, i: usize, j: usize) -> usize {
+        self.position.push((i.max(j), i.min(j)));
+        self.builder.push(i, j)
+    }
+
+    /// The next value slots, one for each lower-triangle entry of the element matrix on the
+    /// equations `eqs` (one per local component, `None` for fixed ones).
+    ///
+    /// # Errors
+    /// [`ModelError::Invalid`] if the element matrix has more than `u32::MAX` entries.
+    fn scatter(&mut self, eqs: Vec<Option<usize>>) -> Result<ElementScatter, ModelError> {
+        let n = eqs.len();
+        let too_large = || ModelError::Invalid(format!("an element with {n} components"));
+        let first_slot = self.position.len();
+        let mut entries = Vec::new();
+        for (p, ep) in eqs.iter().enumerate() {
+            for (q, eq) in eqs.iter().enumerate() {
+                if let (Some(i), Some(j)) = (ep, eq)
+                    && i >= j
+                {
+                    self.push(*i, *j);
+                    entries.push(u32::try_from(p + q * n).map_err(|_| too_large())?);
+                }
+            }
+        }
+        Ok(ElementScatter {
+            eqs,
+            first_slot,
+            entries,
+        })
     }
 }
 
@@ -82,7 +137,14 @@ pub struct Assembler {
     /// The slots of entries in the rows or columns of held equations, for the held set of the
     /// last [`Self::hold`] call (a step's held set stays the same over its increments).
     held_slots: Option<HeldSlots>,
+    /// The value of each slot: first the elements' slots (`values[..element_slots]`, each
+    /// element's in one range, in element order), then the contact candidates', then the
+    /// diagonal.
     values: Vec<f64>,
+    element_slots: usize,
+    /// Per element, its response at the configuration of the last [`Self::internal`] call
+    /// (storage kept from call to call).
+    responses: Vec<ElementResponse>,
     /// Element pressures of the mixed tangent between Newton iterates.
     mixed: MixedPressures,
     /// Numeric factorizations of the tangent so far.
@@ -96,61 +158,38 @@ impl Assembler {
     /// # Errors
     /// [`ModelError::Invalid`] if the pattern cannot be analysed.
     pub fn new<const D: usize>(model: &Model<D>) -> Result<Self, ModelError> {
-        let mut builder = PatternBuilder::default();
-        let mut slot_position = Vec::new();
-        let mut push = |builder: &mut PatternBuilder, i: usize, j: usize| {
-            slot_position.push((i.max(j), i.min(j)));
-            builder.push(i, j)
-        };
-        let mut scatter_of = |eqs: Vec<Option<usize>>| -> Result<ElementScatter, ModelError> {
-            let n = eqs.len();
-            let too_large = || ModelError::Invalid(format!("an element with {n} components"));
-            let mut entries = Vec::new();
-            let mut first_slot = None;
-            for (p, ep) in eqs.iter().enumerate() {
-                for (q, eq) in eqs.iter().enumerate() {
-                    if let (Some(i), Some(j)) = (ep, eq)
-                        && i >= j
-                    {
-                        let slot = push(&mut builder, *i, *j);
-                        first_slot.get_or_insert(slot);
-                        entries.push(u32::try_from(p + q * n).map_err(|_| too_large())?);
-                    }
-                }
-            }
-            Ok(ElementScatter {
-                eqs,
-                first_slot: first_slot.unwrap_or_default(),
-                entries,
-            })
-        };
+        let mut slots = Slots::default();
         let scatter = model
             .part()
             .mesh
             .elements
             .iter()
-            .map(|conn| scatter_of(conn.iter().flat_map(|&n| *model.dofs().node(n)).collect()))
+            .map(|conn| slots.scatter(conn.iter().flat_map(|&n| *model.dofs().node(n)).collect()))
             .collect::<Result<_, _>>()?;
+        let element_slots = slots.position.len();
         let contact_scatter = model
             .contacts()
             .iter()
             .enumerate()
             .flat_map(|(p, pair)| pair.nodes.iter().map(move |&node| (p, node)))
-            .map(|(p, node)| scatter_of(contact_coordinates(model, p, node)))
+            .map(|(p, node)| slots.scatter(contact_coordinates(model, p, node)))
             .collect::<Result<_, _>>()?;
         let n = model.dofs().len();
-        let diagonal = (0..n).map(|i| push(&mut builder, i, i)).collect();
-        let pattern = SparsePattern::new(n, builder, &[]).map_err(ModelError::Invalid)?;
+        let diagonal = (0..n).map(|i| slots.push(i, i)).collect();
+        let pattern = SparsePattern::new(n, slots.builder, &[]).map_err(ModelError::Invalid)?;
         let values = vec![0.0; pattern.slots()];
+        let elements = model.elements().len();
         Ok(Self {
             pattern,
             scatter,
             contact_scatter,
             diagonal,
-            slot_position,
+            slot_position: slots.position,
             held_slots: None,
             values,
-            mixed: MixedPressures::new(model.elements().len()),
+            element_slots,
+            responses: vec![ElementResponse::default(); elements],
+            mixed: MixedPressures::new(elements),
             factorizations: 0,
         })
     }
@@ -166,67 +205,36 @@ impl Assembler {
         x: &DVector<f64>,
         tangent_factor: Option<f64>,
     ) -> Result<InternalState, IncrementFailure> {
-        let part = model.part();
-        let mixed = &self.mixed;
-        let evaluate = |e: usize| -> Result<(ElementResponse, Vec<f64>), IncrementFailure> {
-            let u: Vec<SVector<f64, D>> = part.mesh.elements[e]
-                .iter()
-                .map(|&n| model.dofs().node_displacement(x, n))
-                .collect();
-            let element = &model.elements()[e];
-            let components = D * element.node_count();
-            if tangent_factor.is_some() {
-                let mut k = vec![0.0; components * components];
-                element
-                    .respond_with_tangent(part.material(e), &u, mixed.tangent(e), &mut k)
-                    .map(|r| (r, k))
-            } else {
-                element
-                    .respond(part.material(e), &u)
-                    .map(|r| (r, Vec::new()))
-            }
-            .map_err(|err| match err {
-                FemError::InvertedElement { det_f, corner } => IncrementFailure::InvertedElement {
-                    element: e,
-                    det_f,
-                    corner,
-                },
-                other => IncrementFailure::Element {
-                    element: e,
-                    message: other.to_string(),
-                },
-            })
+        let element_loop = ElementLoop {
+            model,
+            x,
+            tangent_factor,
+            mixed: &self.mixed,
+            scatter: &self.scatter,
         };
-        let n_el = model.elements().len();
-        let responses: Vec<(ElementResponse, Vec<f64>)> = if n_el >= PARALLEL_ELEMENT_THRESHOLD {
-            (0..n_el)
-                .into_par_iter()
-                .map(evaluate)
-                .collect::<Result<_, _>>()?
+        let (element_values, other_values) = self.values.split_at_mut(self.element_slots);
+        if self.responses.len() >= PARALLEL_ELEMENT_THRESHOLD {
+            element_loop.run_parallel(0, &mut self.responses, element_values)?;
         } else {
-            (0..n_el).map(evaluate).collect::<Result<_, _>>()?
-        };
+            element_loop.run(0, &mut self.responses, element_values)?;
+        }
+        if tangent_factor.is_some() {
+            other_values.fill(0.0);
+        }
 
-        self.mixed
-            .record(model, x, responses.iter().map(|(r, _)| r));
+        self.mixed.record(model, x, &self.responses);
         let mut state = InternalState {
             force: DVector::zeros(model.dofs().len()),
             strain_energy: 0.0,
             hourglass_energy: 0.0,
         };
-        if tangent_factor.is_some() {
-            self.values.iter_mut().for_each(|v| *v = 0.0);
-        }
-        for ((response, k), scatter) in responses.iter().zip(&self.scatter) {
+        for (response, scatter) in self.responses.iter().zip(&self.scatter) {
             state.strain_energy += response.strain_energy;
             state.hourglass_energy += response.hourglass_energy;
-            for (p, eq) in scatter.eqs.iter().enumerate() {
+            for (eq, force) in scatter.eqs.iter().zip(response.force()) {
                 if let Some(eq) = eq {
-                    state.force[*eq] += response.force()[p];
+                    state.force[*eq] += force;
                 }
-            }
-            if let Some(c) = tangent_factor {
-                scatter.add(&mut self.values, c, k);
             }
         }
         Ok(state)
@@ -375,6 +383,99 @@ impl Assembler {
     }
 }
 
+/// The element loop of [`Assembler::internal`] and what it reads.
+struct ElementLoop<'a, const D: usize> {
+    model: &'a Model<D>,
+    x: &'a DVector<f64>,
+    /// `c_K`, if the tangent is assembled.
+    tangent_factor: Option<f64>,
+    mixed: &'a MixedPressures,
+    scatter: &'a [ElementScatter],
+}
+
+impl<const D: usize> ElementLoop<'_, D> {
+    /// Evaluates the elements `first..first + responses.len()` in order into `responses`, and
+    /// with a tangent factor `c` sets their value slots, `values` (theirs alone: they follow one
+    /// another in element order), to `c K_e`.
+    ///
+    /// # Errors
+    /// The failure of the first element that fails; the elements after it are not evaluated.
+    fn run(
+        &self,
+        first: usize,
+        responses: &mut [ElementResponse],
+        mut values: &mut [f64],
+    ) -> Result<(), IncrementFailure> {
+        let (part, dofs) = (self.model.part(), self.model.dofs());
+        let mut k = [0.0; MAX_COMPONENTS * MAX_COMPONENTS];
+        for (e, response) in (first..).zip(responses) {
+            let element = &self.model.elements()[e];
+            let mut u = [SVector::zeros(); MAX_NODES];
+            for (u_a, &node) in u.iter_mut().zip(&part.mesh.elements[e]) {
+                *u_a = dofs.node_displacement(self.x, node);
+            }
+            let u = &u[..element.node_count()];
+            let failure = |err| element_failure(e, err);
+            let Some(c) = self.tangent_factor else {
+                *response = element.respond(part.material(e), u).map_err(failure)?;
+                continue;
+            };
+            let components = D * element.node_count();
+            let k = &mut k[..components * components];
+            *response = element
+                .respond_with_tangent(part.material(e), u, self.mixed.tangent(e), k)
+                .map_err(failure)?;
+            let scatter = &self.scatter[e];
+            let (own, rest) = std::mem::take(&mut values).split_at_mut(scatter.entries.len());
+            scatter.write(own, c, k);
+            values = rest;
+        }
+        Ok(())
+    }
+
+    /// [`Self::run`] on halves of the range, evaluated in parallel, until a part has at most
+    /// [`ELEMENTS_PER_TASK`] elements. Every element writes only its own response and slots,
+    /// so the results do not depend on the threads.
+    ///
+    /// # Errors
+    /// The failure of the lowest-numbered failing element, as [`Self::run`] on the whole range
+    /// (the first half's failure is returned before the second's).
+    fn run_parallel(
+        &self,
+        first: usize,
+        responses: &mut [ElementResponse],
+        values: &mut [f64],
+    ) -> Result<(), IncrementFailure> {
+        if responses.len() <= ELEMENTS_PER_TASK {
+            return self.run(first, responses, values);
+        }
+        let middle = responses.len() / 2;
+        let (left, right) = responses.split_at_mut(middle);
+        let split = self.scatter[first + middle].first_slot - self.scatter[first].first_slot;
+        let (left_values, right_values) = values.split_at_mut(split);
+        let (left, right) = rayon::join(
+            || self.run_parallel(first, left, left_values),
+            || self.run_parallel(first + middle, right, right_values),
+        );
+        left.and(right)
+    }
+}
+
+/// The increment failure of element `e` failing with `err`.
+fn element_failure(e: usize, err: FemError) -> IncrementFailure {
+    match err {
+        FemError::InvertedElement { det_f, corner } => IncrementFailure::InvertedElement {
+            element: e,
+            det_f,
+            corner,
+        },
+        other => IncrementFailure::Element {
+            element: e,
+            message: other.to_string(),
+        },
+    }
+}
+
 /// How many tenfold increases of the mass shift [`Assembler::with_mass_shift`] tries before it
 /// reports the tangent as indefinite.
 pub const MAX_SHIFT_DECADES: usize = 8;
@@ -422,6 +523,7 @@ mod tests {
     use crate::model::Tie;
     use crate::test_support::{body, pad_block};
     use nalgebra::DMatrix;
+    use skid_fem::solid::Tangent;
 
     impl Assembler {
         /// The stored lower triangle expanded to a dense symmetric matrix.
@@ -492,6 +594,97 @@ mod tests {
     #[test]
     fn assembled_tangent_matches_finite_differences_3d() {
         tangent_matches_finite_differences::<3>();
+    }
+
+    /// A 3D block of [`PARALLEL_ELEMENT_THRESHOLD`] elements (the parallel loop), its base
+    /// fixed.
+    fn large_block() -> Model<3> {
+        let mut part = pad_block::<3>([0.0; 3], [0.08, 0.04, 0.04], [8, 8, 4]);
+        assert_eq!(part.mesh.elements.len(), PARALLEL_ELEMENT_THRESHOLD);
+        part.fixed = part.mesh.node_sets["ymin"]
+            .iter()
+            .flat_map(|&n| (0..3).map(move |i| (n, i)))
+            .collect();
+        Model::new(part, vec![], vec![], Loads::default(), vec![]).expect("model")
+    }
+
+    /// Writing each element's scaled stiffness straight into its own slots (in parallel on a
+    /// large model, in sequence on a small one) assembles, bit for bit, what adding the element
+    /// responses one by one into zeroed values gives; so do the forces.
+    fn check_in_place_assembly<const D: usize>(model: &Model<D>) {
+        let n = model.dofs().len();
+        let mut assembler = Assembler::new(model).expect("assembler");
+        let x = DVector::from_fn(n, |i, _| 1e-3 * (i as f64 * 0.7).sin());
+        // a mixed tangent at predicted pressures, as in a Newton iteration
+        assembler.internal(model, &x, None).expect("internal");
+        let dx = DVector::from_fn(n, |i, _| 1e-4 * (i as f64 * 1.3).cos());
+        assembler.advance_mixed_pressures(model, &dx);
+        let x = &x + &dx;
+        let c = 1.7;
+        let state = assembler.internal(model, &x, Some(c)).expect("internal");
+
+        let mut values = vec![0.0; assembler.values.len()];
+        let mut force = DVector::zeros(n);
+        let elements = model.elements().iter().zip(&assembler.scatter);
+        for (e, (element, scatter)) in elements.enumerate() {
+            let u: Vec<_> = (model.part().mesh.elements[e].iter())
+                .map(|&node| model.dofs().node_displacement(&x, node))
+                .collect();
+            let m = D * element.node_count();
+            let mut k = vec![0.0; m * m];
+            let tangent = assembler.mixed.tangent(e);
+            assert!(matches!(tangent, Tangent::Mixed { .. }));
+            let r = element
+                .respond_with_tangent(model.part().material(e), &u, tangent, &mut k)
+                .expect("element");
+            scatter.add(&mut values, c, &k);
+            for (eq, f) in scatter.eqs.iter().zip(r.force()) {
+                if let Some(eq) = eq {
+                    force[*eq] += f;
+                }
+            }
+        }
+        assert_eq!(assembler.values, values, "{D}D");
+        assert_eq!(state.force, force, "{D}D");
+    }
+
+    #[test]
+    fn in_place_assembly_matches_element_by_element_addition() {
+        check_in_place_assembly(&large_block());
+        check_in_place_assembly(&tied_block::<2>());
+        check_in_place_assembly(&tied_block::<3>());
+    }
+
+    /// The parallel loop reports the failure of the lowest-numbered failing element, as the
+    /// sequential loop does, with or without a tangent.
+    #[test]
+    fn element_loop_reports_the_first_failing_element() {
+        let model = large_block();
+        let mut x = DVector::zeros(model.dofs().len());
+        let nodes = model.part().mesh.nodes.len();
+        for node in [nodes - 20, nodes / 2] {
+            for eq in model.dofs().node(node).iter().flatten() {
+                x[*eq] = -0.05;
+            }
+        }
+        let fails = |e: usize| {
+            let u: Vec<_> = (model.part().mesh.elements[e].iter())
+                .map(|&node| model.dofs().node_displacement(&x, node))
+                .collect();
+            model.elements()[e]
+                .respond(model.part().material(e), &u)
+                .is_err()
+        };
+        let first = (0..model.elements().len()).find(|&e| fails(e));
+        assert!(first.is_some_and(|e| e > 0));
+        let mut assembler = Assembler::new(&model).expect("assembler");
+        for tangent_factor in [None, Some(1.0)] {
+            let failure = assembler.internal(&model, &x, tangent_factor);
+            assert!(
+                matches!(failure, Err(IncrementFailure::InvertedElement { element, .. }) if Some(element) == first),
+                "{failure:?} vs {first:?}"
+            );
+        }
     }
 
     /// An indefinite matrix gets mass added tenfold at a time until it factorizes; a failure

@@ -69,11 +69,11 @@ impl MixedPressures {
 
     /// Records each element's volumetric linearisation at the configuration `x` just evaluated
     /// (`responses` in element order), overwriting the storage of the last one.
-    pub fn record<'a, const D: usize>(
+    pub fn record<const D: usize>(
         &mut self,
         model: &Model<D>,
         x: &DVector<f64>,
-        responses: impl IntoIterator<Item = &'a ElementResponse>,
+        responses: &[ElementResponse],
     ) {
         let part = model.part();
         match &mut self.recorded_at {
@@ -81,18 +81,17 @@ impl MixedPressures {
             recorded => *recorded = Some(x.clone()),
         }
         self.at.clear();
-        self.at
-            .extend(responses.into_iter().enumerate().map(|(e, r)| {
-                let material = part.material(e);
-                let mut volume_gradient = [0.0; MAX_COMPONENTS];
-                volume_gradient[..r.volume_ratio_gradient().len()]
-                    .copy_from_slice(r.volume_ratio_gradient());
-                Some(Linearisation {
-                    pressure: material.volumetric_pressure(r.volume_ratio),
-                    stiffness: material.volumetric_stiffness(r.volume_ratio),
-                    volume_gradient,
-                })
-            }));
+        self.at.extend(responses.iter().enumerate().map(|(e, r)| {
+            let material = part.material(e);
+            let mut volume_gradient = [0.0; MAX_COMPONENTS];
+            volume_gradient[..r.volume_ratio_gradient().len()]
+                .copy_from_slice(r.volume_ratio_gradient());
+            Some(Linearisation {
+                pressure: material.volumetric_pressure(r.volume_ratio),
+                stiffness: material.volumetric_stiffness(r.volume_ratio),
+                volume_gradient,
+            })
+        }));
     }
 
     /// Predicts the recorded pressures `U'(J)` unchanged for the next tangent.
