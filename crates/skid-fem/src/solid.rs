@@ -34,9 +34,10 @@ pub struct OnePointSolid<const D: usize> {
     /// Per displacement direction i, the constant stabilisation stiffness on the nodes'
     /// i-components: `[i][I][J] = sum_alpha k_{alpha i} gamma_{alpha I} gamma_{alpha J}`.
     hourglass_matrices: [[[f64; MAX_NODES]; MAX_NODES]; D],
-    /// Per corner of the cell, the reference gradients `grad_X N_I` there, for the corner check
-    /// of [`Self::respond`].
-    corner_gradients: Vec<Vec<SVector<f64, D>>>,
+    /// Per corner of the cell, the reference gradients `grad_X N_I` there that do not vanish
+    /// (those of the corner's node and of its D neighbours along the edges), with their node
+    /// `I`, for the corner check of [`Self::respond`].
+    corner_gradients: Vec<Vec<(usize, SVector<f64, D>)>>,
 }
 
 /// Response of one element at a given displacement. Vectors are node-major (index `a * D + i`)
@@ -192,8 +193,13 @@ impl<const D: usize> OnePointSolid<D> {
             hourglass_matrices,
             corner_gradients: corners::<D>()
                 .iter()
-                .map(|xi| reference_gradients(x_ref, xi))
-                .collect::<Result<_, _>>()?,
+                .map(|xi| {
+                    let gradients = reference_gradients(x_ref, xi)?.into_iter().enumerate();
+                    Ok(gradients
+                        .filter(|(_, g)| g.iter().any(|&c| c != 0.0))
+                        .collect())
+                })
+                .collect::<Result<_, FemError>>()?,
         })
     }
 
@@ -212,7 +218,7 @@ impl<const D: usize> OnePointSolid<D> {
     ///
     /// `u` must hold one displacement per node; [`Self::respond`] checks this.
     pub fn deformation_gradient(&self, u: &[SVector<f64, D>]) -> Matrix3<f64> {
-        gradient_of(&self.mean_gradients, u)
+        gradient_of(self.mean_gradients.iter().zip(u))
     }
 
     /// Internal force, energies, stress and volume ratio at displacement u (node-major
@@ -305,7 +311,7 @@ impl<const D: usize> OnePointSolid<D> {
             return Err(inverted);
         }
         for (corner, gradients) in self.corner_gradients.iter().enumerate() {
-            let det_f = gradient_of(gradients, u).determinant();
+            let det_f = gradient_of(gradients.iter().map(|(a, g)| (g, &u[*a]))).determinant();
             if det_f.is_nan() || det_f <= 0.0 {
                 return Err(FemError::InvertedElement {
                     det_f,
@@ -368,7 +374,8 @@ impl<const D: usize> OnePointSolid<D> {
     /// volume-scaled stress `tau = V0 tau` and tangent `c = V0 c^tau` (Voigt, tensor
     /// components): `K_ab,ik = sum_j g_aj (sum_l c_ijkl g_bl) + delta_ik [g_a . (tau g_b)
     /// + sum_alpha k_{alpha i} gamma_{alpha a} gamma_{alpha b}]`, for `b >= a`, written to both
-    /// `K_ab` and `K_ba = K_ab^T` of the column-major `k`.
+    /// `K_ab` and `K_ba = K_ab^T` of the column-major `k` (a block `K_aa` takes the entries of
+    /// its upper triangle for both triangles, so that `k` is exactly symmetric).
     fn stiffness(&self, g: &[Vector3<f64>], tau: &Matrix3<f64>, c: &Matrix6<f64>, k: &mut [f64]) {
         let components = D * g.len();
         // per node b: c B_b, the Voigt tangent times the Voigt vectors of sym(e_m (x) g_b)
@@ -388,6 +395,8 @@ impl<const D: usize> OnePointSolid<D> {
             for (b, (c_b, tau_g_b)) in c_b.iter().zip(&tau_g).enumerate().take(g.len()).skip(a) {
                 let geometric = g_a.dot(tau_g_b);
                 let block = SMatrix::<f64, D, D>::from_fn(|i, m| {
+                    // K_aa is symmetric up to round-off: its upper triangle stands for both
+                    let (i, m) = if a == b && i > m { (m, i) } else { (i, m) };
                     let material: f64 = (0..D).map(|j| g_a[j] * c_b[VOIGT_INDEX[i][j]][m]).sum();
                     if i == m {
                         material + geometric + self.hourglass_matrices[i][a][b]
@@ -395,11 +404,19 @@ impl<const D: usize> OnePointSolid<D> {
                         material
                     }
                 });
-                // column-major: entry (i, m) of the block at index i + m D
-                for (index, &value) in block.iter().enumerate() {
-                    let (row, column) = (a * D + index % D, b * D + index / D);
-                    k[row + column * components] = value;
-                    k[column + row * components] = value;
+                // K_ab: column b D + m holds the block's column m in rows a D..a D + D;
+                // K_ba = K_ab^T: column a D + i holds its row i in rows b D..b D + D
+                for (m, column) in block.column_iter().enumerate() {
+                    let start = (b * D + m) * components + a * D;
+                    for (entry, value) in k[start..start + D].iter_mut().zip(column.iter()) {
+                        *entry = *value;
+                    }
+                }
+                for (i, row) in block.row_iter().enumerate() {
+                    let start = (a * D + i) * components + b * D;
+                    for (entry, value) in k[start..start + D].iter_mut().zip(row.iter()) {
+                        *entry = *value;
+                    }
                 }
             }
         }
@@ -430,17 +447,14 @@ fn check_parameter(
 }
 
 /// `F = I + sum_I u_I (x) g_I` for the shape-function gradients `g_I` at one point, embedded in
-/// 3D.
-fn gradient_of<const D: usize>(
-    gradients: &[SVector<f64, D>],
-    u: &[SVector<f64, D>],
+/// 3D, from the pairs `(g_I, u_I)` (a node whose gradient vanishes adds nothing and may be left
+/// out).
+fn gradient_of<'a, const D: usize>(
+    terms: impl Iterator<Item = (&'a SVector<f64, D>, &'a SVector<f64, D>)>,
 ) -> Matrix3<f64> {
-    gradients
-        .iter()
-        .zip(u)
-        .fold(Matrix3::identity(), |f, (g, u)| {
-            f + embed(u) * embed(g).transpose()
-        })
+    terms.fold(Matrix3::identity(), |f, (g, u)| {
+        f + embed(u) * embed(g).transpose()
+    })
 }
 
 /// The inverse reference Jacobian at `xi`, `J^-1 = d xi / dX`.
