@@ -5,7 +5,7 @@
 //! effective tangent has the form `K_eff = c_K K_T + diag(c_M m)` (HHT: `c_K = 1 + alpha`,
 //! `c_M = 1/(beta h^2)`); equations held fixed in a step get an identity row and column.
 
-use faer::sparse::SparseColMat;
+use faer::sparse::SparseColMatRef;
 use nalgebra::{DVector, SVector};
 use skid_fem::error::FemError;
 use skid_fem::pressure::pressure_face_forces;
@@ -141,6 +141,9 @@ pub struct Assembler {
     /// element's in one range, in element order), then the contact candidates', then the
     /// diagonal.
     values: Vec<f64>,
+    /// The values of the compressed lower triangle, written by [`Self::lower_triangle`] and
+    /// [`Self::factorize`] (storage kept from call to call).
+    compressed: Vec<f64>,
     element_slots: usize,
     /// Per element, its response at the configuration of the last [`Self::internal`] call
     /// (storage kept from call to call).
@@ -187,6 +190,7 @@ impl Assembler {
             slot_position: slots.position,
             held_slots: None,
             values,
+            compressed: Vec::new(),
             element_slots,
             responses: vec![ElementResponse::default(); elements],
             mixed: MixedPressures::new(elements),
@@ -325,8 +329,9 @@ impl Assembler {
     ///
     /// # Errors
     /// [`IncrementFailure::LinearSolve`] for non-finite entries.
-    pub fn lower_triangle(&self) -> Result<SparseColMat<usize, f64>, IncrementFailure> {
-        self.pattern.lower_triangle(&self.values)
+    pub fn lower_triangle(&mut self) -> Result<SparseColMatRef<'_, usize, f64>, IncrementFailure> {
+        self.pattern.compress(&self.values, &mut self.compressed)?;
+        Ok(self.pattern.matrix(&self.compressed))
     }
 
     /// Factorizes the current effective tangent.
@@ -335,7 +340,8 @@ impl Assembler {
     /// [`IncrementFailure::LinearSolve`] if it is not positive definite.
     pub fn factorize(&mut self) -> Result<Factorization, IncrementFailure> {
         self.factorizations += 1;
-        self.pattern.factorize(&self.values)
+        self.pattern.compress(&self.values, &mut self.compressed)?;
+        self.pattern.factorize(&self.compressed)
     }
 
     /// Runs `solve` (which factorizes the current matrix) on `K + c_k M` (the current values

@@ -877,7 +877,7 @@ mod tests {
         .expect("reduced");
 
         let k = assembler.lower_triangle().expect("lower");
-        let rho = contact_weights(k.as_ref(), &rows);
+        let rho = contact_weights(k, &rows);
         let mut solver = GlobalContactSolver {
             quasi_definite_from,
             lu_until,
@@ -888,11 +888,11 @@ mod tests {
         for _ in 0..30 {
             let mut linear = rows.clone();
             linear.u = &rows.u + rows.times(&dx);
-            let linear_residual = &residual + symmetric_product(k.as_ref(), &dx);
+            let linear_residual = &residual + symmetric_product(k, &dx);
             let step = solver
                 .step(
                     &model,
-                    k.as_ref(),
+                    k,
                     &linear,
                     &linear_residual,
                     &r,
@@ -985,10 +985,10 @@ mod tests {
     /// constraint rows' regularisation `-eps rho`; `S` on a second system of the same pattern
     /// reuses it.
     fn operator_entries_and_approximation_agree<const D: usize>() {
-        let (model, assembler, rows, _, held) = pressed_block::<D>();
+        let (model, mut assembler, rows, _, held) = pressed_block::<D>();
         let n = model.dofs().len();
         let k = assembler.lower_triangle().expect("lower");
-        let rho = contact_weights(k.as_ref(), &rows);
+        let rho = contact_weights(k, &rows);
         // forces that open every fourth candidate, and of the others make one in three slide
         // (twice the friction the cone holds) and the rest stick (half of it)
         let mut r = DVector::zeros(rows.rows.len());
@@ -998,7 +998,7 @@ mod tests {
             let share = if c % 3 == 0 { 2.0 } else { 0.5 };
             r[c * D + 1] = rho[c] * rows.u[c * D + 1] + share * rows.mu[c] * tau;
         }
-        let system = LinearSystem::new(&model, k.as_ref(), &rows, &r, &rho, &held);
+        let system = LinearSystem::new(&model, k, &rows, &r, &rho, &held);
         let dim = system.dim();
         let (pairs, values) = system.entries();
         let mut a = DMatrix::<f64>::zeros(dim, dim);

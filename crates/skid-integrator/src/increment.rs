@@ -467,11 +467,11 @@ fn solve_increment_with<const D: usize>(
         } else if method == ContactSolve::Global {
             let clock = Instant::now();
             let k = assembler.lower_triangle()?;
-            let rho = weights.get_or_insert_with(|| contact_weights(k.as_ref(), &rows));
+            let rho = weights.get_or_insert_with(|| contact_weights(k, &rows));
             if warm.len() != rows.rows.len() {
                 warm = DVector::zeros(rows.rows.len());
             }
-            let step = global.step(model, k.as_ref(), &rows, &residual, &warm, rho, held);
+            let step = global.step(model, k, &rows, &residual, &warm, rho, held);
             timings.linear_solve += clock.elapsed();
             let step = step?;
             forces_before = Some(std::mem::replace(&mut warm, step.r.clone()));
@@ -492,7 +492,7 @@ fn solve_increment_with<const D: usize>(
             let mut reuse = reusable.take().filter(|_| forces_converged);
             if weights.is_none() {
                 let k = assembler.lower_triangle()?;
-                weights = Some(contact_weights(k.as_ref(), &rows));
+                weights = Some(contact_weights(k, &rows));
             }
             let ((dx, solution, factor), _) =
                 assembler.with_mass_shift(shift_mass, shift_start, held, |a| {

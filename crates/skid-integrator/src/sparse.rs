@@ -22,9 +22,7 @@ use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
     factorize_symbolic_cholesky,
 };
-use faer::sparse::{
-    Argsort, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef,
-};
+use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, MatMut, Side};
 use nalgebra::{DMatrix, DVector};
 
@@ -78,8 +76,8 @@ impl PatternBuilder {
 pub struct SparsePattern {
     n: usize,
     symbolic: SymbolicSparseColMat<usize>,
-    argsort: Argsort<usize>,
-    slots: usize,
+    /// Per value slot, the position of its entry among the compressed values.
+    positions: Vec<usize>,
     analysis: Arc<SymbolicCholesky<usize>>,
     trailing: Arc<[usize]>,
 }
@@ -93,14 +91,24 @@ impl SparsePattern {
     /// A message if faer rejects the pattern (an index out of range) or `trailing` is not a set
     /// of distinct equations.
     pub fn new(n: usize, builder: PatternBuilder, trailing: &[usize]) -> Result<Self, String> {
-        let (symbolic, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &builder.pairs)
+        let (symbolic, _) = SymbolicSparseColMat::try_new_from_indices(n, n, &builder.pairs)
             .map_err(|e| format!("sparsity pattern: {e:?}"))?;
+        let positions = builder
+            .pairs
+            .iter()
+            .map(|p| {
+                let start = symbolic.col_ptr()[p.col];
+                let rows = symbolic.row_idx_of_col_raw(p.col);
+                rows.binary_search(&p.row)
+                    .map(|k| start + k)
+                    .map_err(|_| format!("sparsity pattern: entry ({}, {}) lost", p.row, p.col))
+            })
+            .collect::<Result<_, _>>()?;
         let analysis = analyse(n, &symbolic, trailing)?;
         Ok(Self {
             n,
             symbolic,
-            argsort,
-            slots: builder.pairs.len(),
+            positions,
             analysis,
             trailing: trailing.into(),
         })
@@ -126,7 +134,7 @@ impl SparsePattern {
 
     /// Number of value slots (registered entries, duplicates counted).
     pub fn slots(&self) -> usize {
-        self.slots
+        self.positions.len()
     }
 
     /// Matrix dimension.
@@ -134,30 +142,40 @@ impl SparsePattern {
         self.n
     }
 
-    /// The lower triangle of the matrix whose slot values are `values`, compressed (entries at
-    /// the same position summed).
+    /// Writes into `compressed` the values of the lower triangle of the matrix whose slot
+    /// values are `values`, entries at the same position summed, in the order of the pattern
+    /// (see [`Self::matrix`]).
     ///
     /// # Errors
     /// [`IncrementFailure::LinearSolve`] for non-finite values.
-    pub fn lower_triangle(
+    pub fn compress(
         &self,
         values: &[f64],
-    ) -> Result<SparseColMat<usize, f64>, IncrementFailure> {
+        compressed: &mut Vec<f64>,
+    ) -> Result<(), IncrementFailure> {
         if values.iter().any(|v| !v.is_finite()) {
             return Err(IncrementFailure::linear(TANGENT, LinearFailure::NonFinite));
         }
-        SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, values).map_err(|e| {
-            IncrementFailure::linear(TANGENT, LinearFailure::Structure(format!("{e:?}")))
-        })
+        compressed.clear();
+        compressed.resize(self.symbolic.row_idx().len(), 0.0);
+        for (&position, &value) in self.positions.iter().zip(values) {
+            compressed[position] += value;
+        }
+        Ok(())
     }
 
-    /// Numeric Cholesky factorization `K = L L^T` of the matrix whose slot values are `values`,
-    /// reusing the symbolic analysis.
+    /// The lower triangle with the compressed values `compressed` (see [`Self::compress`]).
+    pub fn matrix<'a>(&'a self, compressed: &'a [f64]) -> SparseColMatRef<'a, usize, f64> {
+        SparseColMatRef::new(self.symbolic.as_ref(), compressed)
+    }
+
+    /// Numeric Cholesky factorization `K = L L^T` of the matrix of compressed values
+    /// `compressed` (see [`Self::compress`]), reusing the symbolic analysis.
     ///
     /// # Errors
-    /// [`IncrementFailure::LinearSolve`] if the matrix is not positive definite or not finite.
-    pub fn factorize(&self, values: &[f64]) -> Result<Factorization, IncrementFailure> {
-        let matrix = self.lower_triangle(values)?;
+    /// [`IncrementFailure::LinearSolve`] if the matrix is not positive definite.
+    pub fn factorize(&self, compressed: &[f64]) -> Result<Factorization, IncrementFailure> {
+        let matrix = self.matrix(compressed);
         let par = faer::get_global_parallelism();
         let mut factor = vec![0.0; self.analysis.len_val()];
         let mut scratch = MemBuffer::new(
@@ -167,7 +185,7 @@ impl SparsePattern {
         self.analysis
             .factorize_numeric_llt(
                 &mut factor,
-                matrix.as_ref(),
+                matrix,
                 Side::Lower,
                 LltRegularization::default(),
                 par,
@@ -349,6 +367,16 @@ impl Factorization {
 mod tests {
     use super::*;
 
+    /// The factorization of the matrix of slot values `values`.
+    fn factorize_slots(
+        pattern: &SparsePattern,
+        values: &[f64],
+    ) -> Result<Factorization, IncrementFailure> {
+        let mut compressed = Vec::new();
+        pattern.compress(values, &mut compressed)?;
+        pattern.factorize(&compressed)
+    }
+
     /// A 1D chain of springs plus masses: tridiagonal SPD matrix assembled element by element
     /// (duplicates summed), solved twice with the same symbolic analysis.
     #[test]
@@ -377,7 +405,7 @@ mod tests {
             for &d in &diag {
                 values[d] += 1.0;
             }
-            let f = pattern.factorize(&values).expect("spd");
+            let f = factorize_slots(&pattern, &values).expect("spd");
             let x_true = DVector::from_fn(n, |i, _| (i as f64 * 0.3).sin());
             // b = K x_true
             let mut b = x_true.clone();
@@ -418,7 +446,7 @@ mod tests {
             dense[(i, j)] = v;
             dense[(j, i)] = v;
         }
-        let factor = pattern.factorize(&values).expect("spd");
+        let factor = factorize_slots(&pattern, &values).expect("spd");
         assert_eq!(factor.trailing(), trailing.as_slice());
         let block = factor.trailing_inverse();
         let inverse = dense.try_inverse().expect("invertible");
@@ -446,13 +474,13 @@ mod tests {
         values[a] = 1.0;
         values[b] = -1.0;
         assert!(matches!(
-            pattern.factorize(&values),
+            factorize_slots(&pattern, &values),
             Err(IncrementFailure::LinearSolve {
                 failure: LinearFailure::NotPositiveDefinite,
                 ..
             })
         ));
         values[b] = f64::NAN;
-        assert!(pattern.factorize(&values).is_err());
+        assert!(factorize_slots(&pattern, &values).is_err());
     }
 }
