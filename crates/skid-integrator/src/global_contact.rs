@@ -79,13 +79,13 @@ use crate::contact_rows::ContactRows;
 use crate::cost::SolveCounts;
 use crate::error::{IncrementFailure, LinearFailure};
 use crate::krylov::gmres;
-use system::{Approximation, LinearSystem};
-
-mod system;
 use crate::model::Model;
 use crate::ordering::global_system_order;
 use crate::quasi_definite::{Precision, QuasiDefinite};
 use crate::sparse::column_mut;
+use system::{Approximation, LinearSystem};
+
+mod system;
 
 /// The system this module's failures name.
 const SYSTEM: &str = "global contact system";
@@ -890,15 +890,7 @@ mod tests {
             linear.u = &rows.u + rows.times(&dx);
             let linear_residual = &residual + symmetric_product(k, &dx);
             let step = solver
-                .step(
-                    &model,
-                    k,
-                    &linear,
-                    &linear_residual,
-                    &r,
-                    &rho,
-                    &held,
-                )
+                .step(&model, k, &linear, &linear_residual, &r, &rho, &held)
                 .expect("global step");
             dx += &step.dx;
             sizes.push(step.dx.amax() / dx.amax());
