@@ -78,7 +78,7 @@ use skid_contact::coulomb::alart_curnier::{LocalBranch, LocalLaw};
 use crate::contact_rows::ContactRows;
 use crate::cost::SolveCounts;
 use crate::error::{IncrementFailure, LinearFailure};
-use crate::krylov::gmres;
+use crate::krylov::{self, gmres};
 use crate::model::Model;
 use crate::ordering::global_system_order;
 use crate::quasi_definite::{Precision, QuasiDefinite};
@@ -193,10 +193,11 @@ fn checked_gmres(
     rhs: &DVector<f64>,
     m_inv: impl FnMut(&DVector<f64>, &mut DVector<f64>),
     (tolerance, max_iterations): (f64, usize),
-    count: &mut usize,
+    (count, workspace): (&mut usize, &mut krylov::Workspace),
 ) -> Option<(DVector<f64>, usize)> {
     let apply = |x: &DVector<f64>, out: &mut DVector<f64>| system.apply(x, out);
-    let Some((z, iterations)) = gmres(apply, m_inv, rhs, 0.1 * tolerance, max_iterations) else {
+    let limits = (0.1 * tolerance, max_iterations);
+    let Some((z, iterations)) = gmres(apply, m_inv, rhs, limits, workspace) else {
         *count += max_iterations;
         return None;
     };
@@ -227,6 +228,8 @@ pub struct GlobalContactSolver {
     factors_stale: bool,
     /// The quasi-definite preconditioner, factorized for an earlier system or this one.
     quasi_definite: QuasiDefinite,
+    /// GMRES's vectors, kept from one solve to the next.
+    krylov: krylov::Workspace,
     /// The pattern of the quasi-definite approximations, kept while systems share it.
     approximation: Approximation,
     /// The precision of the quasi-definite factors (see
@@ -257,6 +260,7 @@ impl Default for GlobalContactSolver {
             factored_values: None,
             factors_stale: false,
             quasi_definite: QuasiDefinite::default(),
+            krylov: krylov::Workspace::default(),
             approximation: Approximation::default(),
             precision: Precision::Single,
             preconditioner_branches: None,
@@ -448,7 +452,7 @@ impl GlobalContactSolver {
                     rhs,
                     |x, out| preconditioner.precondition(x, out),
                     (INEXACT_TOLERANCE, budget),
-                    &mut self.counts.krylov_iterations,
+                    (&mut self.counts.krylov_iterations, &mut self.krylov),
                 ) {
                     return Ok(z);
                 }
@@ -495,7 +499,7 @@ impl GlobalContactSolver {
             rhs,
             |x, out| factors.solve(x, out),
             (KRYLOV_TOLERANCE, KRYLOV_MAX_ITERATIONS),
-            &mut self.counts.krylov_iterations,
+            (&mut self.counts.krylov_iterations, &mut self.krylov),
         );
         self.factors_stale = solution.is_none();
         solution.map(|(z, _)| z)
@@ -533,7 +537,7 @@ impl GlobalContactSolver {
             self.counts.preconditioner_factorizations += 1;
             if self
                 .quasi_definite
-                .factorize(symbolic, &values, system.equations(), order, precision)
+                .factorize(symbolic, values, system.equations(), order, precision)
                 .is_err()
             {
                 continue;
@@ -544,7 +548,7 @@ impl GlobalContactSolver {
                 rhs,
                 |x, out| preconditioner.precondition(x, out),
                 (INEXACT_TOLERANCE, budget),
-                &mut self.counts.krylov_iterations,
+                (&mut self.counts.krylov_iterations, &mut self.krylov),
             ) {
                 self.precision = precision;
                 self.preconditioner_branches = Some(branches);

@@ -32,7 +32,7 @@
 
 use std::sync::Arc;
 
-use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LdltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
@@ -72,6 +72,20 @@ pub enum Precision {
     Double,
 }
 
+/// Scratch space of a numeric factorization and the requirement it was made for.
+struct Scratch {
+    required: StackReq,
+    buffer: MemBuffer,
+}
+
+impl std::fmt::Debug for Scratch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Scratch")
+            .field("required", &self.required)
+            .finish_non_exhaustive()
+    }
+}
+
 /// The numeric factor, in its precision.
 #[derive(Debug)]
 enum Factor {
@@ -83,6 +97,10 @@ enum Factor {
 #[derive(Debug, Default)]
 pub struct QuasiDefinite {
     analysed: Option<Analysed>,
+    /// The single-precision values of the last matrix factorized in single precision.
+    single: Vec<f32>,
+    /// The numeric factorization's scratch space, kept while the requirement stays the same.
+    scratch: Option<Scratch>,
     /// Symbolic analyses performed.
     pub analyses: usize,
 }
@@ -171,14 +189,17 @@ impl QuasiDefinite {
             .as_mut()
             .ok_or_else(|| fail("analysis", &"missing"))?;
         let previous = a.factor.take();
+        let scratch = &mut self.scratch;
         let factor = match precision {
             Precision::Single => {
-                let single: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+                let single = &mut self.single;
+                single.clear();
+                single.extend(values.iter().map(|&v| v as f32));
                 let mut factor = match previous {
                     Some(Factor::Single(factor)) => factor,
                     _ => Vec::new(),
                 };
-                factorize_numeric(&a.analysis, &a.symbolic, &single, &mut factor)
+                factorize_numeric(&a.analysis, &a.symbolic, single, &mut factor, scratch)
                     .map_err(|e| fail("factorization", &e))?;
                 Factor::Single(factor)
             }
@@ -187,7 +208,7 @@ impl QuasiDefinite {
                     Some(Factor::Double(factor)) => factor,
                     _ => Vec::new(),
                 };
-                factorize_numeric(&a.analysis, &a.symbolic, values, &mut factor)
+                factorize_numeric(&a.analysis, &a.symbolic, values, &mut factor, scratch)
                     .map_err(|e| fail("factorization", &e))?;
                 Factor::Double(factor)
             }
@@ -209,14 +230,15 @@ impl QuasiDefinite {
             .is_some_and(|a| a.factor.is_some() && a.symbolic.nrows() == dim)
     }
 
-    /// Writes `M^{-1} v = S^{-1} diag(I, -I) v` into `out` (nothing if not factorized).
+    /// Writes `M^{-1} v = S^{-1} diag(I, -I) v` into `out` (zeros if not factorized).
     pub fn precondition(&self, v: &DVector<f64>, out: &mut DVector<f64>) {
         let Some(a) = self.analysed.as_ref() else {
+            out.fill(0.0);
             return;
         };
         let flip = |(i, vi): (usize, &f64)| if i < a.unknowns { *vi } else { -vi };
         match &a.factor {
-            None => {}
+            None => out.fill(0.0),
             Some(Factor::Double(factor)) => {
                 for (o, value) in out.iter_mut().zip(v.iter().enumerate().map(flip)) {
                     *o = value;
@@ -236,18 +258,26 @@ impl QuasiDefinite {
 }
 
 /// The numeric `L D L^T` factorization of the matrix of lower triangle `symbolic` with
-/// `values`, into `factor` (resized to the analysis), without regularisation.
+/// `values`, into `factor` (resized to the analysis), without regularisation, in the scratch
+/// space `kept` (made anew only when the requirement changes).
 fn factorize_numeric<T: ComplexField>(
     analysis: &SymbolicCholesky<usize>,
     symbolic: &SymbolicSparseColMat<usize>,
     values: &[T],
     factor: &mut Vec<T>,
+    kept: &mut Option<Scratch>,
 ) -> Result<(), String> {
     factor.resize(analysis.len_val(), T::zero_impl());
     let par = faer::get_global_parallelism();
-    let mut scratch =
-        MemBuffer::try_new(analysis.factorize_numeric_ldlt_scratch::<T>(par, Default::default()))
-            .map_err(|e| format!("{e:?}"))?;
+    let required = analysis.factorize_numeric_ldlt_scratch::<T>(par, Default::default());
+    let scratch = match kept.take() {
+        Some(scratch) if scratch.required == required => kept.insert(scratch),
+        _ => kept.insert(Scratch {
+            required,
+            buffer: MemBuffer::try_new(required).map_err(|e| format!("{e:?}"))?,
+        }),
+    };
+    let scratch = &mut scratch.buffer;
     analysis
         .factorize_numeric_ldlt(
             factor,
@@ -255,7 +285,7 @@ fn factorize_numeric<T: ComplexField>(
             Side::Lower,
             LdltRegularization::default(),
             par,
-            MemStack::new(&mut scratch),
+            MemStack::new(scratch),
             Default::default(),
         )
         .map(|_| ())

@@ -261,11 +261,12 @@ impl<'a> LinearSystem<'a> {
             })
     }
 
-    /// The values of `S` (see [`crate::quasi_definite`]) on `layout`, which must fit this
-    /// system.
-    fn approximation(&self, layout: &ApproximationLayout) -> Vec<f64> {
+    /// Writes into `values` those of `S` (see [`crate::quasi_definite`]) on `layout`, which
+    /// must fit this system.
+    fn approximation(&self, layout: &ApproximationLayout, values: &mut Vec<f64>) {
         let (n, d, k) = (self.equations(), self.d, self.k);
-        let mut values = vec![0.0; layout.symbolic.row_idx().len()];
+        values.clear();
+        values.resize(layout.symbolic.row_idx().len(), 0.0);
         for j in 0..n {
             let start = layout.symbolic.col_ptr()[j];
             let column = k.val_of_col(j);
@@ -318,7 +319,6 @@ impl<'a> LinearSystem<'a> {
                 }
             }
         }
-        values
     }
 }
 
@@ -408,10 +408,12 @@ impl ApproximationLayout {
     }
 }
 
-/// The layout of `S` kept across systems, rebuilt when a system's pattern differs.
+/// The layout of `S` kept across systems, rebuilt when a system's pattern differs, and the
+/// storage of its values.
 #[derive(Debug, Default)]
 pub(super) struct Approximation {
     layout: Option<ApproximationLayout>,
+    values: Vec<f64>,
 }
 
 impl Approximation {
@@ -419,13 +421,13 @@ impl Approximation {
     pub(super) fn of(
         &mut self,
         system: &LinearSystem<'_>,
-    ) -> (&Arc<SymbolicSparseColMat<usize>>, Vec<f64>) {
+    ) -> (&Arc<SymbolicSparseColMat<usize>>, &[f64]) {
         let layout = match self.layout.take() {
             Some(layout) if system.fits(&layout) => layout,
             _ => ApproximationLayout::new(system),
         };
-        let values = system.approximation(&layout);
+        system.approximation(&layout, &mut self.values);
         let layout = self.layout.insert(layout);
-        (&layout.symbolic, values)
+        (&layout.symbolic, &self.values)
     }
 }
