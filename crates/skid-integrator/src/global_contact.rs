@@ -273,9 +273,11 @@ impl Default for GlobalContactSolver {
 }
 
 /// What a [`GlobalContactSolver`] carries from one increment to the next and that changes its
-/// results: the last LU factorization, which preconditions GMRES on later systems. Rebuilt
-/// from the matrix it factorized, the factors are the same bits (the factorization is
-/// deterministic at one thread), so a run continued from a checkpoint takes the same path. The
+/// results: the last LU factorization, while it still preconditions GMRES on later systems
+/// (factors that have stopped serving are not tried again before the next factorization, so
+/// they are left out). Rebuilt from the matrix it factorized, the factors are the same bits
+/// (the factorization is deterministic at one thread), so a run continued from a checkpoint
+/// takes the same path. The
 /// quasi-definite factors are not carried: a checkpoint ends their reuse (see
 /// [`GlobalContactSolver::forget_preconditioner`]), since on a system of 1e5 equations its
 /// matrix alone would make a restart file of 130 MB.
@@ -284,8 +286,6 @@ pub struct GlobalSolverMemory {
     /// The factorized matrix, if any: its dimension, the entries `(row, column)` of its pattern
     /// as assembled (duplicates included, in order) and its compressed values.
     pub factored: Option<FactoredMatrix>,
-    /// Whether those factors have stopped serving as a preconditioner.
-    pub stale: bool,
 }
 
 /// A matrix of the global contact system that was factorized (see [`GlobalSolverMemory`]).
@@ -315,16 +315,13 @@ impl GlobalContactSolver {
             .analysed
             .as_ref()
             .zip(self.factored_values.as_ref())
-            .filter(|_| self.factors.is_some())
+            .filter(|_| self.factors.is_some() && !self.factors_stale)
             .map(|(analysed, values)| FactoredMatrix {
                 dim: analysed.symbolic.nrows(),
                 entries: analysed.pairs.iter().map(|p| (p.row, p.col)).collect(),
                 values: values.clone(),
             });
-        GlobalSolverMemory {
-            factored,
-            stale: self.factors_stale,
-        }
+        GlobalSolverMemory { factored }
     }
 
     /// Ends the reuse of the quasi-definite factors: the next system factorizes its own `S`.
@@ -375,7 +372,6 @@ impl GlobalContactSolver {
             let matrix = SparseColMat::new(symbolic, m.values.clone());
             solver.factorize(matrix.as_ref())?;
         }
-        solver.factors_stale = memory.stale;
         Ok(solver)
     }
 
