@@ -31,6 +31,8 @@ mod polish;
 mod tests;
 mod validation;
 
+use std::borrow::Cow;
+
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::ContactError;
@@ -237,7 +239,7 @@ fn solve_fixed_point(
         None => slip_shift(dim, problem.mu, q),
     };
     let mut program = ConicProgram::new(
-        &(&w / compliance_scale),
+        &(&*w / compliance_scale),
         &scaled_linear_term(&shift),
         dim,
         problem.mu,
@@ -398,8 +400,13 @@ fn inverse_mean_compliance(problem: &FrictionProblem, i: usize) -> f64 {
             .sum::<f64>()
 }
 
-/// The symmetric part `(W + W^T) / 2`.
-fn symmetric_part(w: &DMatrix<f64>) -> DMatrix<f64> {
+/// The symmetric part `(W + W^T) / 2`: `W` itself, borrowed, where it already equals its
+/// transpose (as the Delassus operators of the integrator do), a symmetrised copy otherwise.
+fn symmetric_part(w: &DMatrix<f64>) -> Cow<'_, DMatrix<f64>> {
+    let symmetric = (0..w.ncols()).all(|j| (j + 1..w.nrows()).all(|i| w[(i, j)] == w[(j, i)]));
+    if symmetric {
+        return Cow::Borrowed(w);
+    }
     let mut symmetric = w.clone();
     for j in 0..w.ncols() {
         for i in j + 1..w.nrows() {
@@ -408,7 +415,7 @@ fn symmetric_part(w: &DMatrix<f64>) -> DMatrix<f64> {
             symmetric[(j, i)] = mean;
         }
     }
-    symmetric
+    Cow::Owned(symmetric)
 }
 
 /// Shift `s_i = mu_i ||u_T,i||` of each contact.

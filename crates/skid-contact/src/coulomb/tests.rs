@@ -461,6 +461,12 @@ fn invalid_inputs_are_rejected_without_panic() {
     let mut w_asym = w.clone();
     w_asym[(0, 1)] = 0.5;
     check(FrictionProblem { w: &w_asym, ..good }, None, &settings);
+    // a non-finite entry off the diagonal, in either triangle
+    for (i, j) in [(0, 1), (1, 0)] {
+        let mut w_nan = w.clone();
+        w_nan[(i, j)] = f64::NAN;
+        check(FrictionProblem { w: &w_nan, ..good }, None, &settings);
+    }
     let w_zero_diag = diagonal_w(2, 0.0, 3.0);
     check(
         FrictionProblem {
@@ -698,4 +704,25 @@ fn the_length_error_sees_a_penetration_the_relative_error_hides() {
     let r = DVector::from_vec(vec![exact, 0.0, exact, 0.0]);
     let u = &w * &r + &q;
     assert!(natural_map_length_error(&problem, &r, &u) < 1e-3 * penetration);
+}
+
+/// A `W` equal to its transpose is used as it is; one with round-off asymmetry (accepted by
+/// the checks) is replaced by its symmetric part, and both solve to the same forces.
+#[test]
+fn symmetric_part_borrows_a_symmetric_w() {
+    let mut rng = Rng(7);
+    let w = random_delassus(&mut rng, 6, 0.5);
+    assert!(matches!(symmetric_part(&w), Cow::Borrowed(_)));
+    let mut skewed = w.clone();
+    skewed[(4, 1)] += 1e-9 * w.amax();
+    let Cow::Owned(symmetrised) = symmetric_part(&skewed) else {
+        panic!("a skewed W was borrowed");
+    };
+    let expected = (&skewed + skewed.transpose()) * 0.5;
+    assert!((&symmetrised - &expected).amax() <= f64::EPSILON * w.amax());
+    assert_eq!(symmetrised, symmetrised.transpose());
+    let q = DVector::from_fn(6, |k, _| if k % 3 == 0 { -0.01 } else { 0.003 });
+    let mu = [0.3, 0.2];
+    let (a, b) = (solve(3, &w, &q, &mu), solve(3, &skewed, &q, &mu));
+    assert!((&a.r - &b.r).amax() < 1e-6 * a.r.amax(), "{} vs {}", a.r, b.r);
 }
