@@ -119,44 +119,61 @@ impl ContactRows {
         factor: &Factorization,
         candidates: &[usize],
     ) -> Result<DMatrix<f64>, IncrementFailure> {
-        let mut position = std::collections::HashMap::new();
-        for (k, &eq) in factor.trailing().iter().enumerate() {
-            position.insert(eq, k);
+        let trailing = factor.trailing();
+        // position[eq]: eq's place among the trailing equations (usize::MAX: not among them)
+        let mut position = vec![usize::MAX; trailing.iter().max().map_or(0, |&eq| eq + 1)];
+        for (k, &eq) in trailing.iter().enumerate() {
+            position[eq] = k;
         }
-        let local: Vec<Vec<(usize, f64)>> = self
-            .row_indices(candidates)
-            .into_iter()
-            .map(|k| &self.rows[k])
-            .map(|row| {
-                row.iter()
-                    .map(|&(eq, c)| position.get(&eq).map(|&k| (k, c)))
-                    .collect::<Option<Vec<_>>>()
-            })
-            .collect::<Option<_>>()
-            .ok_or_else(|| {
-                IncrementFailure::linear(
-                    "Delassus operator",
-                    LinearFailure::Structure(
-                        "a contact row involves an equation the factorization does not \
-                         eliminate last"
-                            .into(),
-                    ),
-                )
-            })?;
-        let inverse = factor.trailing_inverse();
-        let m = local.len();
-        // G = (K^-1)_CC H_C^T, column by column
-        let mut g = DMatrix::zeros(inverse.nrows(), m);
-        for (j, row) in local.iter().enumerate() {
-            for &(k, c) in row {
-                g.column_mut(j).axpy(c, &inverse.column(k), 1.0);
+        let index = self.row_indices(candidates);
+        let m = index.len();
+        // the rows H_C in trailing positions, entries of row a at starts[a]..starts[a + 1]
+        let mut local = Vec::with_capacity(index.iter().map(|&k| self.rows[k].len()).sum());
+        let mut starts = Vec::with_capacity(m + 1);
+        for &k in &index {
+            starts.push(local.len());
+            for &(eq, c) in &self.rows[k] {
+                match position.get(eq) {
+                    Some(&p) if p != usize::MAX => local.push((p, c)),
+                    _ => {
+                        return Err(IncrementFailure::linear(
+                            "Delassus operator",
+                            LinearFailure::Structure(
+                                "a contact row involves an equation the factorization does \
+                                 not eliminate last"
+                                    .into(),
+                            ),
+                        ));
+                    }
+                }
             }
         }
-        // W = H_C G
-        let w = DMatrix::from_fn(m, m, |i, j| {
-            local[i].iter().map(|&(k, c)| c * g[(k, j)]).sum::<f64>()
+        starts.push(local.len());
+        let row = |a: usize| &local[starts[a]..starts[a + 1]];
+        let inverse = factor.trailing_inverse();
+        // G = (K^-1)_CC H_C^T, column by column
+        let size = inverse.nrows();
+        let mut g = DMatrix::<f64>::zeros(size, m);
+        for (j, column) in g.as_mut_slice().chunks_exact_mut(size).enumerate() {
+            for &(k, c) in row(j) {
+                let source = &inverse.as_slice()[k * size..(k + 1) * size];
+                for (target, &value) in column.iter_mut().zip(source) {
+                    *target += c * value;
+                }
+            }
+        }
+        // W = H_C G, then its symmetric part (W + W^T) / 2 in place
+        let mut w = DMatrix::from_fn(m, m, |i, j| {
+            row(i).iter().map(|&(k, c)| c * g[(k, j)]).sum::<f64>()
         });
-        Ok((&w + w.transpose()) * 0.5)
+        for j in 0..m {
+            for i in j + 1..m {
+                let mean = (w[(i, j)] + w[(j, i)]) * 0.5;
+                w[(i, j)] = mean;
+                w[(j, i)] = mean;
+            }
+        }
+        Ok(w)
     }
 }
 

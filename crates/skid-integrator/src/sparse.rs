@@ -23,7 +23,7 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky,
 };
 use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
-use faer::{Conj, Mat, MatMut, Side};
+use faer::{Conj, Mat, MatMut, MatRef, Side};
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::{IncrementFailure, LinearFailure};
@@ -316,7 +316,7 @@ impl Factorization {
     fn compute_trailing_inverse(&self) -> DMatrix<f64> {
         let c = self.trailing.len();
         let first = self.n - c;
-        let mut l_cc = Mat::<f64>::zeros(c, c);
+        let mut l_cc = DMatrix::<f64>::zeros(c, c);
         let SymbolicCholeskyRaw::Supernodal(symbolic) = self.analysis.raw() else {
             unreachable!("the analysis is forced supernodal")
         };
@@ -327,39 +327,28 @@ impl Factorization {
         for s in 0..symbolic.n_supernodes() {
             let node = factor.supernode(s);
             let (start, values) = (node.start(), node.val());
-            let width = values.ncols();
-            if start + width <= first {
-                continue;
-            }
             // rows: the diagonal block start..start+width, then the pattern
-            let rows = (start..start + width).chain(node.pattern().iter().copied());
-            for (local_row, row) in rows.enumerate() {
-                for local_col in 0..width.min(local_row + 1) {
-                    let col = start + local_col;
-                    if col >= first {
-                        l_cc[(row - first, col - first)] = values[(local_row, local_col)];
-                    }
+            let rows = || (start..start + values.ncols()).chain(node.pattern().iter().copied());
+            for local_col in first.saturating_sub(start)..values.ncols() {
+                let (col, column) = (start + local_col - first, values.col(local_col));
+                for (local_row, row) in rows().enumerate().skip(local_col) {
+                    l_cc[(row - first, col)] = column[local_row];
                 }
             }
         }
         let par = faer::get_global_parallelism();
-        let mut inverse = Mat::<f64>::zeros(c, c);
+        let mut inverse = DMatrix::<f64>::zeros(c, c);
         let mut scratch =
             MemBuffer::new(faer::linalg::cholesky::llt::inverse::inverse_scratch::<f64>(c, par));
         faer::linalg::cholesky::llt::inverse::inverse(
-            inverse.as_mut(),
-            l_cc.as_ref(),
+            MatMut::from_column_major_slice_mut(inverse.as_mut_slice(), c, c),
+            MatRef::from_column_major_slice(l_cc.as_slice(), c, c),
             par,
             MemStack::new(&mut scratch),
         );
         // only the lower triangle is written
-        DMatrix::from_fn(c, c, |i, j| {
-            if i >= j {
-                inverse[(i, j)]
-            } else {
-                inverse[(j, i)]
-            }
-        })
+        inverse.fill_upper_triangle_with_lower_triangle();
+        inverse
     }
 }
 
