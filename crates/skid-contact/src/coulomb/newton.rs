@@ -9,8 +9,9 @@
 //! Open contacts take the step `dr = -r` outright, so only the closed ones enter the dense
 //! linear solve.
 
-use faer::Mat;
-use faer::linalg::solvers::Solve;
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::lu::partial_pivoting::{factor, solve};
+use faer::{Conj, MatMut, MatRef, Par};
 use nalgebra::{DMatrix, DVector};
 
 use super::alart_curnier::{LocalBranch, LocalLaw};
@@ -25,52 +26,54 @@ const ARMIJO: f64 = 1e-4;
 /// Halvings of the step before the line search gives up.
 const MAX_HALVINGS: usize = 30;
 
-/// The Alart–Curnier function `Phi` at `(r, u)` and the local law of every contact.
+/// The Alart–Curnier function `Phi` at `(r, u)` and the local law of every contact, written
+/// into `phi` (length `m`) and `laws` (refilled).
 fn evaluate(
     problem: &FrictionProblem,
     rho: &[f64],
     r: &DVector<f64>,
     u: &DVector<f64>,
-) -> (DVector<f64>, Vec<LocalLaw>) {
+    phi: &mut DVector<f64>,
+    laws: &mut Vec<LocalLaw>,
+) {
     let dim = problem.dim;
-    let mut phi = DVector::zeros(r.len());
-    let laws = problem
-        .mu
-        .iter()
-        .enumerate()
-        .map(|(i, &mu)| {
-            let range = dim * i..dim * (i + 1);
-            let law = LocalLaw::evaluate(
-                dim,
-                mu,
-                rho[i],
-                &r.as_slice()[range.clone()],
-                &u.as_slice()[range],
-            );
-            phi.rows_mut(dim * i, dim).copy_from_slice(&law.phi[..dim]);
-            law
-        })
-        .collect();
-    (phi, laws)
+    laws.clear();
+    for (i, &mu) in problem.mu.iter().enumerate() {
+        let range = dim * i..dim * (i + 1);
+        let law = LocalLaw::evaluate(
+            dim,
+            mu,
+            rho[i],
+            &r.as_slice()[range.clone()],
+            &u.as_slice()[range.clone()],
+        );
+        phi.as_mut_slice()[range].copy_from_slice(&law.phi[..dim]);
+        laws.push(law);
+    }
 }
 
 /// The generalized Jacobian `dPhi/dr = dPhi/dr|_u + dPhi/du W` of the closed contacts,
-/// transposed (`m` rows, one column per closed-contact row of `Phi`, in contact order), with
-/// the indices of those rows. `W` is symmetric, so its rows are read as (contiguous) columns.
+/// transposed (`m` rows, one column per closed-contact row of `Phi`, in contact order), written
+/// into `transposed`, with the indices of those rows in `rows`. `W` is symmetric, so its rows
+/// are read as (contiguous) columns.
 fn closed_jacobian_transposed(
     problem: &FrictionProblem,
     w: &DMatrix<f64>,
     laws: &[LocalLaw],
-) -> (DMatrix<f64>, Vec<usize>) {
+    transposed: &mut DMatrix<f64>,
+    rows: &mut Vec<usize>,
+) {
     let dim = problem.dim;
     let closed = |law: &LocalLaw| law.branch != LocalBranch::Open;
-    let rows: Vec<usize> = laws
-        .iter()
-        .enumerate()
-        .filter(|(_, law)| closed(law))
-        .flat_map(|(i, _)| dim * i..dim * (i + 1))
-        .collect();
-    let mut transposed = DMatrix::zeros(w.nrows(), rows.len());
+    rows.clear();
+    rows.extend(
+        laws.iter()
+            .enumerate()
+            .filter(|(_, law)| closed(law))
+            .flat_map(|(i, _)| dim * i..dim * (i + 1)),
+    );
+    transposed.resize_mut(w.nrows(), rows.len(), 0.0);
+    transposed.fill(0.0);
     let mut a = 0;
     for (i, law) in laws.iter().enumerate().filter(|(_, law)| closed(law)) {
         let k = dim * i;
@@ -86,42 +89,123 @@ fn closed_jacobian_transposed(
         }
         a += dim;
     }
-    (transposed, rows)
 }
 
-/// Newton step `dr` with `J dr = -Phi`: `dr = -r` on open contacts, the dense solve on the closed
-/// ones. `None` if the closed block is singular.
+/// The buffers of one [`newton`] call, which its steps and line-search trials reuse.
+struct Buffers {
+    /// The transposed Jacobian of the closed contacts (see [`closed_jacobian_transposed`]).
+    transposed: DMatrix<f64>,
+    /// The closed rows of `Phi`.
+    rows: Vec<usize>,
+    /// The closed block of `J^T` (column-major), overwritten by its LU factors.
+    block: Vec<f64>,
+    /// The right-hand side, overwritten by the solution.
+    rhs: Vec<f64>,
+    /// The row permutation of the LU factorization and its inverse.
+    permutation: (Vec<usize>, Vec<usize>),
+    /// faer's workspace for the factorization and the solve of size up to `m`.
+    scratch: MemBuffer,
+}
+
+impl Buffers {
+    /// Buffers for problems of `m` unknowns.
+    fn new(m: usize) -> Self {
+        let par = Par::Seq;
+        Self {
+            transposed: DMatrix::zeros(m, m),
+            rows: Vec::with_capacity(m),
+            block: Vec::with_capacity(m * m),
+            rhs: Vec::with_capacity(m),
+            permutation: (vec![0; m], vec![0; m]),
+            scratch: MemBuffer::new(StackReq::any_of(&[
+                factor::lu_in_place_scratch::<usize, f64>(m, m, par, Default::default()),
+                solve::solve_transpose_in_place_scratch::<usize, f64>(m, 1, par),
+            ])),
+        }
+    }
+}
+
+/// Newton step `dr` with `J dr = -Phi`, written into `step`: `dr = -r` on open contacts, the
+/// dense solve (LU with partial pivoting) on the closed ones. False if the closed block is
+/// singular.
 fn newton_step(
     problem: &FrictionProblem,
     w: &DMatrix<f64>,
     r: &DVector<f64>,
     phi: &DVector<f64>,
     laws: &[LocalLaw],
-) -> Option<DVector<f64>> {
+    step: &mut DVector<f64>,
+    buffers: &mut Buffers,
+) -> bool {
     let dim = problem.dim;
-    let mut step = DVector::zeros(r.len());
+    step.fill(0.0);
     for (i, law) in laws.iter().enumerate() {
         if law.branch == LocalBranch::Open {
-            step.rows_mut(dim * i, dim)
-                .copy_from(&(-r.rows(dim * i, dim)));
+            for k in dim * i..dim * (i + 1) {
+                step[k] = -r[k];
+            }
         }
     }
-    let (transposed, rows) = closed_jacobian_transposed(problem, w, laws);
+    let Buffers {
+        transposed,
+        rows,
+        block,
+        rhs,
+        permutation: (forward, inverse),
+        scratch,
+    } = buffers;
+    closed_jacobian_transposed(problem, w, laws, transposed, rows);
     if rows.is_empty() {
-        return Some(step);
+        return true;
     }
-    let coupling = transposed.tr_mul(&step);
+    let coupling = transposed.tr_mul(step);
     let n = rows.len();
     // the closed block of J^T; J dr = rhs is solved as a transposed system
-    let block = Mat::<f64>::from_fn(n, n, |a, b| transposed[(rows[a], b)]);
-    let mut rhs = Mat::<f64>::from_fn(n, 1, |a, _| -phi[rows[a]] - coupling[a]);
-    block
-        .partial_piv_lu()
-        .solve_transpose_in_place(rhs.as_mut());
-    for (a, &row) in rows.iter().enumerate() {
-        step[row] = rhs[(a, 0)];
+    block.clear();
+    for column in transposed.as_slice().chunks_exact(transposed.nrows()) {
+        block.extend(rows.iter().map(|&row| column[row]));
     }
-    step.iter().all(|v| v.is_finite()).then_some(step)
+    rhs.clear();
+    rhs.extend(
+        rows.iter()
+            .zip(coupling.as_slice())
+            .map(|(&row, c)| -phi[row] - c),
+    );
+    let par = Par::Seq;
+    let mut stack = MemStack::new(scratch);
+    let lu = MatMut::from_column_major_slice_mut(block.as_mut_slice(), n, n);
+    let (_, permutation) = factor::lu_in_place(
+        lu,
+        &mut forward[..n],
+        &mut inverse[..n],
+        par,
+        &mut stack,
+        Default::default(),
+    );
+    // the factors share the block: L strictly below the diagonal (unit diagonal), U on and
+    // above it, and each triangular solve reads only its own triangle
+    let lu = MatRef::from_column_major_slice(block.as_slice(), n, n);
+    solve::solve_transpose_in_place_with_conj(
+        lu,
+        lu,
+        permutation,
+        Conj::No,
+        MatMut::from_column_major_slice_mut(rhs.as_mut_slice(), n, 1),
+        par,
+        &mut stack,
+    );
+    for (&row, &value) in rows.iter().zip(rhs.iter()) {
+        step[row] = value;
+    }
+    step.iter().all(|v| v.is_finite())
+}
+
+/// `out = a + length b`, elementwise.
+fn along(out: &mut DVector<f64>, a: &DVector<f64>, b: &DVector<f64>, length: f64) {
+    let (a, b) = (a.as_slice(), b.as_slice());
+    for ((o, a), b) in out.as_mut_slice().iter_mut().zip(a).zip(b) {
+        *o = a + b * length;
+    }
 }
 
 /// Semismooth Newton from the forces `start`, stopping once the natural-map error is at most
@@ -136,42 +220,58 @@ pub(crate) fn newton(
     let rho: Vec<f64> = (0..problem.mu.len())
         .map(|i| inverse_mean_compliance(problem, i))
         .collect();
+    let m = start.r.len();
+    let mut buffers = Buffers::new(m);
     let (mut r, mut u) = (start.r.clone(), start.u.clone());
     let mut best = start;
-    let (mut phi, mut branches) = evaluate(problem, &rho, &r, &u);
+    let (mut phi, mut laws) = (DVector::zeros(m), Vec::with_capacity(problem.mu.len()));
+    evaluate(problem, &rho, &r, &u, &mut phi, &mut laws);
     let mut merit = phi.norm_squared();
+    let (mut dr, mut du) = (DVector::zeros(m), DVector::zeros(m));
+    let (mut trial_r, mut trial_u, mut trial_phi) =
+        (DVector::zeros(m), DVector::zeros(m), DVector::zeros(m));
+    let mut trial_laws = Vec::with_capacity(problem.mu.len());
     let mut steps = 0;
     while best.error > tolerance && steps < MAX_STEPS {
-        let Some(dr) = newton_step(problem, w, &r, &phi, &branches) else {
+        if !newton_step(problem, w, &r, &phi, &laws, &mut dr, &mut buffers) {
             break;
-        };
+        }
         steps += 1;
-        let du = w * &dr;
+        du.gemv(1.0, w, &dr, 0.0);
         let mut length = 1.0;
         let accepted = loop {
-            let trial_r = &r + &dr * length;
-            let trial_u = &u + &du * length;
-            let (trial_phi, trial_branches) = evaluate(problem, &rho, &trial_r, &trial_u);
+            along(&mut trial_r, &r, &dr, length);
+            along(&mut trial_u, &u, &du, length);
+            evaluate(
+                problem,
+                &rho,
+                &trial_r,
+                &trial_u,
+                &mut trial_phi,
+                &mut trial_laws,
+            );
             let trial_merit = trial_phi.norm_squared();
             if trial_merit <= (1.0 - 2.0 * ARMIJO * length) * merit {
-                break Some((trial_r, trial_u, trial_phi, trial_branches, trial_merit));
+                break Some(trial_merit);
             }
             length *= 0.5;
             if length < 0.5f64.powi(MAX_HALVINGS as i32) {
                 break None;
             }
         };
-        let Some((next_r, next_u, next_phi, next_branches, next_merit)) = accepted else {
+        let Some(next_merit) = accepted else {
             break;
         };
-        (r, u, phi, branches, merit) = (next_r, next_u, next_phi, next_branches, next_merit);
+        std::mem::swap(&mut r, &mut trial_r);
+        std::mem::swap(&mut u, &mut trial_u);
+        std::mem::swap(&mut phi, &mut trial_phi);
+        std::mem::swap(&mut laws, &mut trial_laws);
+        merit = next_merit;
         let error = natural_map(problem, &r, &u);
         if error < best.error {
-            best = Candidate {
-                r: r.clone(),
-                u: u.clone(),
-                error,
-            };
+            best.r.copy_from(&r);
+            best.u.copy_from(&u);
+            best.error = error;
         }
     }
     (best, steps)
@@ -216,18 +316,22 @@ mod tests {
         let rho: Vec<f64> = (0..n)
             .map(|i| inverse_mean_compliance(&problem, i))
             .collect();
-        let (_, branches) = evaluate(&problem, &rho, &r, &u);
+        let (mut phi, mut branches) = (DVector::zeros(m), Vec::new());
+        evaluate(&problem, &rho, &r, &u, &mut phi, &mut branches);
         let kinds: Vec<LocalBranch> = branches.iter().map(|law| law.branch).collect();
         use LocalBranch::{Frictionless, Open, Slide, Stick};
         assert_eq!(kinds, [Open, Stick, Slide, Frictionless], "{dim}D");
-        let (transposed, rows) = closed_jacobian_transposed(&problem, &w, &branches);
+        let (mut transposed, mut rows) = (DMatrix::zeros(0, 0), Vec::new());
+        closed_jacobian_transposed(&problem, &w, &branches, &mut transposed, &mut rows);
         let h = 1e-7;
         for j in 0..m {
             let phi_at = |sign: f64| {
                 let mut r_shifted = r.clone();
                 r_shifted[j] += sign * h;
                 let u_shifted = &w * &r_shifted + &q;
-                evaluate(&problem, &rho, &r_shifted, &u_shifted).0
+                let (mut phi, mut laws) = (DVector::zeros(m), Vec::new());
+                evaluate(&problem, &rho, &r_shifted, &u_shifted, &mut phi, &mut laws);
+                phi
             };
             let derivative = (phi_at(1.0) - phi_at(-1.0)) / (2.0 * h);
             for (a, &row) in rows.iter().enumerate() {
@@ -239,6 +343,73 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The Newton step solves `J dr = -Phi`: `dr = -r` on the open contact and the closed rows
+    /// of `J dr` equal `-Phi` there (one contact on each branch, buffers reused from a larger
+    /// problem's size).
+    fn newton_step_solves_the_linearisation(dim: usize) {
+        let n = 4;
+        let m = dim * n;
+        let b = DMatrix::from_fn(m, m, |i, j| ((i * 5 + j * 2) as f64 * 0.41).cos());
+        let w = &b * b.transpose() / m as f64 + DMatrix::identity(m, m) * 0.5;
+        let blocks = [
+            ([0.1, 0.05, 0.02], [1.0, 0.3, 0.1]),
+            ([1.0, 0.1, 0.05], [0.0, 0.01, 0.0]),
+            ([1.0, 0.2, -0.3], [0.01, 1.5, 0.8]),
+            ([1.0, 0.1, 0.2], [0.05, 0.3, 0.1]),
+        ];
+        let r = DVector::from_fn(m, |k, _| blocks[k / dim].0[k % dim]);
+        let u = DVector::from_fn(m, |k, _| blocks[k / dim].1[k % dim]);
+        let q = &u - &w * &r;
+        let mu = [0.3, 0.3, 0.3, 0.0];
+        let problem = FrictionProblem {
+            dim,
+            w: &w,
+            q: &q,
+            mu: &mu,
+        };
+        let rho: Vec<f64> = (0..n)
+            .map(|i| inverse_mean_compliance(&problem, i))
+            .collect();
+        let (mut phi, mut laws) = (DVector::zeros(m), Vec::new());
+        evaluate(&problem, &rho, &r, &u, &mut phi, &mut laws);
+        let mut buffers = Buffers::new(m + 3);
+        let mut step = DVector::zeros(m);
+        assert!(newton_step(
+            &problem,
+            &w,
+            &r,
+            &phi,
+            &laws,
+            &mut step,
+            &mut buffers
+        ));
+        let (mut transposed, mut rows) = (DMatrix::zeros(0, 0), Vec::new());
+        closed_jacobian_transposed(&problem, &w, &laws, &mut transposed, &mut rows);
+        assert_eq!(rows.len(), m - dim, "{dim}D: one open contact");
+        for k in 0..dim {
+            assert_eq!(step[k], -r[k]);
+        }
+        let product = transposed.tr_mul(&step);
+        for (a, &row) in rows.iter().enumerate() {
+            assert!(
+                (product[a] + phi[row]).abs() < 1e-12 * phi.amax(),
+                "{dim}D: row {row}: {} vs {}",
+                product[a],
+                -phi[row]
+            );
+        }
+    }
+
+    #[test]
+    fn newton_step_solves_the_linearisation_2d() {
+        newton_step_solves_the_linearisation(2);
+    }
+
+    #[test]
+    fn newton_step_solves_the_linearisation_3d() {
+        newton_step_solves_the_linearisation(3);
     }
 
     #[test]

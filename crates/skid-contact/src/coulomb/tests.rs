@@ -724,5 +724,10 @@ fn symmetric_part_borrows_a_symmetric_w() {
     let q = DVector::from_fn(6, |k, _| if k % 3 == 0 { -0.01 } else { 0.003 });
     let mu = [0.3, 0.2];
     let (a, b) = (solve(3, &w, &q, &mu), solve(3, &skewed, &q, &mu));
-    assert!((&a.r - &b.r).amax() < 1e-6 * a.r.amax(), "{} vs {}", a.r, b.r);
+    assert!(
+        (&a.r - &b.r).amax() < 1e-6 * a.r.amax(),
+        "{} vs {}",
+        a.r,
+        b.r
+    );
 }
