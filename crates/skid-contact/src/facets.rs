@@ -46,9 +46,15 @@ pub struct FacetedCylinder {
     first_vertex_angle: f64,
     apothem: f64,
     length: f64,
+    /// Per vertex `k`, the unit direction `(cos phi_k, sin phi_k)` (the sines and cosines of
+    /// the vertex angles, evaluated once here instead of at every projection).
+    directions: Vec<Vector2<f64>>,
+    /// Per facet `k`, its start vertex, tangent and normal.
+    facet_table: Vec<Facet>,
 }
 
 /// One facet in in-plane coordinates.
+#[derive(Clone, Debug)]
 struct Facet {
     start: Vector2<f64>,
     tangent: Vector2<f64>,
@@ -80,6 +86,23 @@ impl FacetedCylinder {
         }
         let circle = AnalyticCylinder::new(radius, axis)?;
         let half_angle = PI / facets as f64;
+        let vertex_angle = |k: usize| first_vertex_angle + TAU * k as f64 / facets as f64;
+        let directions: Vec<Vector2<f64>> = (0..facets)
+            .map(|k| {
+                let (sin, cos) = vertex_angle(k).sin_cos();
+                Vector2::new(cos, sin)
+            })
+            .collect();
+        let facet_table = (0..facets)
+            .map(|k| {
+                let (sin, cos) = (vertex_angle(k) + half_angle).sin_cos();
+                Facet {
+                    start: directions[k] * radius,
+                    tangent: Vector2::new(-sin, cos),
+                    normal: Vector2::new(cos, sin),
+                }
+            })
+            .collect();
         Ok(Self {
             radius,
             axis: circle.axis(),
@@ -89,6 +112,8 @@ impl FacetedCylinder {
             first_vertex_angle,
             apothem: radius * half_angle.cos(),
             length: 2.0 * radius * half_angle.sin(),
+            directions,
+            facet_table,
         })
     }
 
@@ -123,22 +148,8 @@ impl FacetedCylinder {
         self.lift(&self.vertex_2d(k % self.facets))
     }
 
-    fn vertex_angle(&self, k: usize) -> f64 {
-        self.first_vertex_angle + TAU * k as f64 / self.facets as f64
-    }
-
     fn vertex_2d(&self, k: usize) -> Vector2<f64> {
-        let (sin, cos) = self.vertex_angle(k).sin_cos();
-        Vector2::new(cos, sin) * self.radius
-    }
-
-    fn facet(&self, k: usize) -> Facet {
-        let (sin, cos) = (self.vertex_angle(k) + PI / self.facets as f64).sin_cos();
-        Facet {
-            start: self.vertex_2d(k),
-            tangent: Vector2::new(-sin, cos),
-            normal: Vector2::new(cos, sin),
-        }
+        self.directions[k] * self.radius
     }
 
     fn lift(&self, v: &Vector2<f64>) -> Vector3<f64> {
@@ -170,14 +181,14 @@ impl RigidSurface for FacetedCylinder {
         let sector = self.sector(&q);
         // the sector facet and its neighbours, in case round-off picked the wrong sector
         let candidates = [(sector + n - 1) % n, sector, (sector + 1) % n].map(|k| {
-            let facet = self.facet(k);
+            let facet = &self.facet_table[k];
             let plane_gap = facet.normal.dot(&q) - self.apothem;
             let xi = (q - facet.start).dot(&facet.tangent) / self.length;
             (k, facet, plane_gap, xi)
         });
         let tiny = 64.0 * f64::EPSILON * (self.radius + q.norm());
         // (g, dg/dy, d^2g/dy^2, xi_0, d xi_0/dy) with facet k as the closest feature
-        let on_facet = |(k, facet, plane_gap, xi): &(usize, Facet, f64, f64)| {
+        let on_facet = |(k, facet, plane_gap, xi): &(usize, &Facet, f64, f64)| {
             (
                 *plane_gap,
                 self.lift(&facet.normal),
@@ -211,8 +222,7 @@ impl RigidSurface for FacetedCylinder {
                     - direction * direction.transpose();
                 (direction, across / distance)
             } else {
-                let (sin, cos) = self.vertex_angle(j).sin_cos();
-                (self.lift(&Vector2::new(cos, sin)), Matrix3::zeros())
+                (self.lift(&self.directions[j]), Matrix3::zeros())
             };
             (
                 distance,
@@ -287,6 +297,23 @@ pub(crate) mod tests {
 
     fn polar(radius: f64, angle: f64, z: f64) -> Vector3<f64> {
         Vector3::new(radius * angle.cos(), radius * angle.sin(), z)
+    }
+
+    /// The tables hold exactly the sines and cosines of the vertex and facet-normal angles.
+    #[test]
+    fn tables_hold_the_vertex_and_normal_angles() {
+        let (n, phi0) = (72, 0.013);
+        let drum = FacetedCylinder::new(R, Vector3::z(), n, phi0).expect("drum");
+        for k in 0..n {
+            let angle = phi0 + TAU * k as f64 / n as f64;
+            let (sin, cos) = angle.sin_cos();
+            assert_eq!(drum.directions[k], Vector2::new(cos, sin));
+            let facet = &drum.facet_table[k];
+            assert_eq!(facet.start, Vector2::new(cos, sin) * R);
+            let (sin, cos) = (angle + PI / n as f64).sin_cos();
+            assert_eq!(facet.normal, Vector2::new(cos, sin));
+            assert_eq!(facet.tangent, Vector2::new(-sin, cos));
+        }
     }
 
     #[test]
