@@ -34,8 +34,9 @@ pub struct ContactRows {
     pub mu: Vec<f64>,
     /// Per row, the second derivatives of its `u` in the candidate's local coordinates
     /// `z = (node position [D], body translation [D], body angle)` (see [`contact_coordinates`]),
-    /// a symmetric `(2D + 1)^2` matrix.
-    pub curvature: Vec<DMatrix<f64>>,
+    /// a symmetric `(2D + 1)^2` matrix: row `k`'s entries, column-major, at
+    /// `k (2D + 1)^2..(k + 1) (2D + 1)^2`, one allocation for all rows.
+    pub curvature: Vec<f64>,
 }
 
 impl ContactRows {
@@ -68,11 +69,30 @@ impl ContactRows {
     /// `r_N / rho`). `None` for a candidate without force.
     pub fn curvature_stiffness(&self, c: usize, r: &DVector<f64>) -> Option<DMatrix<f64>> {
         let d = self.components;
-        let forces = (c * d..(c + 1) * d).map(|row| (row, r.get(row).copied().unwrap_or(0.0)));
-        forces
-            .filter(|&(_, force)| force != 0.0)
-            .map(|(row, force)| &self.curvature[row] * -force)
-            .reduce(|k, term| k + term)
+        let size = 2 * d + 1;
+        let mut stiffness: Option<DMatrix<f64>> = None;
+        for row in c * d..(c + 1) * d {
+            let force = r.get(row).copied().unwrap_or(0.0);
+            if force == 0.0 {
+                continue;
+            }
+            let curvature = &self.curvature[row * size * size..(row + 1) * size * size];
+            match stiffness.as_mut() {
+                None => {
+                    stiffness = Some(DMatrix::from_iterator(
+                        size,
+                        size,
+                        curvature.iter().map(|&v| v * -force),
+                    ));
+                }
+                Some(k) => {
+                    for (k, &v) in k.as_mut_slice().iter_mut().zip(curvature) {
+                        *k += v * -force;
+                    }
+                }
+            }
+        }
+        stiffness
     }
 
     /// `H dx`.
@@ -206,15 +226,17 @@ pub fn contact_rows<const D: usize>(
 ) -> Result<ContactRows, IncrementFailure> {
     let components = D;
     let dofs = model.dofs();
+    let candidates: usize = model.contacts().iter().map(|pair| pair.nodes.len()).sum();
+    let size = 2 * D + 1;
     let mut out = ContactRows {
         components,
-        rows: Vec::new(),
+        rows: Vec::with_capacity(candidates * D),
         u: DVector::zeros(0),
-        coords: Vec::new(),
-        mu: Vec::new(),
-        curvature: Vec::new(),
+        coords: Vec::with_capacity(candidates),
+        mu: Vec::with_capacity(candidates),
+        curvature: Vec::with_capacity(candidates * D * size * size),
     };
-    let mut u = Vec::new();
+    let mut u = Vec::with_capacity(candidates * D);
     let mut k = 0;
     for (p, pair) in model.contacts().iter().enumerate() {
         let body = &model.bodies()[pair.body];
@@ -270,7 +292,7 @@ pub fn contact_rows<const D: usize>(
                 }
                 add(dofs.body_rotation(pair.body), kin.d_dangle[comp]);
                 out.rows.push(row);
-                out.curvature.push(local_curvature::<D>(&kin, comp));
+                push_local_curvature::<D>(&kin, comp, &mut out.curvature);
                 u.push(if comp == 0 { kin.gap } else { slip[comp - 1] });
             }
             out.coords.push(kin.coords);
@@ -300,20 +322,30 @@ pub fn contact_coordinates<const D: usize>(
 }
 
 /// Second derivatives of component `comp` of `u` in the local coordinates of
-/// [`contact_coordinates`]. The node position `x` and the body translation `c` enter only as
-/// `x - c`, so with `A = d^2u/dx^2`, `b = d^2u/dx dtheta` and `s = d^2u/dtheta^2`:
-/// `[[A, -A, b], [-A, A, -b], [b^T, -b^T, s]]`.
-fn local_curvature<const D: usize>(kin: &ContactKinematics, comp: usize) -> DMatrix<f64> {
+/// [`contact_coordinates`], appended to `out` column by column. The node position `x` and the
+/// body translation `c` enter only as `x - c`, so with `A = d^2u/dx^2`, `b = d^2u/dx dtheta` and
+/// `s = d^2u/dtheta^2`: `[[A, -A, b], [-A, A, -b], [b^T, -b^T, s]]`.
+fn push_local_curvature<const D: usize>(kin: &ContactKinematics, comp: usize, out: &mut Vec<f64>) {
     let a = &kin.d2_dx2[comp];
     let b = &kin.d2_dx_dangle[comp];
     let m = 2 * D + 1;
-    let sign = |i: usize| if i < D { 1.0 } else { -1.0 };
-    DMatrix::from_fn(m, m, |i, j| match (i, j) {
-        (i, j) if i == 2 * D && j == 2 * D => kin.d2_dangle2[comp],
-        (i, j) if i == 2 * D => sign(j) * b[j % D],
-        (i, j) if j == 2 * D => sign(i) * b[i % D],
-        (i, j) => sign(i) * sign(j) * a[(i % D, j % D)],
-    })
+    let start = out.len();
+    out.resize(start + m * m, 0.0);
+    let block = &mut out[start..];
+    for j in 0..D {
+        for i in 0..D {
+            let v = a[(i, j)];
+            block[j * m + i] = v;
+            block[j * m + i + D] = -v;
+            block[(j + D) * m + i] = -v;
+            block[(j + D) * m + i + D] = v;
+        }
+        block[2 * D * m + j] = b[j];
+        block[2 * D * m + j + D] = -b[j];
+        block[j * m + 2 * D] = b[j];
+        block[(j + D) * m + 2 * D] = -b[j];
+    }
+    block[2 * D * m + 2 * D] = kin.d2_dangle2[comp];
 }
 
 #[cfg(test)]
@@ -357,6 +389,56 @@ mod tests {
                 .iter()
                 .all(|r| r.iter().all(|(eq, _)| !drum_eqs.contains(eq)))
         );
+    }
+
+    /// Each row's stored curvature is the symmetric `[[A, -A, b], [-A, A, -b], [b^T, -b^T, s]]`
+    /// of its kinematics, and a candidate's stiffness is `-sum_k r_k` of its rows' blocks.
+    fn curvature_blocks_have_the_documented_form<const D: usize>() {
+        let model = block_on_drum::<D>();
+        let n = model.dofs().len();
+        let x = DVector::from_fn(n, |i, _| 1e-3 * ((i as f64 * 1.3).sin() - 0.5));
+        let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
+        let rows = contact_rows(&model, &x, None, &start, &vec![false; n]).expect("rows");
+        let m = 2 * D + 1;
+        assert_eq!(rows.curvature.len(), rows.rows.len() * m * m);
+        let block =
+            |k: usize| DMatrix::from_column_slice(m, m, &rows.curvature[k * m * m..][..m * m]);
+        let mut curved = 0;
+        for k in 0..rows.rows.len() {
+            let b = block(k);
+            // A = Q F Q^T is symmetric to round-off
+            assert!(
+                (&b - b.transpose()).amax() <= 1e-14 * b.amax(),
+                "{D}D row {k}: {b}"
+            );
+            for i in 0..D {
+                for j in 0..D {
+                    assert_eq!(b[(i, j + D)], -b[(i, j)]);
+                    assert_eq!(b[(i + D, j + D)], b[(i, j)]);
+                }
+                assert_eq!(b[(i + D, 2 * D)], -b[(i, 2 * D)]);
+            }
+            curved += usize::from(b.amax() > 0.0);
+        }
+        assert!(curved > 0, "{D}D: no curvature at all");
+        let r = DVector::from_fn(rows.rows.len(), |k, _| 1.0 + k as f64);
+        for c in 0..rows.len() {
+            let expected =
+                (c * D..(c + 1) * D).fold(DMatrix::zeros(m, m), |sum, k| sum - block(k) * r[k]);
+            let stiffness = rows.curvature_stiffness(c, &r).expect("forces");
+            assert!((stiffness - &expected).amax() <= 1e-12 * expected.amax());
+        }
+        assert!(rows.curvature_stiffness(0, &(r * 0.0)).is_none());
+    }
+
+    #[test]
+    fn curvature_blocks_have_the_documented_form_2d() {
+        curvature_blocks_have_the_documented_form::<2>();
+    }
+
+    #[test]
+    fn curvature_blocks_have_the_documented_form_3d() {
+        curvature_blocks_have_the_documented_form::<3>();
     }
 
     #[test]
