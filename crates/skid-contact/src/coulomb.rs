@@ -40,7 +40,9 @@ use cone::{project_onto_friction_cone, tangential_norm};
 use conic_program::ConicProgram;
 use newton::newton;
 use polish::{Candidate, polish};
-use validation::{check_forces, check_problem, check_settings, check_shape, check_shift};
+use validation::{
+    check_forces, check_problem, check_settings, check_shape, check_shift, exactly_symmetric,
+};
 
 /// Tolerances and iteration limits of [`solve_coulomb`].
 #[derive(Clone, Debug)]
@@ -155,7 +157,7 @@ pub fn solve_coulomb(
     initial_forces: Option<&DVector<f64>>,
 ) -> Result<CoulombSolution, ContactError> {
     check_settings(settings)?;
-    check_problem(problem)?;
+    let symmetric = check_problem(problem)?;
     if let Some(forces) = initial_forces {
         check_forces(forces, problem.q.len())?;
     }
@@ -165,7 +167,7 @@ pub fn solve_coulomb(
     {
         return solve_fixed_point(problem, settings, None, true);
     }
-    let w = symmetric_part(problem.w);
+    let w = symmetric_part(problem.w, symmetric);
     let start = initial_forces.map_or_else(|| DVector::zeros(problem.q.len()), Clone::clone);
     let (candidate, newton_steps) = newton(
         problem,
@@ -221,7 +223,7 @@ fn solve_fixed_point(
         });
     }
 
-    let w = symmetric_part(problem.w);
+    let w = symmetric_part(problem.w, exactly_symmetric(problem.w));
     // positive: some q_N < 0, and the diagonal of W was checked positive
     let length_scale = q.amax();
     let compliance_scale = w.diagonal().mean();
@@ -401,21 +403,21 @@ fn inverse_mean_compliance(problem: &FrictionProblem, i: usize) -> f64 {
 }
 
 /// The symmetric part `(W + W^T) / 2`: `W` itself, borrowed, where it already equals its
-/// transpose (as the Delassus operators of the integrator do), a symmetrised copy otherwise.
-fn symmetric_part(w: &DMatrix<f64>) -> Cow<'_, DMatrix<f64>> {
-    let symmetric = (0..w.ncols()).all(|j| (j + 1..w.nrows()).all(|i| w[(i, j)] == w[(j, i)]));
+/// transpose (`symmetric`, as [`exactly_symmetric`] finds for the Delassus operators of the
+/// integrator), a symmetrised copy otherwise.
+fn symmetric_part(w: &DMatrix<f64>, symmetric: bool) -> Cow<'_, DMatrix<f64>> {
     if symmetric {
         return Cow::Borrowed(w);
     }
-    let mut symmetric = w.clone();
+    let mut symmetrised = w.clone();
     for j in 0..w.ncols() {
         for i in j + 1..w.nrows() {
             let mean = 0.5 * (w[(i, j)] + w[(j, i)]);
-            symmetric[(i, j)] = mean;
-            symmetric[(j, i)] = mean;
+            symmetrised[(i, j)] = mean;
+            symmetrised[(j, i)] = mean;
         }
     }
-    Cow::Owned(symmetric)
+    Cow::Owned(symmetrised)
 }
 
 /// Shift `s_i = mu_i ||u_T,i||` of each contact.
