@@ -32,11 +32,17 @@ impl RotatingFrame {
     /// The unit axis `e` and the rotation `Q(theta)`; `None` if the frame is degenerate (zero or
     /// non-finite axis, non-finite centre or angle).
     fn orientation(&self) -> Option<(Unit<Vector3<f64>>, Rotation3<f64>)> {
+        let axis = self.unit_axis()?;
+        Some((axis, Rotation3::from_axis_angle(&axis, self.angle)))
+    }
+
+    /// The unit axis `e` alone, without the rotation (whose sine and cosine cost more than the
+    /// rest); `None` where [`Self::orientation`] is.
+    fn unit_axis(&self) -> Option<Unit<Vector3<f64>>> {
         if !(self.angle.is_finite() && self.center.iter().all(|c| c.is_finite())) {
             return None;
         }
-        let axis = Unit::try_new(self.axis, 0.0).filter(|a| a.iter().all(|c| c.is_finite()))?;
-        Some((axis, Rotation3::from_axis_angle(&axis, self.angle)))
+        Unit::try_new(self.axis, 0.0).filter(|a| a.iter().all(|c| c.is_finite()))
     }
 
     /// The world position `x = c + Q(theta) y` of the body-frame point `y`; `None` if the frame
@@ -207,7 +213,7 @@ pub fn rotation_column(
     if !(turn.abs() >= MIN_SECANT_TURN && turn.is_finite()) {
         return None;
     }
-    let (axis, rotation) = frame.orientation()?;
+    let axis = frame.unit_axis()?;
     let start_rotation = Rotation3::from_axis_angle(&axis, start.angle);
     let before = surface.project(&start_rotation.inverse_transform_vector(&start.offset))?;
     let change = |gap: f64, coords: &Vector2<f64>| {
@@ -221,6 +227,7 @@ pub fn rotation_column(
     if column.iter().all(|c| c.abs() <= bound) {
         return Some(column);
     }
+    let rotation = Rotation3::from_axis_angle(&axis, frame.angle);
     let turned = surface.project(&rotation.inverse_transform_vector(&start.offset))?;
     let secant = change(turned.gap, &turned.coords).map(|d| d / turn);
     secant.iter().all(|c| c.is_finite()).then_some(secant)
