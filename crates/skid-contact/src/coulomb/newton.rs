@@ -172,14 +172,14 @@ fn newton_step(
             .map(|(&row, c)| -phi[row] - c),
     );
     let par = Par::Seq;
-    let mut stack = MemStack::new(scratch);
+    let stack = MemStack::new(scratch);
     let lu = MatMut::from_column_major_slice_mut(block.as_mut_slice(), n, n);
     let (_, permutation) = factor::lu_in_place(
         lu,
         &mut forward[..n],
         &mut inverse[..n],
         par,
-        &mut stack,
+        stack,
         Default::default(),
     );
     // the factors share the block: L strictly below the diagonal (unit diagonal), U on and
@@ -192,7 +192,7 @@ fn newton_step(
         Conj::No,
         MatMut::from_column_major_slice_mut(rhs.as_mut_slice(), n, 1),
         par,
-        &mut stack,
+        stack,
     );
     for (&row, &value) in rows.iter().zip(rhs.iter()) {
         step[row] = value;
