@@ -171,10 +171,11 @@ impl ContactRows {
         starts.push(local.len());
         let row = |a: usize| &local[starts[a]..starts[a + 1]];
         let inverse = factor.trailing_inverse();
-        // G = (K^-1)_CC H_C^T, column by column
+        // G = (K^-1)_CC H_C^T, column by column (with no trailing equation G has no rows:
+        // the chunk length is kept positive and the empty slice yields no column)
         let size = inverse.nrows();
         let mut g = DMatrix::<f64>::zeros(size, m);
-        for (j, column) in g.as_mut_slice().chunks_exact_mut(size).enumerate() {
+        for (j, column) in g.as_mut_slice().chunks_exact_mut(size.max(1)).enumerate() {
             for &(k, c) in row(j) {
                 let source = &inverse.as_slice()[k * size..(k + 1) * size];
                 for (target, &value) in column.iter_mut().zip(source) {
