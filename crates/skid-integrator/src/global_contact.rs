@@ -277,10 +277,9 @@ impl Default for GlobalContactSolver {
 /// (factors that have stopped serving are not tried again before the next factorization, so
 /// they are left out). Rebuilt from the matrix it factorized, the factors are the same bits
 /// (the factorization is deterministic at one thread), so a run continued from a checkpoint
-/// takes the same path. The
-/// quasi-definite factors are not carried: a checkpoint ends their reuse (see
-/// [`GlobalContactSolver::forget_preconditioner`]), since on a system of 1e5 equations its
-/// matrix alone would make a restart file of 130 MB.
+/// takes the same path. The quasi-definite factors are not carried: a checkpoint ends their
+/// reuse (see [`GlobalContactSolver::forget_preconditioner`]), since on a system of 1e5
+/// equations its matrix alone would make a restart file of 130 MB.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct GlobalSolverMemory {
     /// The factorized matrix, if any: its dimension, the entries `(row, column)` of its pattern
