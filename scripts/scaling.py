@@ -159,8 +159,12 @@ def main():
     study = {"case": str(CASE.relative_to(ROOT)), "dt": DT, "threads": args.threads,
              "dynamic_increments": DYNAMIC_INCREMENTS, "records": records}
     (out / "scaling.json").write_text(json.dumps(study, indent=2) + "\n")
-    report = subprocess.run([str(SKID), "report", "--scaling", str(out / "scaling.json"),
-                             "--out", str(out / "scaling.md")])
+    # the report names the paths it is given: relative to the repository where they lie in it
+    full = out.resolve()
+    shown = Path(os.path.relpath(full, ROOT)) if full.is_relative_to(ROOT) else full
+    report = subprocess.run([str(SKID.resolve()), "report", "--scaling",
+                             str(shown / "scaling.json"), "--out", str(shown / "scaling.md")],
+                            cwd=ROOT)
     if report.returncode != 0:
         return report.returncode
     return 0 if all(r.get("status") == "completed" for r in records) else 1
