@@ -82,7 +82,7 @@ use crate::krylov::{self, gmres};
 use crate::model::Model;
 use crate::ordering::global_system_order;
 use crate::quasi_definite::{Precision, QuasiDefinite};
-use crate::sparse::column_mut;
+use crate::sparse::{column_mut, symmetric_times};
 use system::{Approximation, LinearSystem};
 
 mod system;
@@ -100,6 +100,8 @@ const KRYLOV_TOLERANCE: f64 = 1e-12;
 /// 76, 78) and histories equal to 2e-8 relative; over 4 ms with factors reused, 1e-6 took 9.5
 /// iterations per system and 1e-4 7.0, with 123 and 124 Newton iterations.
 const INEXACT_TOLERANCE: f64 = 1e-4;
+/// Halvings of a step of [`GlobalContactSolver::linearised_solution`] in its line search.
+const LINE_SEARCH_HALVINGS: usize = 10;
 /// GMRES iterations on an earlier factorization before the next preconditioner is tried.
 const KRYLOV_MAX_ITERATIONS: usize = 8;
 /// Systems of at least this many equations try the quasi-definite preconditioner before an LU
@@ -116,11 +118,11 @@ const QUASI_DEFINITE_MAX_ITERATIONS: usize = 30;
 /// memory of a short run of the 3D pad, the LU taken in the static preload: 1.8 GB at 21,000
 /// unknowns, 8.2 GB at 54,000, 20.7 GB at 108,000). GMRES on this system's quasi-definite
 /// factors gets [`WITHOUT_LU_MAX_ITERATIONS`] instead, and a system it does not solve fails
-/// the Newton iteration (the increment is then solved by the reduced path, or cut back). Below
-/// it the LU stays: reused as GMRES's preconditioner over later iterations and increments, it
-/// took a dynamic increment of 54,000 unknowns 1.0 s, against 8.5 s on fresh quasi-definite
-/// factors.
-const LU_UNTIL: usize = 60_000;
+/// the Newton iteration (the increment is then solved by the reduced path, or cut back). Nor
+/// does the LU pay where it fits: at 49,574 unknowns (pad 80 x 12 x 16 on the analytical drum,
+/// one thread) a dynamic increment takes 0.92 s either way, and the static preload 205 s with
+/// four LU factorizations against 56 s without (two of its increments on the reduced path).
+const LU_UNTIL: usize = 20_000;
 /// GMRES iterations on the quasi-definite preconditioner of this system's `S` for systems that
 /// are not LU-factorized.
 const WITHOUT_LU_MAX_ITERATIONS: usize = 200;
@@ -413,6 +415,87 @@ impl GlobalContactSolver {
         });
         if dx.iter().chain(forces.iter()).any(|v| !v.is_finite()) {
             return Err(IncrementFailure::linear(SYSTEM, LinearFailure::Singular));
+        }
+        Ok(GlobalStep { dx, r: forces })
+    }
+
+    /// Solves the contact problem of one linearisation, as the reduced path does: semismooth
+    /// Newton steps of [`GlobalContactSolver::step`] on the system with `K` and `H` fixed,
+    /// each from the linearised state `R + K dx`, `u + H dx` of the steps so far, until the
+    /// law holds there (`max_c ||Phi_c|| / rho_c`, see [`law_residual`]) to `tolerance`, or
+    /// for `max_steps`. Only the candidates' branches change from one step to the next, so the
+    /// step's preconditioner mostly serves again. Its result is the sum of the steps and the
+    /// last forces.
+    ///
+    /// # Errors
+    /// As [`GlobalContactSolver::step`].
+    #[allow(clippy::too_many_arguments)] // step's inputs and the inner iteration's limits
+    pub fn linearised_solution<const D: usize>(
+        &mut self,
+        model: &Model<D>,
+        k: SparseColMatRef<'_, usize, f64>,
+        rows: &ContactRows,
+        residual: &DVector<f64>,
+        r: &DVector<f64>,
+        rho: &[f64],
+        held: &[bool],
+        (tolerance, max_steps): (f64, usize),
+    ) -> Result<GlobalStep, IncrementFailure> {
+        let n = residual.len();
+        // the merit 0.5 ||F||^2 of the linearised problem, each row a length: the balance
+        // rows g = R + K dx - H^T r over K's diagonal, the law rows Phi_c / rho_c
+        let diagonal: Vec<f64> = (0..n)
+            .map(|j| {
+                let rows_of_j = k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j));
+                let entry = rows_of_j.filter(|(i, _)| **i == j).map(|(_, v)| *v).next();
+                entry.filter(|v| v.abs() > 0.0).map_or(1.0, f64::abs)
+            })
+            .collect();
+        let merit = |balance: &DVector<f64>, linear: &ContactRows, forces: &DVector<f64>| {
+            let g: f64 = balance
+                .iter()
+                .zip(&diagonal)
+                .map(|(g, d)| (g / d).powi(2))
+                .sum();
+            0.5 * (g + law_residuals(linear, forces, rho)
+                .map(|l| l * l)
+                .sum::<f64>())
+        };
+        let mut linear = rows.clone();
+        let mut dx = DVector::zeros(n);
+        let mut forces = r.clone();
+        let mut linear_residual = residual.clone();
+        let mut balance = residual - rows.transpose_times(&forces, n);
+        let mut current = merit(&balance, &linear, &forces);
+        let mut k_step = DVector::zeros(n);
+        for _ in 0..max_steps {
+            let step = self.step(model, k, &linear, &linear_residual, &forces, rho, held)?;
+            let u = linear.u.clone();
+            let du = rows.times(&step.dx);
+            let dr = &step.r - &forces;
+            // the balance rows are linear: g(t) = g + t (K ddx - H^T dr)
+            symmetric_times(k, step.dx.as_slice(), k_step.as_mut_slice());
+            let dg = &k_step - rows.transpose_times(&dr, n);
+            // backtracking (Armijo) on the merit
+            let (mut t, mut halvings) = (1.0, 0);
+            loop {
+                linear.u = &u + &du * t;
+                let value = merit(&(&balance + &dg * t), &linear, &(&forces + &dr * t));
+                if value <= (1.0 - 1e-4 * t) * current || halvings == LINE_SEARCH_HALVINGS {
+                    current = value;
+                    break;
+                }
+                t *= 0.5;
+                halvings += 1;
+            }
+            dx.axpy(t, &step.dx, 1.0);
+            forces.axpy(t, &dr, 1.0);
+            balance.axpy(t, &dg, 1.0);
+            symmetric_times(k, dx.as_slice(), linear_residual.as_mut_slice());
+            linear_residual += residual;
+            if law_residual(&linear, &forces, rho) <= tolerance {
+                break;
+            }
         }
         Ok(GlobalStep { dx, r: forces })
     }
@@ -947,6 +1030,62 @@ mod tests {
                 .all(|w| w[1] <= 10.0 * (w[0] * w[0] + INEXACT_TOLERANCE * w[0]) + 1e-14),
             "{D}D: {sizes:?}"
         );
+    }
+
+    /// [`GlobalContactSolver::linearised_solution`] solves the contact problem of one
+    /// linearisation in one call: the reduced path's forces and step to 1e-8, the law
+    /// holding at the linearised kinematics to its tolerance; given a single step, it is one
+    /// step of [`GlobalContactSolver::step`] (which leaves the law unsatisfied).
+    fn linearised_solution_is_the_reduced_step<const D: usize>() {
+        let (model, mut assembler, rows, residual, held) = pressed_block::<D>();
+        let warm = DVector::zeros(rows.rows.len());
+        let (dx_reduced, reduced, _) = contact_step(
+            &mut assembler,
+            &rows,
+            &residual,
+            &warm,
+            1e3,
+            1e-9 * 1e3,
+            &CoulombSettings::default(),
+            None,
+            &mut Timings::default(),
+        )
+        .expect("reduced");
+        let k = assembler.lower_triangle().expect("lower");
+        let rho = contact_weights(k, &rows);
+        let law_after = |step: &GlobalStep| {
+            let mut linear = rows.clone();
+            linear.u = &rows.u + rows.times(&step.dx);
+            law_residual(&linear, &step.r, &rho)
+        };
+        let mut solver = GlobalContactSolver::default();
+        let solved = solver
+            .linearised_solution(&model, k, &rows, &residual, &warm, &rho, &held, (1e-12, 30))
+            .expect("linearised solution");
+        assert!(law_after(&solved) <= 1e-12, "{D}D: {}", law_after(&solved));
+        assert!(
+            (&solved.r - &reduced.r).amax() <= 1e-8 * reduced.r.amax(),
+            "{D}D"
+        );
+        assert!(
+            (&solved.dx - &dx_reduced).amax() <= 1e-8 * dx_reduced.amax(),
+            "{D}D"
+        );
+
+        let one = GlobalContactSolver::default()
+            .linearised_solution(&model, k, &rows, &residual, &warm, &rho, &held, (0.0, 1))
+            .expect("one step");
+        let step = GlobalContactSolver::default()
+            .step(&model, k, &rows, &residual, &warm, &rho, &held)
+            .expect("global step");
+        assert_eq!((&one.dx, &one.r), (&step.dx, &step.r), "{D}D");
+        assert!(law_after(&one) > 1e-6, "{D}D: {}", law_after(&one));
+    }
+
+    #[test]
+    fn linearised_solution_is_the_reduced_step_2d_and_3d() {
+        linearised_solution_is_the_reduced_step::<2>();
+        linearised_solution_is_the_reduced_step::<3>();
     }
 
     #[test]
