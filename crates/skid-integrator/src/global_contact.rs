@@ -82,7 +82,7 @@ use crate::krylov::{self, gmres};
 use crate::model::Model;
 use crate::ordering::global_system_order;
 use crate::quasi_definite::{Precision, QuasiDefinite};
-use crate::sparse::{column_mut, symmetric_times};
+use crate::sparse::{column_mut, diagonal, symmetric_times};
 use system::{Approximation, LinearSystem};
 
 mod system;
@@ -444,12 +444,9 @@ impl GlobalContactSolver {
         let n = residual.len();
         // the merit 0.5 ||F||^2 of the linearised problem, each row a length: the balance
         // rows g = R + K dx - H^T r over K's diagonal, the law rows Phi_c / rho_c
-        let diagonal: Vec<f64> = (0..n)
-            .map(|j| {
-                let rows_of_j = k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j));
-                let entry = rows_of_j.filter(|(i, _)| **i == j).map(|(_, v)| *v).next();
-                entry.filter(|v| v.abs() > 0.0).map_or(1.0, f64::abs)
-            })
+        let diagonal: Vec<f64> = diagonal(k)
+            .into_iter()
+            .map(|v| if v != 0.0 { v.abs() } else { 1.0 })
             .collect();
         let merit = |balance: &DVector<f64>, linear: &ContactRows, forces: &DVector<f64>| {
             let g: f64 = balance
@@ -813,14 +810,7 @@ fn reuse_budget(switched: usize, cost: f64, fresh: usize) -> Option<usize> {
 /// triangle) were diagonal. A candidate whose rows involve no equation gets the mean weight of
 /// the others (1 if there are none).
 pub fn contact_weights(k: SparseColMatRef<'_, usize, f64>, rows: &ContactRows) -> Vec<f64> {
-    let mut diagonal = vec![0.0; k.ncols()];
-    for (j, entry) in diagonal.iter_mut().enumerate() {
-        for (&i, &v) in k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
-            if i == j {
-                *entry += v;
-            }
-        }
-    }
+    let diagonal = diagonal(k);
     let d = rows.components;
     let compliance: Vec<f64> = (0..rows.len())
         .map(|c| {

@@ -38,6 +38,17 @@ pub(crate) fn column_mut(v: &mut DVector<f64>) -> MatMut<'_, f64> {
     MatMut::from_column_major_slice_mut(v.as_mut_slice(), n, 1)
 }
 
+/// The diagonal `K_jj` of a matrix given by its lower triangle `lower` (duplicate entries
+/// summed).
+pub(crate) fn diagonal(lower: SparseColMatRef<'_, usize, f64>) -> Vec<f64> {
+    (0..lower.ncols())
+        .map(|j| {
+            let column = lower.row_idx_of_col_raw(j).iter().zip(lower.val_of_col(j));
+            column.filter(|(i, _)| **i == j).map(|(_, v)| v).sum()
+        })
+        .collect()
+}
+
 /// `out = K x` for a symmetric `K` given by its lower triangle `lower` (an entry above the
 /// diagonal would be counted twice, so there must be none).
 pub(crate) fn symmetric_times(lower: SparseColMatRef<'_, usize, f64>, x: &[f64], out: &mut [f64]) {
