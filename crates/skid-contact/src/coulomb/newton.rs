@@ -281,32 +281,45 @@ pub(crate) fn newton(
 mod tests {
     use super::*;
 
+    /// Four contacts, one on each branch (open, stick, slide, frictionless), built by choosing
+    /// `r` and `u` and setting `q = u - W r`, with `W = B B^T / m + I / 2` and `B_ij = b(i, j)`.
+    struct OneContactPerBranch {
+        w: DMatrix<f64>,
+        q: DVector<f64>,
+        r: DVector<f64>,
+        u: DVector<f64>,
+        mu: [f64; 4],
+    }
+
+    fn one_contact_per_branch(dim: usize, b: impl Fn(usize, usize) -> f64) -> OneContactPerBranch {
+        let m = dim * 4;
+        let b = DMatrix::from_fn(m, m, b);
+        let w = &b * b.transpose() / m as f64 + DMatrix::identity(m, m) * 0.5;
+        let blocks = [
+            ([0.1, 0.05, 0.02], [1.0, 0.3, 0.1]),
+            ([1.0, 0.1, 0.05], [0.0, 0.01, 0.0]),
+            ([1.0, 0.2, -0.3], [0.01, 1.5, 0.8]),
+            ([1.0, 0.1, 0.2], [0.05, 0.3, 0.1]),
+        ];
+        let r = DVector::from_fn(m, |k, _| blocks[k / dim].0[k % dim]);
+        let u = DVector::from_fn(m, |k, _| blocks[k / dim].1[k % dim]);
+        let q = &u - &w * &r;
+        OneContactPerBranch {
+            w,
+            q,
+            r,
+            u,
+            mu: [0.3, 0.3, 0.3, 0.0],
+        }
+    }
+
     /// Away from the branch switches the generalized Jacobian is the derivative of `Phi`:
-    /// central differences on a problem with one contact on each branch (open, stick, slide,
-    /// frictionless), built by choosing `r` and `u` and setting `q = u - W r`.
+    /// central differences on [`one_contact_per_branch`].
     fn jacobian_matches_finite_differences(dim: usize) {
         let n = 4;
         let m = dim * n;
-        let b = DMatrix::from_fn(m, m, |i, j| ((i * 7 + j * 3) as f64 * 0.37).sin());
-        let w = &b * b.transpose() / m as f64 + DMatrix::identity(m, m) * 0.5;
-        let mu = [0.3, 0.3, 0.3, 0.0];
-        let (r_blocks, u_blocks) = (
-            [
-                [0.1, 0.05, 0.02],
-                [1.0, 0.1, 0.05],
-                [1.0, 0.2, -0.3],
-                [1.0, 0.1, 0.2],
-            ],
-            [
-                [1.0, 0.3, 0.1],
-                [0.0, 0.01, 0.0],
-                [0.01, 1.5, 0.8],
-                [0.05, 0.3, 0.1],
-            ],
-        );
-        let r = DVector::from_fn(m, |k, _| r_blocks[k / dim][k % dim]);
-        let u = DVector::from_fn(m, |k, _| u_blocks[k / dim][k % dim]);
-        let q = &u - &w * &r;
+        let OneContactPerBranch { w, q, r, u, mu } =
+            one_contact_per_branch(dim, |i, j| ((i * 7 + j * 3) as f64 * 0.37).sin());
         let problem = FrictionProblem {
             dim,
             w: &w,
@@ -351,18 +364,8 @@ mod tests {
     fn newton_step_solves_the_linearisation(dim: usize) {
         let n = 4;
         let m = dim * n;
-        let b = DMatrix::from_fn(m, m, |i, j| ((i * 5 + j * 2) as f64 * 0.41).cos());
-        let w = &b * b.transpose() / m as f64 + DMatrix::identity(m, m) * 0.5;
-        let blocks = [
-            ([0.1, 0.05, 0.02], [1.0, 0.3, 0.1]),
-            ([1.0, 0.1, 0.05], [0.0, 0.01, 0.0]),
-            ([1.0, 0.2, -0.3], [0.01, 1.5, 0.8]),
-            ([1.0, 0.1, 0.2], [0.05, 0.3, 0.1]),
-        ];
-        let r = DVector::from_fn(m, |k, _| blocks[k / dim].0[k % dim]);
-        let u = DVector::from_fn(m, |k, _| blocks[k / dim].1[k % dim]);
-        let q = &u - &w * &r;
-        let mu = [0.3, 0.3, 0.3, 0.0];
+        let OneContactPerBranch { w, q, r, u, mu } =
+            one_contact_per_branch(dim, |i, j| ((i * 5 + j * 2) as f64 * 0.41).cos());
         let problem = FrictionProblem {
             dim,
             w: &w,
