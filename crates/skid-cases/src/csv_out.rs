@@ -2,63 +2,26 @@
 //!
 //! Writing ([`PartialCsv`]): a header record, then one record per call, each field as given
 //! (the caller formats the numbers), fields holding a comma, a quote or a line break quoted
-//! (RFC 4180, `\n` ending each record). The records go to `<name>.partial`, renamed to `<name>`
-//! by [`PartialCsv::finish`] ([`crate::atomic`]), so an interrupted process never leaves a file
-//! that looks complete. A restart point marks how much of the file is on disk
-//! ([`PartialCsv::mark`]: its length and hash); a resumed run reopens the file cut back to that
-//! mark ([`PartialCsv::reopen`]) and appends from there.
+//! (RFC 4180, `\n` ending each record), into an [`AppendFile`]: written as `<name>.partial`,
+//! renamed to `<name>` by [`PartialCsv::finish`], marked at restart points
+//! ([`PartialCsv::mark`]) and reopened at a mark by a resumed run ([`PartialCsv::reopen`]).
 //!
 //! Reading ([`CsvTable`]): the first record is the header, whose names are trimmed; a column is
 //! found by its name, and a record may hold fewer fields than the header (a missing field is an
 //! error only where it is read). Errors name the file, the line the record starts on, and the
 //! column.
 
-use std::fs::File;
-use std::io::{self, Read, Seek, SeekFrom, Write};
+use std::io;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use csv::StringRecord;
-use serde::{Deserialize, Serialize};
 
-use crate::atomic::partial_path;
-use crate::fingerprint::Fnv1a;
+use crate::append_file::{AppendFile, FileMark};
 
-/// How much of a [`PartialCsv`] was on disk at a restart point: its length and the hash of
-/// those bytes.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct CsvMark {
-    /// Length, bytes.
-    pub bytes: u64,
-    /// FNV-1a hash of those bytes (16 hex digits).
-    pub fnv1a: String,
-}
-
-/// The file under a [`PartialCsv`], counting and hashing what reaches it.
-struct Tracked {
-    file: File,
-    bytes: u64,
-    hash: Fnv1a,
-}
-
-impl Write for Tracked {
-    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        let n = self.file.write(buf)?;
-        self.hash.update(&buf[..n]);
-        self.bytes += n as u64;
-        Ok(n)
-    }
-
-    fn flush(&mut self) -> io::Result<()> {
-        self.file.flush()
-    }
-}
-
-/// A CSV file being written under its temporary name.
+/// A CSV file being written under its temporary name ([`AppendFile`]).
 pub struct PartialCsv {
-    writer: csv::Writer<Tracked>,
-    partial: PathBuf,
-    final_path: PathBuf,
+    writer: csv::Writer<AppendFile>,
 }
 
 impl PartialCsv {
@@ -67,69 +30,20 @@ impl PartialCsv {
     /// # Errors
     /// I/O errors.
     pub fn create(path: &Path, columns: &[&str]) -> std::io::Result<Self> {
-        let partial = partial_path(path);
-        let file = Tracked {
-            file: File::create(&partial)?,
-            bytes: 0,
-            hash: Fnv1a::default(),
-        };
-        let mut writer = csv::Writer::from_writer(file);
+        let mut writer = csv::Writer::from_writer(AppendFile::create(path)?);
         writer.write_record(columns)?;
-        Ok(Self {
-            writer,
-            partial,
-            final_path: path.to_path_buf(),
-        })
+        Ok(Self { writer })
     }
 
-    /// Reopens the file of an interrupted run at `mark`: `path` + `.partial` (or `path` itself,
-    /// renamed back, if the run was interrupted after finishing it), checked to begin with the
-    /// marked bytes and cut back to them; records are appended from there.
+    /// Reopens the file of an interrupted run at `mark` ([`AppendFile::reopen`]); records are
+    /// appended from there.
     ///
     /// # Errors
-    /// An `InvalidData` error if the file is shorter than the mark or its first bytes differ
-    /// from the marked ones; I/O errors.
-    pub fn reopen(path: &Path, mark: &CsvMark) -> io::Result<Self> {
-        let partial = partial_path(path);
-        if !partial.exists() && path.exists() {
-            std::fs::rename(path, &partial)?;
-        }
-        let mut file = File::options().read(true).write(true).open(&partial)?;
-        let mut hash = Fnv1a::default();
-        let mut buffer = vec![0; 1 << 16];
-        let mut bytes = 0;
-        let mut marked = (&mut file).take(mark.bytes);
-        loop {
-            let n = marked.read(&mut buffer)?;
-            if n == 0 {
-                break;
-            }
-            hash.update(&buffer[..n]);
-            bytes += n as u64;
-        }
-        let invalid = |what: String| {
-            io::Error::new(
-                io::ErrorKind::InvalidData,
-                format!("{}: {what}", partial.display()),
-            )
-        };
-        if bytes < mark.bytes {
-            return Err(invalid(format!(
-                "{bytes} bytes, shorter than the {} of the restart point",
-                mark.bytes
-            )));
-        }
-        if hash.hex() != mark.fnv1a {
-            return Err(invalid(
-                "its first bytes are not those written up to the restart point".into(),
-            ));
-        }
-        file.set_len(mark.bytes)?;
-        file.seek(SeekFrom::End(0))?;
+    /// As [`AppendFile::reopen`].
+    pub fn reopen(path: &Path, mark: &FileMark) -> io::Result<Self> {
+        let (file, _) = AppendFile::reopen(path, mark)?;
         Ok(Self {
-            writer: csv::Writer::from_writer(Tracked { file, bytes, hash }),
-            partial,
-            final_path: path.to_path_buf(),
+            writer: csv::Writer::from_writer(file),
         })
     }
 
@@ -138,14 +52,9 @@ impl PartialCsv {
     ///
     /// # Errors
     /// I/O errors.
-    pub fn mark(&mut self) -> io::Result<CsvMark> {
+    pub fn mark(&mut self) -> io::Result<FileMark> {
         self.writer.flush()?;
-        let tracked = self.writer.get_ref();
-        tracked.file.sync_data()?;
-        Ok(CsvMark {
-            bytes: tracked.bytes,
-            fnv1a: tracked.hash.hex(),
-        })
+        self.writer.get_ref().mark()
     }
 
     /// Writes one record, one field per column of the header.
@@ -165,9 +74,10 @@ impl PartialCsv {
     /// # Errors
     /// I/O errors.
     pub fn finish(self) -> std::io::Result<()> {
-        let file = self.writer.into_inner().map_err(|e| e.into_error())?.file;
-        file.sync_all()?;
-        std::fs::rename(&self.partial, &self.final_path)
+        self.writer
+            .into_inner()
+            .map_err(|e| e.into_error())?
+            .finish()
     }
 }
 

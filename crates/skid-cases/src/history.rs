@@ -8,15 +8,22 @@
 //! name holding a comma, a quote or a line break is quoted) to `history.csv.partial`, renamed to
 //! `history.csv` only when the run has ended (completed, or stopped with an error that the
 //! summary reports), so an interrupted process never leaves a file that looks complete.
+//!
+//! A run that writes restart files also appends each sample, as one line of JSON (numbers
+//! that read back to the same bits), to [`SAMPLES_JOURNAL`]: a restart point marks how much of
+//! it is on disk instead of holding the samples, so that writing one costs what was appended
+//! since the last, and a resumed run reads the samples back from it.
 
+use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
 use skid_integrator::Model;
 use skid_integrator::state::EnergyLedger;
 use skid_integrator::stepper::{IncrementReport, Observer};
 
+use crate::append_file::{AppendFile, FileMark};
 use crate::contact_totals::pair_totals;
-use crate::csv_out::{CsvMark, PartialCsv};
+use crate::csv_out::PartialCsv;
 use crate::schema::{BACK_PLATE, DRUM};
 
 /// Column names of `history.csv`.
@@ -67,34 +74,81 @@ pub struct Sample {
     pub sliding_separation: f64,
 }
 
+/// File name of the journal of samples beside the restart file (see the module documentation).
+pub const SAMPLES_JOURNAL: &str = "restart-samples.jsonl";
+
+/// The journal of samples of an interrupted run, reopened at a restart point's mark.
+pub struct SampleJournal {
+    file: BufWriter<AppendFile>,
+    samples: Vec<Sample>,
+}
+
+impl SampleJournal {
+    /// Reopens `dir/`[`SAMPLES_JOURNAL`] at `mark` ([`AppendFile::reopen`]) and reads its
+    /// samples back.
+    ///
+    /// # Errors
+    /// As [`AppendFile::reopen`]; an `InvalidData` error naming the line of a sample that does
+    /// not read back.
+    pub fn reopen(dir: &Path, mark: &FileMark) -> io::Result<Self> {
+        let (file, lines) = AppendFile::reopen(&dir.join(SAMPLES_JOURNAL), mark)?;
+        let samples = lines
+            .split(|&b| b == b'\n')
+            .filter(|line| !line.is_empty())
+            .enumerate()
+            .map(|(k, line)| {
+                serde_json::from_slice(line).map_err(|e| {
+                    io::Error::new(io::ErrorKind::InvalidData, format!("line {}: {e}", k + 1))
+                })
+            })
+            .collect::<io::Result<_>>()?;
+        Ok(Self {
+            file: BufWriter::new(file),
+            samples,
+        })
+    }
+}
+
 /// Observer writing `history.csv` and keeping the samples.
 pub struct DrumRecorder {
     csv: PartialCsv,
     /// Samples of all converged increments (and the initial state).
     pub samples: Vec<Sample>,
+    /// The journal of the samples, in a run that writes restart files.
+    journal: Option<BufWriter<AppendFile>>,
 }
 
 impl DrumRecorder {
-    /// Creates `dir/history.csv.partial` and writes the header.
+    /// Creates `dir/history.csv.partial` and writes the header; with `journal`, also the
+    /// journal of samples for restart points.
     ///
     /// # Errors
     /// I/O errors.
-    pub fn create(dir: &Path) -> std::io::Result<Self> {
+    pub fn create(dir: &Path, journal: bool) -> io::Result<Self> {
+        let journal = if journal {
+            Some(BufWriter::new(AppendFile::create(
+                &dir.join(SAMPLES_JOURNAL),
+            )?))
+        } else {
+            None
+        };
         Ok(Self {
             csv: PartialCsv::create(&dir.join("history.csv"), &COLUMNS)?,
             samples: Vec::new(),
+            journal,
         })
     }
 
     /// Continues the history of an interrupted run: `dir/history.csv.partial` reopened at
-    /// `mark` ([`PartialCsv::reopen`]), with the samples up to that point.
+    /// `history` ([`PartialCsv::reopen`]), with the samples of `journal`.
     ///
     /// # Errors
     /// As [`PartialCsv::reopen`].
-    pub fn reopen(dir: &Path, mark: &CsvMark, samples: Vec<Sample>) -> std::io::Result<Self> {
+    pub fn reopen(dir: &Path, history: &FileMark, journal: SampleJournal) -> io::Result<Self> {
         Ok(Self {
-            csv: PartialCsv::reopen(&dir.join("history.csv"), mark)?,
-            samples,
+            csv: PartialCsv::reopen(&dir.join("history.csv"), history)?,
+            samples: journal.samples,
+            journal: Some(journal.file),
         })
     }
 
@@ -102,16 +156,32 @@ impl DrumRecorder {
     ///
     /// # Errors
     /// I/O errors.
-    pub fn mark(&mut self) -> std::io::Result<CsvMark> {
+    pub fn mark(&mut self) -> io::Result<FileMark> {
         self.csv.mark()
     }
 
-    /// Flushes and renames the file to `history.csv`.
+    /// Flushes the journal of samples to disk and returns its mark, for a restart point.
+    ///
+    /// # Errors
+    /// I/O errors, or a recorder created without a journal.
+    pub fn journal_mark(&mut self) -> io::Result<FileMark> {
+        let journal = self
+            .journal
+            .as_mut()
+            .ok_or_else(|| io::Error::other("a restart point in a run without restart files"))?;
+        journal.flush()?;
+        journal.get_ref().mark()
+    }
+
+    /// Flushes and renames the files to their final names (`history.csv`, and the journal's).
     ///
     /// # Errors
     /// I/O errors.
-    pub fn finish(self) -> std::io::Result<Vec<Sample>> {
+    pub fn finish(self) -> io::Result<Vec<Sample>> {
         self.csv.finish()?;
+        if let Some(journal) = self.journal {
+            journal.into_inner().map_err(|e| e.into_error())?.finish()?;
+        }
         Ok(self.samples)
     }
 }
@@ -166,7 +236,7 @@ impl<const D: usize> Observer<D> for DrumRecorder {
             format!("{:.9e}", e.algorithmic_dissipation),
             format!("{:.6e}", report.size),
         ])?;
-        self.samples.push(Sample {
+        let sample = Sample {
             time: s.time,
             dynamic: report.dynamic,
             angle,
@@ -175,7 +245,12 @@ impl<const D: usize> Observer<D> for DrumRecorder {
             energy: e.clone(),
             max_penetration: penetration.max(0.0),
             sliding_separation: separation,
-        });
+        };
+        if let Some(journal) = self.journal.as_mut() {
+            serde_json::to_writer(&mut *journal, &sample)?;
+            journal.write_all(b"\n")?;
+        }
+        self.samples.push(sample);
         Ok(())
     }
 }

@@ -27,6 +27,7 @@
 //!
 //! The reports made from the runs' outputs are the crate `skid-report`'s.
 
+pub mod append_file;
 pub mod atomic;
 pub mod batch;
 pub mod check;

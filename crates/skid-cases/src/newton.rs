@@ -15,7 +15,8 @@ use std::path::Path;
 use skid_integrator::Model;
 use skid_integrator::stepper::{IncrementReport, Observer};
 
-use crate::csv_out::{CsvMark, PartialCsv};
+use crate::append_file::FileMark;
+use crate::csv_out::PartialCsv;
 
 /// File name of the Newton residual history.
 pub const NEWTON_CSV: &str = "newton.csv";
@@ -52,7 +53,7 @@ impl NewtonRecorder {
     ///
     /// # Errors
     /// As [`PartialCsv::reopen`].
-    pub fn reopen(dir: &Path, mark: &CsvMark) -> std::io::Result<Self> {
+    pub fn reopen(dir: &Path, mark: &FileMark) -> std::io::Result<Self> {
         Ok(Self {
             csv: PartialCsv::reopen(&dir.join(NEWTON_CSV), mark)?,
         })
@@ -62,7 +63,7 @@ impl NewtonRecorder {
     ///
     /// # Errors
     /// I/O errors.
-    pub fn mark(&mut self) -> std::io::Result<CsvMark> {
+    pub fn mark(&mut self) -> std::io::Result<FileMark> {
         self.csv.mark()
     }
 

@@ -9,8 +9,9 @@
 //!   next increment size, growth counter, an adaptive step's last mean acceleration), the
 //!   counters for the summary and the solver's memory (the last factorized matrix);
 //! - what the outputs hold at that point: the length and hash of `history.csv.partial` and
-//!   `newton.csv.partial` ([`CsvMark`]), the samples or record the summary is computed from,
-//!   the field frames written;
+//!   `newton.csv.partial` ([`FileMark`]), what the summary is computed from (a drum case's
+//!   samples, as the mark of their journal [`crate::history::SAMPLES_JOURNAL`], so that a
+//!   restart file does not grow with the run; a model file's record), the field frames written;
 //! - the identity of the run: the hash of the input as run (`case.json` or `model.json` in the
 //!   same directory), the skid version and the restart interval.
 //!
@@ -25,10 +26,9 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 use skid_integrator::stepper::Checkpoint;
 
+use crate::append_file::FileMark;
 use crate::atomic::write_atomic;
-use crate::csv_out::CsvMark;
 use crate::fields::FieldMemory;
-use crate::history::Sample;
 use crate::model_file::history::RunRecord;
 
 /// File name of the restart file in a run's output directory.
@@ -36,7 +36,7 @@ pub const RESTART_JSON: &str = "restart.json";
 /// Converged increments between restart files when the command line does not say.
 pub const DEFAULT_RESTART_EVERY: usize = 100;
 /// Version of the restart file's layout.
-pub const RESTART_FORMAT: u32 = 4;
+pub const RESTART_FORMAT: u32 = 5;
 
 /// The input a run was started with: the file in its output directory and its hash.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -51,8 +51,8 @@ pub struct InputIdentity {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RecorderMemory {
-    /// A drum case: its samples so far.
-    Drum(Vec<Sample>),
+    /// A drum case: how much of its journal of samples is on disk.
+    Drum(FileMark),
     /// A model file: its record so far.
     Model(Box<RunRecord>),
 }
@@ -69,9 +69,9 @@ pub struct RestartFile {
     /// Converged increments between restart files (0: none but the one at the start).
     pub restart_every: usize,
     /// `history.csv.partial` at this point.
-    pub history: CsvMark,
+    pub history: FileMark,
     /// `newton.csv.partial` at this point.
-    pub newton: CsvMark,
+    pub newton: FileMark,
     /// The history observer's memory.
     pub recorder: RecorderMemory,
     /// The field writer's memory, if the run writes fields.

@@ -20,12 +20,12 @@ use skid_integrator::{Model, RunError, State};
 
 use serde::Serialize;
 
+use crate::append_file::FileMark;
 use crate::atomic::write_atomic;
-use crate::csv_out::CsvMark;
 use crate::deck::is_deck;
 use crate::fields::{self, FieldMemory, FieldWriter};
 use crate::fingerprint::Fnv1a;
-use crate::history::DrumRecorder;
+use crate::history::{DrumRecorder, SAMPLES_JOURNAL, SampleJournal};
 use crate::model_file::contact_nodes;
 use crate::model_file::history::{ModelRecorder, ReactionColumns};
 use crate::model_file::summary::{ModelSummary, summarize as summarize_model};
@@ -353,7 +353,8 @@ fn run_in<const D: usize>(
         Start::Fresh => {
             clear_outputs(dir)?;
             let input = write_input(dir, CASE_JSON, case_text(case))?;
-            let recorder = DrumRecorder::create(dir).map_err(output(dir.join("history.csv")))?;
+            let recorder = DrumRecorder::create(dir, restart_every > 0)
+                .map_err(output(dir.join("history.csv")))?;
             let newton = NewtonRecorder::create(dir).map_err(output(dir.join(NEWTON_CSV)))?;
             let fields = field_writer(dir, case.output.field_interval, None)?;
             (recorder, newton, fields, input, None)
@@ -368,10 +369,12 @@ fn run_in<const D: usize>(
                 checkpoint,
                 ..
             } = *restart;
-            let RecorderMemory::Drum(samples) = recorder else {
+            let RecorderMemory::Drum(journal) = recorder else {
                 return Err(misfit(dir, "it holds a model file's history, not a drum's"));
             };
-            let recorder = DrumRecorder::reopen(dir, &history, samples)
+            let journal = SampleJournal::reopen(dir, &journal)
+                .map_err(reopen_error(dir, dir.join(SAMPLES_JOURNAL)))?;
+            let recorder = DrumRecorder::reopen(dir, &history, journal)
                 .map_err(reopen_error(dir, dir.join("history.csv")))?;
             let newton = NewtonRecorder::reopen(dir, &newton)
                 .map_err(reopen_error(dir, dir.join(NEWTON_CSV)))?;
@@ -478,6 +481,7 @@ fn clear_outputs(dir: &Path) -> Result<(), CaseError> {
         CASE_JSON,
         MODEL_JSON,
         RESTART_JSON,
+        SAMPLES_JOURNAL,
     ] {
         let p = dir.join(stale);
         if p.exists() {
@@ -604,28 +608,28 @@ fn run_model_in<const D: usize>(
 /// A history observer whose file and memory go into the restart files.
 trait History<const D: usize>: Observer<D> {
     /// Flushes the history file to disk and returns its mark.
-    fn mark(&mut self) -> std::io::Result<CsvMark>;
-    /// What the summary will be computed from, so far.
-    fn memory(&self) -> RecorderMemory;
+    fn mark(&mut self) -> std::io::Result<FileMark>;
+    /// What the summary will be computed from, so far, on disk.
+    fn memory(&mut self) -> std::io::Result<RecorderMemory>;
 }
 
 impl<const D: usize> History<D> for DrumRecorder {
-    fn mark(&mut self) -> std::io::Result<CsvMark> {
+    fn mark(&mut self) -> std::io::Result<FileMark> {
         DrumRecorder::mark(self)
     }
 
-    fn memory(&self) -> RecorderMemory {
-        RecorderMemory::Drum(self.samples.clone())
+    fn memory(&mut self) -> std::io::Result<RecorderMemory> {
+        self.journal_mark().map(RecorderMemory::Drum)
     }
 }
 
 impl<const D: usize> History<D> for ModelRecorder {
-    fn mark(&mut self) -> std::io::Result<CsvMark> {
+    fn mark(&mut self) -> std::io::Result<FileMark> {
         ModelRecorder::mark(self)
     }
 
-    fn memory(&self) -> RecorderMemory {
-        RecorderMemory::Model(Box::new(self.record().clone()))
+    fn memory(&mut self) -> std::io::Result<RecorderMemory> {
+        Ok(RecorderMemory::Model(Box::new(self.record().clone())))
     }
 }
 
@@ -698,7 +702,7 @@ impl<const D: usize, H: History<D>> Observer<D> for Observers<'_, H> {
             restart_every: self.restart.every,
             history: self.history.mark()?,
             newton: self.newton.mark()?,
-            recorder: self.history.memory(),
+            recorder: self.history.memory()?,
             fields: self.fields.as_deref().map(FieldWriter::memory),
             checkpoint: checkpoint.clone(),
         };

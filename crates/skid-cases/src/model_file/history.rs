@@ -24,8 +24,9 @@ use skid_integrator::state::EnergyLedger;
 use skid_integrator::stepper::{IncrementReport, Observer};
 use skid_integrator::{BodyMotion, Model, MotionTarget, State};
 
+use crate::append_file::FileMark;
 use crate::contact_totals::{PairTotals, pair_totals};
-use crate::csv_out::{CsvMark, PartialCsv};
+use crate::csv_out::PartialCsv;
 use crate::model_spec::ModelSpec;
 
 /// File name of the history.
@@ -249,7 +250,7 @@ impl ModelRecorder {
     /// As [`PartialCsv::reopen`].
     pub fn reopen(
         dir: &Path,
-        mark: &CsvMark,
+        mark: &FileMark,
         record: RunRecord,
         reactions: ReactionColumns,
     ) -> std::io::Result<Self> {
@@ -264,7 +265,7 @@ impl ModelRecorder {
     ///
     /// # Errors
     /// I/O errors.
-    pub fn mark(&mut self) -> std::io::Result<CsvMark> {
+    pub fn mark(&mut self) -> std::io::Result<FileMark> {
         self.csv.mark()
     }
 
