@@ -4,6 +4,7 @@
 //! * [`surface`]: rigid surfaces described in the body frame of their rigid body, with closest-point
 //!   projections giving the signed gap and convected (arc-length, axial) coordinates.
 //! * [`plane`]: the analytical rigid plane (a line in 2D).
+//! * [`polyline`]: the rigid polyline in 2D (rigid line elements in a chain, open or closed).
 //! * [`facets`]: the faceted cylinder (rigid line, quad, membrane or shell facets of a drum).
 //! * [`triangles`]: triangulated surfaces (exterior faces of a tetrahedral drum).
 //! * [`kinematics`]: gap, convected coordinates and their exact first derivatives for a slave node
@@ -19,6 +20,7 @@ pub mod error;
 pub mod facets;
 pub mod kinematics;
 pub mod plane;
+pub mod polyline;
 pub mod surface;
 pub mod triangles;
 
@@ -33,5 +35,6 @@ pub use kinematics::{
     gap_discrete_gradient, rotation_column, slip_increment,
 };
 pub use plane::RigidPlane;
+pub use polyline::RigidPolyline;
 pub use surface::{AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, SurfaceShape};
-pub use triangles::{CylinderChart, TriangulatedSurface};
+pub use triangles::{CylinderChart, SurfaceChart, TriangulatedSurface};

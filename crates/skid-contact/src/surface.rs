@@ -53,6 +53,14 @@ pub enum SurfaceShape {
         /// Polygon vertices in order.
         vertices: Vec<Vector3<f64>>,
     },
+    /// The chain of straight segments through `vertices` (in the plane `z = 0`), back to the
+    /// first vertex if `closed`; the outside is on the right walking along it.
+    Polyline {
+        /// Vertices in order.
+        vertices: Vec<Vector3<f64>>,
+        /// Whether the last vertex joins the first.
+        closed: bool,
+    },
     /// Triangles by their corners, counter-clockwise seen from outside.
     Triangles(Vec<[Vector3<f64>; 3]>),
 }

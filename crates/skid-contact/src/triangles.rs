@@ -1,5 +1,5 @@
 //! Rigid triangle mesh (the exterior faces of a tetrahedral C3D4 drum) with exact closest points
-//! found through an R*-tree, and cylinder-chart convected coordinates.
+//! found through an R*-tree, and convected coordinates from a cylinder or plane chart.
 
 use std::collections::BTreeMap;
 
@@ -8,6 +8,7 @@ use rstar::{AABB, PointDistance, RTree, RTreeObject};
 
 use crate::error::ContactError;
 use crate::facets::FacetedCylinder;
+use crate::plane::RigidPlane;
 use crate::surface::{AnalyticCylinder, Projection, RigidSurface, SurfaceShape};
 
 /// Cylinder whose coordinates label points of a triangulated drum: `xi_0 = R atan2(p.b2, p.b1)`,
@@ -18,6 +19,54 @@ pub struct CylinderChart {
     pub radius: f64,
     /// Axis `e` through the body-frame origin (normalised on use).
     pub axis: Vector3<f64>,
+}
+
+/// The surface whose coordinates label the points of a triangle mesh: those of the closest point
+/// on the mesh, read on the chart.
+#[derive(Clone, Copy, Debug)]
+pub enum SurfaceChart {
+    /// A drum's chart (see [`CylinderChart`]); `xi_0` has period `2 pi R`.
+    Cylinder(CylinderChart),
+    /// `xi = (t1.p, t2.p)` for a surface point `p`, as on the [`RigidPlane`] of outward `normal`
+    /// and first in-plane direction `tangent = t1`, for a mesh that is nowhere steep against
+    /// that plane (a floor, a ramp, a punch face).
+    Plane {
+        /// Normal `n` of the chart plane (normalised on use).
+        normal: Vector3<f64>,
+        /// First in-plane direction `t1` (its part along `n` is removed on use).
+        tangent: Vector3<f64>,
+    },
+}
+
+impl From<CylinderChart> for SurfaceChart {
+    fn from(chart: CylinderChart) -> Self {
+        Self::Cylinder(chart)
+    }
+}
+
+/// A chart made ready to project.
+#[derive(Clone, Debug)]
+enum Chart {
+    Cylinder(AnalyticCylinder),
+    Plane(RigidPlane),
+}
+
+impl Chart {
+    fn new(chart: SurfaceChart) -> Result<Self, ContactError> {
+        Ok(match chart {
+            SurfaceChart::Cylinder(c) => Self::Cylinder(AnalyticCylinder::new(c.radius, c.axis)?),
+            SurfaceChart::Plane { normal, tangent } => {
+                Self::Plane(RigidPlane::new(normal, tangent)?)
+            }
+        })
+    }
+
+    fn surface(&self) -> &dyn RigidSurface {
+        match self {
+            Self::Cylinder(c) => c,
+            Self::Plane(p) => p,
+        }
+    }
 }
 
 /// Closest feature of one triangle to a point.
@@ -189,15 +238,15 @@ impl Triangle {
 /// * `g = s |y - p|` (`= n.(y - a)` in a face region), `dg/dy = s (y - p)/|y - p|` (`= n` in a
 ///   face region; `N/|N|` when `|y - p| ~ 0`), `d^2g/dy^2 = s (I - dp/dy - d d^T)/|y - p|` with
 ///   `d = (y - p)/|y - p|` (zero in a face region and when `|y - p| ~ 0`);
-/// * `xi = (R atan2(p.b2, p.b1), e.p)` from the [`CylinderChart`], with
-///   `d xi/dy = (dp/dy)^T d xi/dp`, `dp/dy = I - n n^T` (face), `u u^T` (edge of direction `u`),
+/// * `xi` the chart's coordinates of `p` (for a [`CylinderChart`] `xi = (R atan2(p.b2, p.b1),
+///   e.p)`, with period `2 pi R` in `xi_0`), with `d xi/dy = (dp/dy)^T d xi/dp`, `dp/dy = I - n n^T` (face), `u u^T` (edge of direction `u`),
 ///   `0` (vertex), and, `p` being affine in `y` within a region,
-///   `d^2 xi/dy^2 = (dp/dy)^T (d^2 xi/dp^2) dp/dy`; `xi_0` has period `2 pi R`.
+///   `d^2 xi/dy^2 = (dp/dy)^T (d^2 xi/dp^2) dp/dy`.
 ///
 /// The sign is that of a closed, consistently oriented mesh; on an open mesh it is only
 /// meaningful near the surface. Equally distant features (to round-off) resolve to the face,
 /// then the edge, then the lowest triangle index. The projection is undefined (`None`) if `p`
-/// lies on the chart axis.
+/// lies on a cylinder chart's axis.
 ///
 /// The closest triangles are found in an R*-tree of the triangles' bounding boxes, bulk-loaded
 /// on construction, so that a projection visits the few triangles near `y` rather than all.
@@ -205,7 +254,7 @@ impl Triangle {
 pub struct TriangulatedSurface {
     triangles: Vec<Triangle>,
     tree: RTree<Located>,
-    chart: AnalyticCylinder,
+    chart: Chart,
     /// Largest vertex norm, the length scale of round-off tolerances.
     scale: f64,
 }
@@ -221,9 +270,9 @@ impl TriangulatedSurface {
     pub fn new(
         vertices: Vec<Vector3<f64>>,
         triangles: Vec<[usize; 3]>,
-        chart: CylinderChart,
+        chart: impl Into<SurfaceChart>,
     ) -> Result<Self, ContactError> {
-        let chart = AnalyticCylinder::new(chart.radius, chart.axis)?;
+        let chart = Chart::new(chart.into())?;
         let invalid = |message: String| Err(ContactError::InvalidSurface(message));
         if triangles.is_empty() {
             return invalid("triangle mesh has no triangles".into());
@@ -413,7 +462,7 @@ impl RigidSurface for TriangulatedSurface {
             };
             (sign * closest.distance, gradient, curvature)
         };
-        let chart = self.chart.project(&closest.point)?;
+        let chart = self.chart.surface().project(&closest.point)?;
         Some(Projection {
             gap,
             gap_gradient,
@@ -425,7 +474,7 @@ impl RigidSurface for TriangulatedSurface {
     }
 
     fn coords_period(&self) -> [Option<f64>; 2] {
-        self.chart.coords_period()
+        self.chart.surface().coords_period()
     }
 }
 
@@ -481,6 +530,51 @@ mod tests {
 
     fn drum_72() -> FacetedCylinder {
         FacetedCylinder::new(R, Vector3::z(), 72, PI / 72.0).expect("drum")
+    }
+
+    /// A tilted floor of two triangles, `z = 0.1 x` over `[-1, 1]^2`, with the plane chart of
+    /// normal `+z`, `t1 = +x`: on a face the gap is the distance to the tilted plane and the
+    /// coordinates those of the closest point, read on the chart.
+    #[test]
+    fn a_plane_chart_labels_a_floor() -> Result<(), ContactError> {
+        let floor = |x: f64, y: f64| Vector3::new(x, y, 0.1 * x);
+        let vertices = vec![
+            floor(-1.0, -1.0),
+            floor(1.0, -1.0),
+            floor(1.0, 1.0),
+            floor(-1.0, 1.0),
+        ];
+        let chart = SurfaceChart::Plane {
+            normal: Vector3::z(),
+            tangent: Vector3::x(),
+        };
+        let mesh = TriangulatedSurface::new(vertices, vec![[0, 1, 2], [0, 2, 3]], chart)?;
+        assert_eq!(mesh.coords_period(), [None, None]);
+        let normal = Vector3::new(-0.1, 0.0, 1.0).normalize();
+        let y = Vector3::new(0.3, 0.4, 0.2);
+        let p = project(&mesh, &y);
+        let gap = normal.dot(&(y - floor(0.3, 0.4)));
+        assert_relative_eq!(p.gap, gap, epsilon = 1e-15);
+        let closest = y - normal * gap;
+        assert_relative_eq!(p.coords[0], closest.x, epsilon = 1e-15);
+        assert_relative_eq!(p.coords[1], closest.y, epsilon = 1e-15);
+        for y in [
+            y,
+            Vector3::new(-0.6, 0.2, -0.05),
+            Vector3::new(1.2, 0.5, 0.3),
+        ] {
+            check_gradients(&mesh, &y, 1e-6);
+        }
+        let flat = SurfaceChart::Plane {
+            normal: Vector3::z(),
+            tangent: Vector3::z(),
+        };
+        let v = vec![Vector3::zeros(), Vector3::x(), Vector3::y()];
+        assert!(matches!(
+            TriangulatedSurface::new(v, vec![[0, 1, 2]], flat),
+            Err(ContactError::InvalidSurface(_))
+        ));
+        Ok(())
     }
 
     #[test]

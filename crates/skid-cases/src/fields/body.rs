@@ -112,6 +112,15 @@ fn draw(shape: &SurfaceShape, around: &[Vector3<f64>], planar: bool) -> Drawing 
                 cells: vec![vec![0, 1, 2, 3]],
             }
         }
+        SurfaceShape::Polyline { vertices, closed } => {
+            // a 2D-only surface: its segments as lines
+            let n = vertices.len();
+            let segments = if *closed { n } else { n.saturating_sub(1) };
+            Drawing {
+                points: vertices.clone(),
+                cells: (0..segments).map(|k| vec![k, (k + 1) % n]).collect(),
+            }
+        }
         SurfaceShape::Triangles(triangles) => {
             // shared corners become shared points
             let mut index: BTreeMap<[u64; 3], usize> = BTreeMap::new();
