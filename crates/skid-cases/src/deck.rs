@@ -7,8 +7,8 @@
 //!   [`rigid`] analytical and faceted rigid surfaces, [`loads`] amplitudes and loads).
 //! - [`assemble`]: the definitions turned into a model; [`write`]: a model written as a deck.
 //!
-//! The subset: `*HEADING`, `*NODE`, `*ELEMENT` (CPE4R, C3D8R; R2D2, R3D4, M3D4R, S4R, C3D4
-//! made rigid; MASS, ROTARYI), `*NSET` / `*ELSET` (GENERATE), `*SURFACE` (ELEMENT, NODE,
+//! The subset: `*HEADING`, `*NODE`, `*ELEMENT` (CPE4R, C3D8R; R2D2, R3D3, R3D4, M3D4R, S4R,
+//! C3D4 made rigid; MASS, ROTARYI), `*NSET` / `*ELSET` (GENERATE), `*SURFACE` (ELEMENT, NODE,
 //! SEGMENTS, CYLINDER, REVOLUTION), `*RIGID BODY` (REF NODE, ELSET, ANALYTICAL SURFACE,
 //! TIE NSET), `*MATERIAL` with `*HYPERELASTIC` (POLYNOMIAL N=1, MOONEY-RIVLIN, NEO HOOKE),
 //! `*ELASTIC` and `*DENSITY`, `*SOLID SECTION`, `*MEMBRANE SECTION`, `*SHELL SECTION`,
@@ -40,8 +40,13 @@
 //! - `*ELASTIC` is the compressible neo-Hookean solid with the same small-strain moduli;
 //! - rigid membranes and shells are contacted on their mid-surface (zero thickness), rigid
 //!   elements carry no mass (give it with `*MASS` and `*ROTARY INERTIA`);
-//! - lines and quadrilaterals made rigid must form a regular prism (the faceted drum), which is
-//!   treated as axially unbounded, and the slave nodes are checked to lie within its ends;
+//! - lines and quadrilaterals made rigid that form a regular prism are the faceted drum, which
+//!   is treated as axially unbounded, and the slave nodes are checked to lie within its ends;
+//!   other lines must form one chain (a polyline; closed, it must face outwards), other
+//!   quadrilaterals (split along their 1-3 diagonal: exact when flat) and triangles a triangle
+//!   mesh whose surface coordinates are read on its plane if it is flat, else on a cylinder
+//!   about its body's one free rotation (see [`rigid`]); a bent `SEGMENTS` profile of lines
+//!   is a polyline, a straight one the unbounded line through its reference node;
 //! - a point rotary inertia counts about its body's one free rotation axis;
 //! - general contact makes every node of the part's exterior faces a candidate;
 //! - `*OUTPUT, FIELD` with `TIME INTERVAL=t` or `NUMBER INTERVAL=n` (the step's period over n)

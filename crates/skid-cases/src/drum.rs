@@ -20,7 +20,7 @@ use crate::deck::write::{RigidElements, write_deck};
 use crate::model_file::{self, Scene};
 use crate::model_spec::ContactPairSpec;
 use crate::model_spec::{
-    BoundarySpec, Dof, ElementBlockSpec, ElementType, LoadSpec, ModelStepSpec, PartSpec,
+    BoundarySpec, ChartSpec, Dof, ElementBlockSpec, ElementType, LoadSpec, ModelStepSpec, PartSpec,
     RigidBodySpec, RigidSurfaceSpec, SectionSpec, SlaveSpec, StepBoundarySpec, TieSpec,
 };
 use crate::model_spec::{MODEL_FORMAT_VERSION, ModelSpec};
@@ -289,8 +289,7 @@ fn drum_surface(case: &Case) -> Result<RigidSurfaceSpec, String> {
             RigidSurfaceSpec::Triangles {
                 vertices: vertices.into_iter().map(Into::into).collect(),
                 triangles,
-                chart_radius: r,
-                chart_axis: axis,
+                chart: ChartSpec::Cylinder { radius: r, axis },
             }
         }
     })

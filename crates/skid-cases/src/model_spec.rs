@@ -242,17 +242,54 @@ pub enum RigidSurfaceSpec {
         /// Angle of the first vertex, rad.
         phase: f64,
     },
-    /// Triangles (3D), counter-clockwise seen from outside, with surface coordinates from a
-    /// cylinder chart (arc length about `chart_axis` at `chart_radius`, axial position).
+    /// A chain of straight segments (2D: rigid line elements) through `points`, back to the
+    /// first point if `closed`. Its outward normal is each segment's direction turned clockwise
+    /// (a closed chain counter-clockwise is contacted from outside, clockwise from inside); the
+    /// surface coordinate is the
+    /// arc length from the first point. Beyond an open chain's ends the gap is the signed
+    /// distance to the end point.
+    Polyline {
+        /// Points `[x, y]`, m.
+        points: Vec<[f64; 2]>,
+        /// Whether the last point joins the first.
+        #[serde(default)]
+        closed: bool,
+    },
+    /// Triangles (3D), counter-clockwise seen from outside, with surface coordinates read on
+    /// the `chart` at each closest point. Beyond an open mesh's boundary the gap is the signed
+    /// distance to the boundary.
     Triangles {
         /// Vertices, m.
         vertices: Vec<[f64; 3]>,
         /// Vertex numbers of each triangle.
         triangles: Vec<[usize; 3]>,
-        /// Radius of the chart cylinder, m.
-        chart_radius: f64,
-        /// Axis of the chart cylinder.
-        chart_axis: [f64; 3],
+        /// The surface whose coordinates label the mesh's points.
+        chart: ChartSpec,
+    },
+}
+
+/// The surface coordinates of a triangle mesh: those of its closest point read on a cylinder or a
+/// plane through the body origin. Friction measures slip in these coordinates, so they are
+/// lengths on the mesh only where the mesh lies on the chart: a flat mesh on its plane chart
+/// exactly, a faceted drum on its cylinder up to the facets' chord (`1 - cos(pi / n)`, 1e-3
+/// for 72 facets).
+#[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ChartSpec {
+    /// Arc length `radius * angle` about `axis` from the cylinder's reference direction, and the
+    /// position along `axis`.
+    Cylinder {
+        /// Radius, m.
+        radius: f64,
+        /// Axis direction.
+        axis: [f64; 3],
+    },
+    /// The positions along `tangent` and along `normal x tangent`.
+    Plane {
+        /// Normal of the chart plane.
+        normal: [f64; 3],
+        /// First in-plane direction.
+        tangent: [f64; 3],
     },
 }
 

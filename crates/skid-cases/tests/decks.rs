@@ -334,9 +334,9 @@ fn a_circle_traversed_counter_clockwise_faces_inwards_and_is_refused() {
 }
 
 /// Rigid line elements: a regular polygon is the faceted drum, whatever its orientation in
-/// the plane; a polygon with a short facet or facing inwards is refused.
+/// the plane; facing inwards it is refused; any other polygon is a closed polyline.
 #[test]
-fn rigid_lines_form_a_regular_polygon_or_are_refused() {
+fn rigid_lines_form_a_regular_polygon_or_a_polyline() {
     let polygon = |n: usize, phase: f64, inward: bool, squash: f64| {
         let mut text = String::from("*Node\n");
         for k in 0..n {
@@ -376,8 +376,26 @@ fn rigid_lines_form_a_regular_polygon_or_are_refused() {
     }
     let message = variant(analytic, &polygon(24, 0.3, true, 1.0)).expect_err("inward");
     assert!(message.contains("contacted from outside"), "{message}");
-    let message = variant(analytic, &polygon(24, 0.3, false, 0.9)).expect_err("squashed");
-    assert!(message.contains("not on the circle"), "{message}");
+    // a squashed polygon is no drum: a closed polyline, counter-clockwise from the first
+    // line's first node
+    let model = variant(analytic, &polygon(24, 0.3, false, 0.9)).expect("squashed");
+    match &model.model.rigid_bodies[0].surface {
+        Some(RigidSurfaceSpec::Polyline { points, closed }) => {
+            assert!(*closed);
+            assert_eq!(points.len(), 24);
+            let expected = [0.2 * 0.3_f64.cos(), 0.2 * 0.3_f64.sin()];
+            assert!(
+                (points[0][0] - expected[0]).abs() < 1e-15
+                    && (points[0][1] - expected[1]).abs() < 1e-15,
+                "{:?}",
+                points[0]
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    // ... and facing inwards it is refused as well
+    let message = variant(analytic, &polygon(24, 0.3, true, 0.9)).expect_err("squashed inward");
+    assert!(message.contains("faces inwards"), "{message}");
 }
 
 /// A faceted drum narrower than the pad: the prism has no ends, so slave nodes beyond its
@@ -652,4 +670,27 @@ fn field_output_requests_set_the_field_interval() {
         assert!(collection.contains(&file), "{file} in {collection}");
         assert!(out.join("fields").join(&file).is_file(), "{file}");
     }
+}
+
+/// A body loaded by two concentrated loads of different amplitudes (the pushed block's plate:
+/// pressed along y, pushed along x) is written as one `*CLOAD` block per load with only its
+/// non-zero components, since a later line on the same degree of freedom replaces an earlier
+/// one: the deck reads back to the same loads. Two loads on one degree of freedom cannot be
+/// written so, and are refused.
+#[test]
+fn concentrated_loads_of_two_amplitudes_on_one_body_are_written_apart() {
+    let path = repo("cases/verification/3d-block-pushed-on-flat.json");
+    let text = std::fs::read_to_string(&path).expect("scene");
+    let mut model = skid_cases::model_file::parse_model(&text, &path, &[]).expect("model");
+    let written = skid_cases::deck::write::write_deck(&model, &Default::default()).expect("deck");
+    let read = read_text(&written).expect("reads back").model;
+    assert_eq!(read.loads, model.loads);
+    let mut twice = model.loads[1].clone();
+    if let skid_cases::model_spec::LoadSpec::Concentrated { force, .. } = &mut twice {
+        *force = Some(vec![0.0, -1.0, 0.0]);
+    }
+    model.loads.push(twice);
+    let message = skid_cases::deck::write::write_deck(&model, &Default::default())
+        .expect_err("two loads on y");
+    assert!(message.contains("loads[0] and loads[2]"), "{message}");
 }

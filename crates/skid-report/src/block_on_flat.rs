@@ -162,17 +162,58 @@ impl BlockOnFlat {
     }
 }
 
-/// The scene's one contact pair, if its master is a rigid plane: the pair, the plane's body
-/// and its unit normal.
+/// The scene's one contact pair, if its master is flat (a rigid plane, or rigid elements that
+/// lie in one plane): the pair, the flat's body and its unit normal.
 pub(crate) fn flat_pair(spec: &ModelSpec) -> Option<(&ContactPairSpec, &RigidBodySpec, [f64; 3])> {
     let [pair] = spec.contact.as_slice() else {
         return None;
     };
     let flat = spec.rigid_bodies.iter().find(|b| b.name == pair.master)?;
-    let Some(RigidSurfaceSpec::Plane { normal, .. }) = flat.surface else {
-        return None;
+    Some((pair, flat, flat_normal(flat.surface.as_ref()?)?))
+}
+
+/// The unit outward normal of a flat surface: a plane's; a polyline's whose segments all run
+/// one way (their direction turned clockwise); a triangle mesh's whose triangles all face one
+/// way (within 1e-9). `None` for any other surface.
+fn flat_normal(surface: &RigidSurfaceSpec) -> Option<[f64; 3]> {
+    let same = |normals: Vec<[f64; 3]>| {
+        let first = *normals.first()?;
+        normals
+            .iter()
+            .all(|n| n.iter().zip(&first).all(|(a, b)| (a - b).abs() <= 1e-9))
+            .then_some(first)
     };
-    Some((pair, flat, unit(normal)))
+    match surface {
+        RigidSurfaceSpec::Plane { normal, .. } => Some(unit(*normal)),
+        RigidSurfaceSpec::Polyline { points, .. } => same(
+            points
+                .windows(2)
+                .map(|w| unit([w[1][1] - w[0][1], w[0][0] - w[1][0], 0.0]))
+                .collect(),
+        ),
+        RigidSurfaceSpec::Triangles {
+            vertices,
+            triangles,
+            ..
+        } => same(
+            triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|i| vertices[i]);
+                    let (u, v) = (
+                        [0, 1, 2].map(|k| b[k] - a[k]),
+                        [0, 1, 2].map(|k| c[k] - a[k]),
+                    );
+                    unit([
+                        u[1] * v[2] - u[2] * v[1],
+                        u[2] * v[0] - u[0] * v[2],
+                        u[0] * v[1] - u[1] * v[0],
+                    ])
+                })
+                .collect(),
+        ),
+        _ => None,
+    }
 }
 
 /// `v / |v|`.
@@ -235,6 +276,36 @@ pub(crate) fn scene(file: &str) -> ModelSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use skid_cases::model_spec::ChartSpec;
+
+    /// Rigid elements in one plane are a flat with that plane's normal; bent ones are not.
+    #[test]
+    fn flat_element_surfaces_have_one_normal() {
+        let line = |points: Vec<[f64; 2]>| RigidSurfaceSpec::Polyline {
+            points,
+            closed: false,
+        };
+        // walked towards -x: the outside (right-hand side) is up
+        let floor = line(vec![[1.0, 0.0], [0.2, 0.0], [-1.0, 0.0]]);
+        assert_eq!(flat_normal(&floor), Some([0.0, 1.0, 0.0]));
+        let ramp = line(vec![[1.0, 0.1], [0.2, 0.0], [-1.0, 0.0]]);
+        assert_eq!(flat_normal(&ramp), None);
+        let mesh = |lift: f64| RigidSurfaceSpec::Triangles {
+            vertices: vec![
+                [0.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [1.0, 0.0, 1.0],
+                [1.0, lift, 0.0],
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            chart: ChartSpec::Plane {
+                normal: [0.0, 1.0, 0.0],
+                tangent: [1.0, 0.0, 0.0],
+            },
+        };
+        assert_eq!(flat_normal(&mesh(0.0)), Some([0.0, 1.0, 0.0]));
+        assert_eq!(flat_normal(&mesh(0.1)), None);
+    }
 
     /// The pushed block: N = 20 N down, F = 9 N sideways (1.5 mu N), held from 25 ms.
     #[test]

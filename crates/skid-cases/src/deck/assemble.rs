@@ -16,7 +16,7 @@ use super::read::{
     BoundaryDef, Change, Definitions, FaceLabel, FieldRequest, InitialDef, Procedure, RigidDef,
     SectionKind, StepDef, SurfaceDef,
 };
-use super::rigid::{prism, triangles};
+use super::rigid::{chain, prism, triangles};
 use crate::model_spec::{
     BoundarySpec, ContactPairSpec, Dof, ElementBlockSpec, ElementType, LoadSpec,
     MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, NodeVelocitySpec, PartSpec, RigidBodySpec,

@@ -15,6 +15,8 @@ pub enum ElementKind {
     C3d8r,
     /// Two-node rigid line (2D).
     R2d2,
+    /// Three-node rigid triangle (3D).
+    R3d3,
     /// Four-node rigid quadrilateral (3D).
     R3d4,
     /// Four-node membrane (3D), read as a facet of a rigid body.
@@ -36,6 +38,7 @@ impl ElementKind {
             "CPE4R" => Self::Cpe4r,
             "C3D8R" => Self::C3d8r,
             "R2D2" => Self::R2d2,
+            "R3D3" => Self::R3d3,
             "R3D4" => Self::R3d4,
             "M3D4R" => Self::M3d4r,
             "S4R" => Self::S4r,
@@ -50,8 +53,8 @@ impl ElementKind {
             }
             other => {
                 return Err(format!(
-                    "TYPE={other} is outside the element subset (CPE4R, C3D8R, R2D2, R3D4, \
-                     M3D4R, S4R, C3D4, MASS, ROTARYI)"
+                    "TYPE={other} is outside the element subset (CPE4R, C3D8R, R2D2, R3D3, \
+                     R3D4, M3D4R, S4R, C3D4, MASS, ROTARYI)"
                 ));
             }
         })
@@ -61,6 +64,7 @@ impl ElementKind {
     pub fn node_count(self) -> usize {
         match self {
             Self::Cpe4r | Self::R3d4 | Self::M3d4r | Self::S4r | Self::C3d4 => 4,
+            Self::R3d3 => 3,
             Self::C3d8r => 8,
             Self::R2d2 => 2,
             Self::Mass | Self::RotaryI => 1,

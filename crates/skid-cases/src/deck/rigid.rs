@@ -16,7 +16,7 @@ use std::f64::consts::TAU;
 
 use super::fields::{allow_parameters, at_most, field, line_error, real};
 use super::keywords::{Block, DeckError};
-use crate::model_spec::RigidSurfaceSpec;
+use crate::model_spec::{ChartSpec, RigidSurfaceSpec};
 
 /// One piece of a profile, from the end of the previous one.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -212,12 +212,11 @@ impl AnalyticalSurface {
                 .ok_or("the first LINE has zero length")?;
             for end in &lines {
                 let d = end - from;
-                if d.norm() <= tol || (d.normalize() - direction).norm() > 1e-9 {
-                    return Err(
-                        "a profile of lines must run straight on in one direction (a \
-                                plane); bent profiles are not supported"
-                            .into(),
-                    );
+                if d.norm() <= tol {
+                    return Err("a LINE of the profile has zero length".into());
+                }
+                if (d.normalize() - direction).norm() > 1e-9 {
+                    return self.polyline(reference, &lines);
                 }
                 from = *end;
             }
@@ -301,6 +300,43 @@ impl AnalyticalSurface {
         Ok(RigidSurfaceSpec::Cylinder {
             radius,
             axis: self.ez.into(),
+        })
+    }
+
+    /// A bent profile of lines in 2D (`SEGMENTS`) as a [`RigidSurfaceSpec::Polyline`] in the
+    /// body frame, closed if it ends where it starts. Its points are taken in reverse: the
+    /// deck's outward normal is the direction of travel turned counter-clockwise, the
+    /// polyline's turned clockwise.
+    fn polyline(
+        &self,
+        reference: &Vector3<f64>,
+        ends: &[Vector2<f64>],
+    ) -> Result<RigidSurfaceSpec, String> {
+        if self.kind != AnalyticalKind::Segments {
+            return Err(
+                "a bent profile of lines is read in 2D (TYPE=SEGMENTS); in 3D give the \
+                 surface as rigid elements (R3D4 or R3D3)"
+                    .into(),
+            );
+        }
+        let tol = 1e-9 * self.size().max(reference.norm());
+        let mut points: Vec<Vector2<f64>> = std::iter::once(self.start)
+            .chain(ends.iter().copied())
+            .collect();
+        let closed = (points[points.len() - 1] - points[0]).norm() <= tol;
+        if closed {
+            points.pop();
+        }
+        Ok(RigidSurfaceSpec::Polyline {
+            points: points
+                .iter()
+                .rev()
+                .map(|p| {
+                    let y = self.global(p) - reference;
+                    [y.x, y.y]
+                })
+                .collect(),
+            closed,
         })
     }
 
@@ -510,25 +546,140 @@ fn aligned_phase(phase: f64, n: usize) -> f64 {
 }
 
 /// The rigid surface of triangles given outward (counter-clockwise seen from outside), in the
-/// body frame, with surface coordinates from the cylinder about `axis` through the origin whose
-/// radius reaches the farthest vertex.
+/// body frame, with its chart: a flat mesh (every triangle's normal within 1e-9 of their
+/// area-weighted mean `n`) the plane chart of `n`, whose first direction is the coordinate axis
+/// least along `n` made perpendicular to it, so that its coordinates are lengths on the mesh;
+/// any other mesh the cylinder about `axis` (the body's one free rotation, through the origin)
+/// whose radius reaches the farthest vertex.
 pub fn triangles(
     vertices: Vec<[f64; 3]>,
     triangles: Vec<[usize; 3]>,
-    axis: Vector3<f64>,
-) -> RigidSurfaceSpec {
-    let chart_radius = vertices
+    axis: Option<Vector3<f64>>,
+) -> Result<RigidSurfaceSpec, String> {
+    let corners = |t: &[usize; 3]| t.map(|i| Vector3::from(vertices[i]));
+    let areas: Vec<Vector3<f64>> = triangles
         .iter()
-        .map(|v| {
-            let v = Vector3::from(*v);
-            (v - axis * axis.dot(&v)).norm()
+        .map(|t| {
+            let [a, b, c] = corners(t);
+            (b - a).cross(&(c - a))
         })
-        .fold(0.0, f64::max);
-    let chart_radius = shortest_decimal(chart_radius);
-    RigidSurfaceSpec::Triangles {
+        .collect();
+    let mean = areas.iter().sum::<Vector3<f64>>();
+    let flat = unit(mean).filter(|n| {
+        areas
+            .iter()
+            .all(|a| unit(*a).is_some_and(|m| (m - n).norm() <= 1e-9))
+    });
+    let chart = match (flat, axis) {
+        (Some(normal), _) => {
+            let least = normal.iamin();
+            let tangent = unit(Vector3::ith(least, 1.0) - normal * normal[least])
+                .ok_or("the mesh's normal has no perpendicular")?;
+            ChartSpec::Plane {
+                normal: normal.into(),
+                tangent: tangent.into(),
+            }
+        }
+        (None, Some(axis)) => {
+            let radius = vertices
+                .iter()
+                .map(|v| {
+                    let v = Vector3::from(*v);
+                    (v - axis * axis.dot(&v)).norm()
+                })
+                .fold(0.0, f64::max);
+            ChartSpec::Cylinder {
+                radius: shortest_decimal(radius),
+                axis: axis.into(),
+            }
+        }
+        (None, None) => {
+            return Err(
+                "a curved (not flat) rigid element surface takes its surface coordinates on a \
+                 cylinder about its body's one free rotation, and this body has none or several"
+                    .into(),
+            );
+        }
+    };
+    Ok(RigidSurfaceSpec::Triangles {
         vertices,
         triangles,
-        chart_radius,
-        chart_axis: axis.into(),
+        chart,
+    })
+}
+
+/// The rigid surface of segments given outward in skid's convention (each segment's direction
+/// turned clockwise points out), in the body frame, that [`prism`] does not take for a regular
+/// polygon: one chain of segments, each starting where the one before ends, as a
+/// [`RigidSurfaceSpec::Polyline`] (closed if the chain returns to its first point; a closed
+/// chain must face outwards, as a deck's closed rigid surfaces are contacted from outside).
+pub fn chain(segments: &[[Vector3<f64>; 2]]) -> Result<RigidSurfaceSpec, String> {
+    let key = |p: &Vector3<f64>| [p.x.to_bits(), p.y.to_bits()];
+    let mut leaving: std::collections::HashMap<[u64; 2], usize> = Default::default();
+    for (k, [a, _]) in segments.iter().enumerate() {
+        if leaving.insert(key(a), k).is_some() {
+            return Err(format!(
+                "two rigid lines start at ({}, {}) in the body frame: the lines of a surface \
+                 form one chain, each line's second node the next line's first (reverse the \
+                 lines that run against it, or use the other side, SPOS or SNEG)",
+                a.x, a.y
+            ));
+        }
     }
+    let ends: std::collections::HashSet<[u64; 2]> = segments.iter().map(|[_, b]| key(b)).collect();
+    let first = (0..segments.len())
+        .find(|&k| !ends.contains(&key(&segments[k][0])))
+        .unwrap_or(0);
+    let mut points = vec![segments[first][0]];
+    let mut visited = vec![false; segments.len()];
+    let mut k = first;
+    let closed = loop {
+        visited[k] = true;
+        let end = segments[k][1];
+        match leaving.get(&key(&end)) {
+            Some(&next) if next == first => break true,
+            Some(&next) if visited[next] => {
+                return Err(format!(
+                    "the rigid lines meet at ({}, {}) in the body frame from two sides: a \
+                     surface of lines is one chain without branches",
+                    end.x, end.y
+                ));
+            }
+            Some(&next) => {
+                points.push(end);
+                k = next;
+            }
+            None => {
+                points.push(end);
+                break false;
+            }
+        }
+    };
+    let walked = visited.iter().filter(|v| **v).count();
+    if walked != segments.len() {
+        return Err(format!(
+            "the rigid lines form more than one chain ({walked} of {} lines joined from the \
+             first): a surface of lines is one chain, each line's second node the next line's \
+             first",
+            segments.len()
+        ));
+    }
+    // a closed chain runs counter-clockwise (positive area) to face outwards
+    let area: f64 = (0..points.len())
+        .map(|k| {
+            let (a, b) = (points[k], points[(k + 1) % points.len()]);
+            a.x * b.y - b.x * a.y
+        })
+        .sum();
+    if closed && area < 0.0 {
+        return Err(
+            "the closed chain of rigid lines faces inwards: skid's closed rigid surfaces are \
+             contacted from outside (use the other side, SPOS or SNEG)"
+                .into(),
+        );
+    }
+    Ok(RigidSurfaceSpec::Polyline {
+        points: points.iter().map(|p| [p.x, p.y]).collect(),
+        closed,
+    })
 }

@@ -449,10 +449,12 @@ fn write_motions(out: &mut String, motions: &[&BoundarySpec], step: usize) {
 }
 
 /// The loads, one keyword block each (its amplitude is a parameter of the keyword):
-/// `*DSLOAD` pressures, `*CLOAD` components on a node set or a body's reference node (its
-/// node set has the body's name), `*DLOAD, GRAV` with the acceleration as the direction and
+/// `*DSLOAD` pressures, `*CLOAD` non-zero components on a node set or a body's reference node
+/// (its node set has the body's name; two loads on one degree of freedom are refused), `*DLOAD, GRAV` with the acceleration as the direction and
 /// its norm as the magnitude, which reads back to the same bits.
 fn write_loads(out: &mut String, spec: &ModelSpec) -> Result<(), String> {
+    // the load that acts on each (target, degree of freedom) so far
+    let mut loaded: BTreeMap<(String, usize), usize> = BTreeMap::new();
     for (k, load) in spec.loads.iter().enumerate() {
         if load.step_factors().is_some() {
             return Err(format!(
@@ -494,7 +496,17 @@ fn write_loads(out: &mut String, spec: &ModelSpec) -> Result<(), String> {
                         .filter(|&(axis, _)| spec.dimension == 3 || axis == 2)
                         .map(|(axis, m)| (axis + 3, m)),
                 );
-                for (index, value) in components {
+                // only the components the load has: a later *CLOAD line on the same degree of
+                // freedom replaces an earlier one (OP=MOD), whatever its amplitude
+                for (index, value) in components.filter(|&(_, value)| value != 0.0) {
+                    if let Some(earlier) = loaded.insert((target.to_string(), index), k) {
+                        return Err(format!(
+                            "loads[{earlier}] and loads[{k}] both act on degree of freedom {} \
+                             of {target}: in a deck the later *CLOAD would replace the earlier \
+                             (OP=MOD), so the model is not written as a deck",
+                            index + 1
+                        ));
+                    }
                     let _ = writeln!(out, "{target}, {}, {}", index + 1, num(value));
                 }
             }
@@ -743,11 +755,61 @@ fn surface_deck(
             let _ = writeln!(out, "*SURFACE, NAME={name}, TYPE=ELEMENT\n{elset}, SPOS");
             Ok(format!(", ELSET={elset}"))
         }
-        RigidSurfaceSpec::Triangles { .. } => {
+        RigidSurfaceSpec::Polyline { points, closed } => {
+            let first = *next_node;
+            let _ = writeln!(out, "*NODE");
+            for q in points {
+                let _ = writeln!(
+                    out,
+                    "{}, {}",
+                    *next_node,
+                    p(&(c + Vector3::new(q[0], q[1], 0.0)))
+                );
+                *next_node += 1;
+            }
+            let elset = format!("{name}-lines");
+            let _ = writeln!(out, "*ELEMENT, TYPE=R2D2, ELSET={elset}");
+            let n = points.len();
+            let segments = if *closed { n } else { n.saturating_sub(1) };
+            for k in 0..segments {
+                // SPOS (e_z x t) outward: each line from the polyline's next point back
+                let _ = writeln!(
+                    out,
+                    "{}, {}, {}",
+                    *next_element,
+                    first + (k + 1) % n,
+                    first + k
+                );
+                *next_element += 1;
+            }
+            let _ = writeln!(out, "*SURFACE, NAME={name}, TYPE=ELEMENT\n{elset}, SPOS");
+            Ok(format!(", ELSET={elset}"))
+        }
+        RigidSurfaceSpec::Triangles {
+            vertices,
+            triangles,
+            ..
+        } => {
             let Some(RigidElements::Tetrahedra(mesh)) = elements else {
-                return Err(format!(
-                    "rigid body {name}: a triangulated surface is written with its tetrahedra"
-                ));
+                let first = *next_node;
+                let _ = writeln!(out, "*NODE");
+                for v in vertices {
+                    let _ = writeln!(out, "{}, {}", *next_node, p(&(c + Vector3::from(*v))));
+                    *next_node += 1;
+                }
+                let elset = format!("{name}-triangles");
+                let _ = writeln!(out, "*ELEMENT, TYPE=R3D3, ELSET={elset}");
+                for t in triangles {
+                    let _ = writeln!(
+                        out,
+                        "{}, {}",
+                        *next_element,
+                        list(t.iter().map(|v| (first + v).to_string()))
+                    );
+                    *next_element += 1;
+                }
+                let _ = writeln!(out, "*SURFACE, NAME={name}, TYPE=ELEMENT\n{elset}, SPOS");
+                return Ok(format!(", ELSET={elset}"));
             };
             let first = *next_node;
             let _ = writeln!(out, "*NODE");

@@ -3,11 +3,12 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use nalgebra::{SVector, Vector3};
+use nalgebra::{SVector, Vector2, Vector3};
 use skid_contact::facets::FacetedCylinder;
 use skid_contact::plane::RigidPlane;
+use skid_contact::polyline::RigidPolyline;
 use skid_contact::surface::{AnalyticCylinder, RigidSurface};
-use skid_contact::triangles::{CylinderChart, TriangulatedSurface};
+use skid_contact::triangles::{CylinderChart, SurfaceChart, TriangulatedSurface};
 use skid_fem::cell::{embed, face_corners};
 use skid_fem::material::{Hyperelastic, PolynomialN1};
 use skid_fem::mesh::SolidMesh;
@@ -22,8 +23,8 @@ mod loads;
 mod motions;
 
 use crate::model_spec::{
-    BoundarySpec, Dof, MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, RigidSurfaceSpec, SlaveSpec,
-    StepBoundarySpec,
+    BoundarySpec, ChartSpec, Dof, MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, RigidSurfaceSpec,
+    SlaveSpec, StepBoundarySpec,
 };
 use crate::schema::{AdaptiveSpec, MaterialSpec, SolverSpec};
 use crate::validate::check_file_name;
@@ -685,20 +686,34 @@ fn rigid_surface<const D: usize>(
             let axis = vector3(&format!("{field}.axis"), *axis)?;
             Box::new(FacetedCylinder::new(*radius, axis, *facets, *phase).map_err(invalid)?)
         }
+        RigidSurfaceSpec::Polyline { points, closed } => {
+            if D != 2 {
+                return fail(field, "a polyline is a 2D surface");
+            }
+            let points = points.iter().map(|p| Vector2::from(*p)).collect();
+            Box::new(RigidPolyline::new(points, *closed).map_err(invalid)?)
+        }
         RigidSurfaceSpec::Triangles {
             vertices,
             triangles,
-            chart_radius,
-            chart_axis,
+            chart,
         } => {
             if D != 3 {
                 return fail(field, "triangles are a 3D surface");
             }
-            positive(&format!("{field}.chart_radius"), *chart_radius)?;
             let vertices = vertices.iter().map(|v| Vector3::from(*v)).collect();
-            let chart = CylinderChart {
-                radius: *chart_radius,
-                axis: vector3(&format!("{field}.chart_axis"), *chart_axis)?,
+            let chart = match chart {
+                ChartSpec::Cylinder { radius, axis } => {
+                    positive(&format!("{field}.chart.radius"), *radius)?;
+                    SurfaceChart::Cylinder(CylinderChart {
+                        radius: *radius,
+                        axis: vector3(&format!("{field}.chart.axis"), *axis)?,
+                    })
+                }
+                ChartSpec::Plane { normal, tangent } => SurfaceChart::Plane {
+                    normal: vector3(&format!("{field}.chart.normal"), *normal)?,
+                    tangent: vector3(&format!("{field}.chart.tangent"), *tangent)?,
+                },
             };
             Box::new(TriangulatedSurface::new(vertices, triangles.clone(), chart).map_err(invalid)?)
         }

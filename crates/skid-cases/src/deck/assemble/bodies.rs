@@ -37,7 +37,7 @@ pub(super) fn rigid_bodies(defs: &Definitions, part: &Part) -> Result<Vec<Body>,
                     return Err(error(
                         &def.location,
                         format!(
-                            "*RIGID BODY: element {e} of ELSET={elset} is a deformable {kind:?}: only R2D2, R3D4, M3D4R, S4R and C3D4 elements are made rigid"
+                            "*RIGID BODY: element {e} of ELSET={elset} is a deformable {kind:?}: only R2D2, R3D3, R3D4, M3D4R, S4R and C3D4 elements are made rigid"
                         ),
                     ));
                 }
@@ -330,8 +330,10 @@ pub(super) fn all_facets(
         })
 }
 
-/// Facets of rigid elements in the body frame: lines and quadrilaterals must form a regular
-/// prism; tetrahedra give their exterior (or listed) faces as triangles.
+/// Facets of rigid elements in the body frame: lines and quadrilaterals that form a regular
+/// prism give a faceted cylinder; other lines one chain (a polyline), other quadrilaterals and
+/// triangles a triangle mesh (each quadrilateral split along its 1-3 diagonal, exact for flat
+/// ones); tetrahedra give their exterior (or listed) faces as triangles.
 pub(super) fn facets_surface(
     defs: &Definitions,
     part: &Part,
@@ -356,13 +358,6 @@ pub(super) fn facets_surface(
         if tets.len() != faces.len() {
             return Err("a surface mixes tetrahedra with other rigid elements".into());
         }
-        let axis = free_axis(dim, body).ok_or_else(|| {
-            format!(
-                "a triangulated surface takes its surface coordinates about its body's one free \
-                 rotation, and {} has none or several",
-                body.def.name
-            )
-        })?;
         // the tetrahedra's nodes, numbered in the order *NODE defines them
         let used: BTreeSet<u64> = tets
             .iter()
@@ -405,7 +400,8 @@ pub(super) fn facets_surface(
         }
         let (vertices, triangles_list) = compact_triangles(&mesh.nodes, &listed);
         let vertices = vertices.into_iter().map(Into::into).collect();
-        return Ok((triangles(vertices, triangles_list, axis), None));
+        let surface = triangles(vertices, triangles_list, free_axis(dim, body))?;
+        return Ok((surface, None));
     }
     let mut facets = Vec::new();
     for (e, face) in faces {
@@ -428,7 +424,7 @@ pub(super) fn facets_surface(
                     corners.reverse();
                 }
             }
-            ElementKind::R3d4 | ElementKind::M3d4r | ElementKind::S4r => {
+            ElementKind::R3d3 | ElementKind::R3d4 | ElementKind::M3d4r | ElementKind::S4r => {
                 if !positive {
                     corners.reverse();
                 }
@@ -441,7 +437,66 @@ pub(super) fn facets_surface(
         }
         facets.push(corners);
     }
-    prism(&facets, dim)
+    let regular = if facets.iter().all(|f| f.len() == 2 || f.len() == 4) {
+        prism(&facets, dim)
+    } else {
+        Err(String::new())
+    };
+    regular.or_else(|regular| {
+        // a regular prism facing its axis is refused, not read as a general surface
+        let reversed: Vec<Vec<Vector3<f64>>> = facets
+            .iter()
+            .map(|f| f.iter().rev().copied().collect())
+            .collect();
+        if !regular.is_empty() && prism(&reversed, dim).is_ok() {
+            return Err(regular);
+        }
+        let general = if dim == 2 {
+            let segments: Vec<[Vector3<f64>; 2]> = facets.iter().map(|f| [f[0], f[1]]).collect();
+            chain(&segments)
+        } else {
+            let mut corners: Vec<Vector3<f64>> = Vec::new();
+            let mut list = Vec::new();
+            for f in &facets {
+                let at = corners.len();
+                corners.extend(f.iter().copied());
+                list.push([at, at + 1, at + 2]);
+                if f.len() == 4 {
+                    list.push([at, at + 2, at + 3]);
+                }
+            }
+            let (vertices, list) = merge_corners(&corners, &list);
+            triangles(vertices, list, free_axis(dim, body))
+        };
+        general.map(|s| (s, None)).map_err(|general| {
+            if regular.is_empty() || dim == 2 {
+                general
+            } else {
+                format!("{general} (nor do the facets form a regular prism: {regular})")
+            }
+        })
+    })
+}
+
+/// The distinct points of `corners` (equal bits; corners of one node are), numbered in order of
+/// first appearance, and the triangles renumbered onto them.
+fn merge_corners(
+    corners: &[Vector3<f64>],
+    triangles: &[[usize; 3]],
+) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+    let mut number: HashMap<[u64; 3], usize> = HashMap::new();
+    let mut vertices = Vec::new();
+    let renumbered: Vec<usize> = corners
+        .iter()
+        .map(|c| {
+            *number.entry(c.map(f64::to_bits).into()).or_insert_with(|| {
+                vertices.push([c.x, c.y, c.z]);
+                vertices.len() - 1
+            })
+        })
+        .collect();
+    let triangles = triangles.iter().map(|t| t.map(|i| renumbered[i])).collect();
+    (vertices, triangles)
 }
 
 pub(super) fn check_axial_range(
