@@ -334,6 +334,23 @@ fn a_cylinder_is_drawn_about_its_final_reference_point() {
     }
 }
 
+/// A floor of three rigid lines is drawn as its polyline: its four points in the world frame
+/// (the floor does not move), three lines, the outside on the right of each.
+#[test]
+fn a_polyline_is_drawn_as_its_lines() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let file = "2d-block-dragged-on-lines-deck.inp";
+    let out = run_into(file, &["output.field_interval=1"], tmp.path());
+    let ground = body_grid(tmp.path(), &out, "ground");
+    let expected = [[2.0, 0.0], [0.0055, 0.0], [-0.0025, 0.0], [-2.0, 0.0]];
+    assert_eq!(ground.points.len(), expected.len());
+    for (p, e) in ground.points.iter().zip(expected) {
+        assert_eq!([p[0], p[1], p[2]], [e[0], e[1], 0.0]);
+    }
+    assert_eq!(ground.cells, [[0, 1], [1, 2], [2, 3]]);
+    assert!(ground.types.iter().all(|t| *t == CellType::Line));
+}
+
 /// Field output names files after the part and the drawn bodies: a name that is no file name,
 /// or two names of the same files, are refused with the field at fault, and only when field
 /// output is asked for.
