@@ -16,8 +16,8 @@
 //! `*CONTACT` with `*CONTACT INCLUSIONS, ALL EXTERIOR` and `*CONTACT PROPERTY ASSIGNMENT`,
 //! `*BOUNDARY` (OP=MOD/NEW and, on rigid bodies and part nodes, magnitudes with AMPLITUDE= in
 //! steps: see `assemble::motions`), `*INITIAL CONDITIONS` (VELOCITY, ROTATING VELOCITY),
-//! `*AMPLITUDE` (TABULAR, step or total time), `*STEP` (NLGEOM, AMPLITUDE=RAMP|STEP), `*STATIC` and `*DYNAMIC` (DIRECT,
-//! ALPHA), `*CLOAD`, `*DSLOAD` / `*DLOAD` pressures and `*DLOAD` gravity (`GRAV`), each with
+//! `*AMPLITUDE` (TABULAR, step or total time), `*STEP` (NLGEOM, AMPLITUDE=RAMP|STEP), `*STATIC` (DIRECT, or automatic
+//! increments without it) and `*DYNAMIC` (DIRECT, ALPHA), `*CLOAD`, `*DSLOAD` / `*DLOAD` pressures and `*DLOAD` gravity (`GRAV`), each with
 //! `AMPLITUDE=`, `*OUTPUT`, `*NODE OUTPUT`, `*CONTACT OUTPUT`,
 //! `*END STEP`, `*INCLUDE`. Anything else is an error at its line.
 //!

@@ -199,7 +199,8 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
                 regularization_time,
             } => ModelStepSpec::Static {
                 name: name.clone(),
-                increments: *increments,
+                increments: Some(*increments),
+                automatic: None,
                 regularization_time: *regularization_time,
                 time_period: None,
                 default_amplitude: None,

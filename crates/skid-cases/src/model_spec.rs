@@ -293,6 +293,21 @@ pub enum ChartSpec {
     },
 }
 
+/// Automatic increments of a static step, as fractions of the step (its time period is 1):
+/// the first `initial`; after two increments in a row that converge within 4 Newton iterations
+/// the size grows by 1.5, to at most `max`; a failed increment is cut back, and the step fails
+/// rather than go below `min`; the last increment ends on the step's end.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AutomaticIncrementsSpec {
+    /// First size, in `[min, max]`.
+    pub initial: f64,
+    /// Smallest size, `> 0`.
+    pub min: f64,
+    /// Largest size, `<= 1`.
+    pub max: f64,
+}
+
 /// A degree of freedom: translations `x`, `y`, `z`, rotations `rx`, `ry`, `rz`.
 #[derive(
     Clone, Copy, Debug, Deserialize, Serialize, JsonSchema, PartialEq, Eq, PartialOrd, Ord,
@@ -556,8 +571,12 @@ pub enum ModelStepSpec {
     Static {
         /// Step name.
         name: String,
-        /// Number of increments.
-        increments: usize,
+        /// Number of equal increments (exactly one of `increments` and `automatic`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        increments: Option<usize>,
+        /// Increments sized by Newton's effort (exactly one of `increments` and `automatic`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        automatic: Option<AutomaticIncrementsSpec>,
         /// Time scale of the Newton regularisation `M/h_s^2`, s.
         #[serde(default = "default_regularization_time")]
         regularization_time: f64,

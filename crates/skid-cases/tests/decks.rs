@@ -174,7 +174,7 @@ fn a_deck_written_by_hand_reads_to_the_drum_model() {
                 ..
             },
         ) => {
-            assert_eq!(*increments, 5);
+            assert_eq!(*increments, Some(5));
             assert_eq!(boundary.len(), 1);
             assert_eq!((*duration, *dt, *alpha), (0.15, 1e-4, -0.3));
             assert!(dynamic_boundary.is_empty());
@@ -209,7 +209,7 @@ fn variant(from: &str, to: &str) -> Result<skid_cases::deck::DeckModel, String> 
 
 #[test]
 fn keywords_parameters_and_values_outside_the_subset_are_errors_at_their_line() {
-    let cases: [(&str, &str, &[&str]); 19] = [
+    let cases: [(&str, &str, &[&str]); 20] = [
         (
             "*Density\n",
             "*Plastic\n 1.\n*Density\n",
@@ -240,7 +240,16 @@ fn keywords_parameters_and_values_outside_the_subset_are_errors_at_their_line() 
             "drum_ref, 6, 6, 0.1\n*Dsload",
             &["prescribed here but free in step 2 (spin-down)"],
         ),
-        ("*Static, direct", "*Static", &["*STATIC", "add DIRECT"]),
+        (
+            "*Dynamic, direct",
+            "*Dynamic",
+            &["*DYNAMIC", "half-increment residual", "add DIRECT"],
+        ),
+        (
+            "*Static, direct\n 0.2, 1.",
+            "*Static\n 0.2, 1., 0.5",
+            &["*STATIC", "0 < min <= initial <= max <= period", "min 0.5"],
+        ),
         (
             "*End Step\n**\n*Step, name=spin-down",
             "**\n*Step, name=spin-down",
@@ -516,7 +525,7 @@ ground, ENCASTRE
             boundary,
             ..
         } => {
-            assert_eq!(*increments, 4);
+            assert_eq!(*increments, Some(4));
             // ENCASTRE on a 2D body: x (y and rz are held by the model data)
             assert_eq!(boundary[0].dofs, Some(vec![skid_cases::model_spec::Dof::X]));
         }
@@ -693,4 +702,43 @@ fn concentrated_loads_of_two_amplitudes_on_one_body_are_written_apart() {
     let message = skid_cases::deck::write::write_deck(&model, &Default::default())
         .expect_err("two loads on y");
     assert!(message.contains("loads[0] and loads[2]"), "{message}");
+}
+
+/// `*STATIC` without `DIRECT` is automatic incrementation: the data line `initial, period,
+/// min, max` read as fractions of the period, with the keyword's defaults where absent
+/// (period 1, initial the period, min the smaller of initial and 1e-5 of the period, max the
+/// period); the writer writes it back the same way.
+#[test]
+fn automatic_static_incrementation_reads_with_the_keyword_defaults() {
+    let automatic = |data: &str| {
+        let model = variant("*Static, direct\n 0.2, 1.\n", &format!("*Static\n{data}"))
+            .expect("automatic static")
+            .model;
+        match &model.steps[0] {
+            ModelStepSpec::Static {
+                increments,
+                automatic,
+                time_period,
+                ..
+            } => {
+                assert_eq!(*increments, None);
+                let a = automatic.expect("automatic");
+                ((a.initial, a.min, a.max), *time_period, model)
+            }
+            other => panic!("{other:?}"),
+        }
+    };
+    let (sizes, period, _) = automatic(" 0.2, 1.\n");
+    assert_eq!((sizes, period), ((0.2, 1e-5, 1.0), None));
+    let (sizes, period, _) = automatic("");
+    assert_eq!((sizes, period), ((1.0, 1e-5, 1.0), None));
+    let (sizes, period, model) = automatic(" 0.5, 2., 0.01, 1.\n");
+    assert_eq!((sizes, period), ((0.25, 0.005, 0.5), Some(2.0)));
+    let written = skid_cases::deck::write::write_deck(&model, &Default::default()).expect("deck");
+    assert!(
+        written.contains("*STATIC\n0.5, 2.0, 0.01, 1.0\n"),
+        "{written}"
+    );
+    let read = read_text(&written).expect("reads back").model;
+    assert_eq!(read.steps, model.steps);
 }

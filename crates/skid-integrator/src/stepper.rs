@@ -43,10 +43,10 @@ use crate::state::{ContactPointState, EnergyLedger, State};
 /// What a step does.
 #[derive(Clone, Debug, PartialEq)]
 pub enum StepKind {
-    /// Static equilibrium, loads ramped to full value over `increments` increments.
+    /// Static equilibrium, loads ramped to full value over `increments`.
     Static {
-        /// Number of (nominal) increments.
-        increments: usize,
+        /// How the ramp is divided into increments.
+        increments: StaticIncrements,
         /// Time scale `h_s` of the mass regularisation `M/h_s^2` of the Newton tangent, s.
         regularization_time: f64,
     },
@@ -60,6 +60,32 @@ pub enum StepKind {
         alpha: f64,
         /// Increments chosen by the local error (`None`: `dt` throughout, cut back on failure).
         adaptive: Option<Adaptive>,
+    },
+}
+
+/// Newton iterations within which an increment of an automatic static step counts as easy.
+pub const EASY_ITERATIONS: usize = 4;
+/// Growth of an automatic static step's increment after two easy increments in a row.
+pub const AUTOMATIC_GROWTH: f64 = 1.5;
+
+/// How a static step divides its load ramp (its progress from 0 to 1) into increments.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StaticIncrements {
+    /// `n` increments of `1/n`; a failed increment is cut back by the settings' factor (to at
+    /// least `min_fraction / n`) and the size grows back to `1/n` after successes.
+    Fixed(usize),
+    /// Sizes chosen by Newton's effort, as fractions of the step: the first `initial`; after two
+    /// increments in a row that converge within [`EASY_ITERATIONS`] Newton iterations the size
+    /// grows by [`AUTOMATIC_GROWTH`], to at most `max`; a failed increment is cut back by the
+    /// settings' factor, and the step fails rather than go below `min`. The last increment is
+    /// shortened to end on the step's end.
+    Automatic {
+        /// First size, in `[min, max]`.
+        initial: f64,
+        /// Smallest size, `> 0`.
+        min: f64,
+        /// Largest size, `<= 1`.
+        max: f64,
     },
 }
 
@@ -369,7 +395,8 @@ pub struct StepPosition {
     pub progress: f64,
     /// Size of the next increment, as a fraction of the step.
     pub size: f64,
-    /// Successful increments since the last cutback or growth of the size.
+    /// Successful increments since the last cutback or growth of the size (of an automatic
+    /// static step, easy ones in a row).
     pub successes: usize,
     /// Converged increments of the step so far.
     pub increment: usize,
@@ -704,8 +731,22 @@ fn validate_steps<const D: usize>(model: &Model<D>, steps: &[Step]) -> Result<()
                 increments,
                 regularization_time,
             } => {
-                if increments == 0 {
-                    return bad(s, "a static step needs at least one increment".into());
+                match increments {
+                    StaticIncrements::Fixed(0) => {
+                        return bad(s, "a static step needs at least one increment".into());
+                    }
+                    StaticIncrements::Fixed(_) => {}
+                    StaticIncrements::Automatic { initial, min, max } => {
+                        if !(min > 0.0 && min <= initial && initial <= max && max <= 1.0) {
+                            return bad(
+                                s,
+                                format!(
+                                    "automatic increments need 0 < min <= initial <= max <= 1, \
+                                     got min {min}, initial {initial}, max {max}"
+                                ),
+                            );
+                        }
+                    }
                 }
                 if !(regularization_time.is_finite() && regularization_time > 0.0) {
                     return bad(
@@ -939,8 +980,20 @@ impl<const D: usize> Run<'_, D> {
         for (eq, _) in model.prescribed() {
             held[*eq] = true;
         }
+        // an automatic static step's smallest and largest sizes
+        let mut automatic = None;
         let (nominal, span, adaptive) = match step.kind {
-            StepKind::Static { increments, .. } => (1.0 / increments as f64, 1.0, None),
+            StepKind::Static {
+                increments: StaticIncrements::Fixed(n),
+                ..
+            } => (1.0 / n as f64, 1.0, None),
+            StepKind::Static {
+                increments: StaticIncrements::Automatic { initial, min, max },
+                ..
+            } => {
+                automatic = Some((min, max));
+                (initial, 1.0, None)
+            }
             StepKind::Dynamic {
                 duration,
                 dt,
@@ -964,8 +1017,11 @@ impl<const D: usize> Run<'_, D> {
             }
         }
         // With adaptive increments the size may shrink to `min_dt`.
-        let smallest =
-            adaptive.map_or(nominal * settings.cutback.min_fraction, |a| a.min_dt / span);
+        let smallest = match (adaptive, automatic) {
+            (Some(a), _) => a.min_dt / span,
+            (None, Some((min, _))) => min,
+            (None, None) => nominal * settings.cutback.min_fraction,
+        };
         let memory = position.as_ref().and_then(|p| p.adaptive.as_ref());
         let mut adaptive = adaptive.map(|control| AdaptiveRun::new(control, memory, n));
         let StepPosition {
@@ -1075,6 +1131,13 @@ impl<const D: usize> Run<'_, D> {
                     successes += 1;
                     if let Some(next) = next_size {
                         size = next;
+                    } else if let Some((_, max)) = automatic {
+                        if counters.newton_iterations > EASY_ITERATIONS {
+                            successes = 0;
+                        } else if successes >= 2 {
+                            size = (size * AUTOMATIC_GROWTH).min(max);
+                            successes = 0;
+                        }
                     } else if size < nominal && successes >= settings.cutback.growth_after {
                         size = (size * settings.cutback.growth_factor).min(nominal);
                         successes = 0;

@@ -9,7 +9,8 @@ use skid_contact::plane::RigidPlane;
 use skid_integrator::settings::ContactSolve;
 use skid_integrator::settings::Settings;
 use skid_integrator::stepper::{
-    Adaptive, Checkpoint, IncrementReport, Observer, RunStatistics, Step, StepKind, resume, run,
+    Adaptive, Checkpoint, IncrementReport, Observer, RunStatistics, StaticIncrements, Step,
+    StepKind, resume, run,
 };
 use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie, Variation};
 
@@ -108,7 +109,7 @@ fn simulate(
             Step {
                 name: "preload".into(),
                 kind: StepKind::Static {
-                    increments: 4,
+                    increments: StaticIncrements::Fixed(4),
                     regularization_time: 1e-2,
                 },
                 held: vec![],
@@ -366,7 +367,7 @@ fn resumes_bit_for_bit(side_force: f64, first: usize) {
         Step {
             name: "preload".into(),
             kind: StepKind::Static {
-                increments: 3,
+                increments: StaticIncrements::Fixed(3),
                 regularization_time: 1e-2,
             },
             held: vec![],

@@ -7,7 +7,7 @@ use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 use skid_integrator::Section;
 use skid_integrator::settings::Settings;
-use skid_integrator::stepper::{IncrementReport, Observer, Step, StepKind, run};
+use skid_integrator::stepper::{IncrementReport, Observer, StaticIncrements, Step, StepKind, run};
 use skid_integrator::{Model, PressureLoad, SolidPart, State, Tie, Variation};
 
 const LENGTH: f64 = 0.1;
@@ -80,7 +80,7 @@ fn tip_deflection(k_over_mu: f64) -> f64 {
     let steps = [Step {
         name: "load".into(),
         kind: StepKind::Static {
-            increments: 1,
+            increments: StaticIncrements::Fixed(1),
             regularization_time: 1.0,
         },
         held: vec![],

@@ -10,7 +10,7 @@ mod common;
 use nalgebra::Vector3;
 use skid_contact::plane::RigidPlane;
 use skid_integrator::settings::Settings;
-use skid_integrator::stepper::{IncrementReport, Observer, Step, StepKind, run};
+use skid_integrator::stepper::{IncrementReport, Observer, StaticIncrements, Step, StepKind, run};
 use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie, Variation};
 
 const LENGTH: f64 = 0.1;
@@ -79,7 +79,7 @@ fn load(model: &Model<2>, regularization_time: f64, settle: usize) -> State {
     let mut steps = vec![Step {
         name: "preload".into(),
         kind: StepKind::Static {
-            increments: 4,
+            increments: StaticIncrements::Fixed(4),
             regularization_time,
         },
         held: vec![],

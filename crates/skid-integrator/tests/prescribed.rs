@@ -11,7 +11,7 @@ mod common;
 use nalgebra::{SVector, Vector3};
 use skid_contact::plane::RigidPlane;
 use skid_integrator::settings::Settings;
-use skid_integrator::stepper::{IncrementReport, Observer, Step, StepKind, run};
+use skid_integrator::stepper::{IncrementReport, Observer, StaticIncrements, Step, StepKind, run};
 use skid_integrator::{
     Amplitude, BodyMotion, ConcentratedLoad, ContactPair, LoadTarget, Loads, Model, MotionTarget,
     PrescribedMotion, State, StepVariation, Tie, Variation,
@@ -92,7 +92,7 @@ fn steps() -> Vec<Step> {
         Step {
             name: "press".into(),
             kind: StepKind::Static {
-                increments: 4,
+                increments: StaticIncrements::Fixed(4),
                 regularization_time: 1e-2,
             },
             held: vec![],

@@ -16,7 +16,9 @@ use skid_contact::plane::RigidPlane;
 use skid_fem::rigid::RigidBody;
 use skid_integrator::settings::ContactSolve;
 use skid_integrator::settings::Settings;
-use skid_integrator::stepper::{HeldMotion, IncrementReport, Observer, Step, StepKind, run};
+use skid_integrator::stepper::{
+    HeldMotion, IncrementReport, Observer, StaticIncrements, Step, StepKind, run,
+};
 use skid_integrator::{ContactPair, Model, PressureLoad, State, Tie, Variation};
 
 const MU: f64 = 0.3;
@@ -90,7 +92,7 @@ fn slide(dt: f64, method: ContactSolve) -> Vec<State> {
         Step {
             name: "preload".into(),
             kind: StepKind::Static {
-                increments: 4,
+                increments: StaticIncrements::Fixed(4),
                 regularization_time: 1e-2,
             },
             held: vec![HeldMotion::body(0)],

@@ -8,7 +8,7 @@ mod common;
 
 use nalgebra::SVector;
 use skid_integrator::settings::Settings;
-use skid_integrator::stepper::{IncrementReport, Observer, Step, StepKind, run};
+use skid_integrator::stepper::{IncrementReport, Observer, StaticIncrements, Step, StepKind, run};
 use skid_integrator::{
     Amplitude, ConcentratedLoad, LoadTarget, Loads, Model, RunError, State, StepVariation, Tie,
     Variation,
@@ -58,7 +58,7 @@ fn static_step(name: &str, increments: usize) -> Step {
     Step {
         name: name.into(),
         kind: StepKind::Static {
-            increments,
+            increments: StaticIncrements::Fixed(increments),
             regularization_time: 1.0,
         },
         held: vec![],
@@ -185,5 +185,75 @@ fn a_variation_for_another_number_of_steps_is_refused() {
             "{message}"
         ),
         other => panic!("expected the steps to be refused, got {other:?}"),
+    }
+}
+
+/// Automatic increments of a static step: they start at the initial size, grow by 1.5 after
+/// two easy increments (this linear-ish bending converges in a few Newton iterations), land on
+/// the step's end, and reach the equilibrium of fixed increments; invalid sizes are refused.
+#[test]
+fn automatic_static_increments_grow_and_land_on_the_step_end() {
+    let automatic = |initial: f64, min: f64, max: f64| Step {
+        name: "load".into(),
+        kind: StepKind::Static {
+            increments: StaticIncrements::Automatic { initial, min, max },
+            regularization_time: 1.0,
+        },
+        held: vec![],
+    };
+    let (model, tip) = cantilever(Variation::PerStep(vec![ramp(0.0, 2.0)]));
+    let mut record = Record::default();
+    let (_, result) = run(
+        &model,
+        &[automatic(0.1, 1e-5, 0.4)],
+        &Settings::default(),
+        &mut record,
+    );
+    let end = result.expect("automatic increments converge");
+    let factors: Vec<f64> = record
+        .0
+        .iter()
+        .filter(|(name, _)| name == "load")
+        .map(|(_, state)| applied_factor(&model, &tip, state) / 2.0)
+        .collect();
+    let sizes: Vec<f64> = std::iter::once(0.0)
+        .chain(factors.iter().copied())
+        .collect::<Vec<_>>()
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .collect();
+    assert!((sizes[0] - 0.1).abs() < 1e-12, "{sizes:?}");
+    assert!(sizes.iter().all(|s| *s <= 0.4 + 1e-12), "{sizes:?}");
+    assert!(
+        sizes.windows(2).any(|w| w[1] > 1.4 * w[0]),
+        "the size grows: {sizes:?}"
+    );
+    assert!(sizes.len() < 10, "fewer than fixed 0.1 steps: {sizes:?}");
+    assert_eq!(*factors.last().expect("increments"), 1.0);
+    let mut fixed = Record::default();
+    let (_, result) = run(
+        &model,
+        &[static_step("load", 10)],
+        &Settings::default(),
+        &mut fixed,
+    );
+    let reference = result.expect("fixed increments converge");
+    let (a, b) = (
+        deflection(&model, &tip, &end),
+        deflection(&model, &tip, &reference),
+    );
+    assert!((a - b).abs() < 1e-6 * b.abs(), "{a} against {b}");
+
+    for (initial, min, max) in [(0.5, 0.6, 1.0), (0.1, 0.0, 1.0), (0.5, 0.1, 1.5)] {
+        let (_, result) = run(
+            &model,
+            &[automatic(initial, min, max)],
+            &Settings::default(),
+            &mut Record::default(),
+        );
+        assert!(
+            matches!(&result, Err(RunError::Invalid(m)) if m.contains("0 < min <= initial")),
+            "{result:?}"
+        );
     }
 }

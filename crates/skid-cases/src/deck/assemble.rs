@@ -18,9 +18,9 @@ use super::read::{
 };
 use super::rigid::{chain, prism, triangles};
 use crate::model_spec::{
-    BoundarySpec, ContactPairSpec, Dof, ElementBlockSpec, ElementType, LoadSpec,
-    MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, NodeVelocitySpec, PartSpec, RigidBodySpec,
-    RigidSurfaceSpec, SectionSpec, SlaveSpec, StepBoundarySpec, TieSpec,
+    AutomaticIncrementsSpec, BoundarySpec, ContactPairSpec, Dof, ElementBlockSpec, ElementType,
+    LoadSpec, MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, NodeVelocitySpec, PartSpec,
+    RigidBodySpec, RigidSurfaceSpec, SectionSpec, SlaveSpec, StepBoundarySpec, TieSpec,
 };
 use crate::schema::{OutputSpec, SolverSpec, default_regularization_time};
 

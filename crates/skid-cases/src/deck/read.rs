@@ -151,12 +151,15 @@ pub enum InitialDef {
 /// Step procedures.
 #[derive(Clone, Debug)]
 pub enum Procedure {
-    /// `*STATIC, DIRECT`: `initial` increment over `period`.
+    /// `*STATIC`: `initial` increment over `period`; with `DIRECT` fixed, without it automatic
+    /// between `[min, max]`.
     Static {
-        /// Increment.
+        /// Increment (the first one if automatic).
         initial: f64,
         /// Step period.
         period: f64,
+        /// Smallest and largest increment of automatic incrementation (`None`: `DIRECT`).
+        automatic: Option<[f64; 2]>,
     },
     /// `*DYNAMIC, DIRECT`.
     Dynamic {
@@ -974,6 +977,41 @@ fn start_step(defs: &Definitions, block: &Block) -> Result<StepDef, DeckError> {
     })
 }
 
+/// `*STATIC` without `DIRECT`: automatic incrementation, from the optional data line
+/// `initial, period, min, max` with the keyword's defaults: period 1, initial the period, min
+/// the smaller of initial and `1e-5` of the period, max the period.
+fn automatic_static(block: &Block) -> Result<Procedure, DeckError> {
+    let line = match block.data.as_slice() {
+        [] => None,
+        [line] => Some(line),
+        _ => return Err(block.error("expected one data line: 'initial, period, min, max'")),
+    };
+    let value = |i: usize, what: &str| -> Result<Option<f64>, DeckError> {
+        match line {
+            Some(line) if field(line, i).is_some() => real(block, line, i, what).map(Some),
+            _ => Ok(None),
+        }
+    };
+    if let Some(line) = line {
+        at_most(block, line, 4)?;
+    }
+    let period = value(1, "time period")?.unwrap_or(1.0);
+    let initial = value(0, "initial increment")?.unwrap_or(period);
+    let min = value(2, "minimum increment")?.unwrap_or(initial.min(1e-5 * period));
+    let max = value(3, "maximum increment")?.unwrap_or(period);
+    if !(period > 0.0 && min > 0.0 && min <= initial && initial <= max && max <= period) {
+        return Err(block.error(format!(
+            "automatic increments need 0 < min <= initial <= max <= period, got initial \
+             {initial}, period {period}, min {min}, max {max}"
+        )));
+    }
+    Ok(Procedure::Static {
+        initial,
+        period,
+        automatic: Some([min, max]),
+    })
+}
+
 fn read_step_block(
     defs: &mut Definitions,
     step: &mut StepDef,
@@ -1001,11 +1039,16 @@ fn read_step_block(
                     &["DIRECT"]
                 },
             )?;
-            if !flag(block, "DIRECT")? {
+            let direct = flag(block, "DIRECT")?;
+            if dynamic && !direct {
                 return Err(block.error(
-                    "automatic incrementation is not read: add DIRECT (fixed increments of the \
-                     initial size)",
+                    "automatic time incrementation of *DYNAMIC (by the half-increment residual) \
+                     is not read: add DIRECT (fixed increments of the initial size)",
                 ));
+            }
+            if !direct {
+                step.procedure = Some((automatic_static(block)?, block.location.clone()));
+                return Ok(());
             }
             let [line] = block.data.as_slice() else {
                 return Err(block.error("expected one data line: 'increment, period'"));
@@ -1023,6 +1066,7 @@ fn read_step_block(
                 Procedure::Static {
                     initial: increment,
                     period,
+                    automatic: None,
                 }
             };
             step.procedure = Some((procedure, block.location.clone()));

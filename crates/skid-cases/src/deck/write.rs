@@ -338,6 +338,7 @@ pub fn write_deck(
         match step {
             ModelStepSpec::Static {
                 increments,
+                automatic,
                 regularization_time,
                 time_period,
                 ..
@@ -346,12 +347,31 @@ pub fn write_deck(
                     return Err(format!("steps[{i}].regularization_time has no keyword"));
                 }
                 let period = time_period.unwrap_or(1.0);
-                let _ = writeln!(
-                    out,
-                    "*STATIC, DIRECT\n{}, {}",
-                    num(period / *increments as f64),
-                    num(period)
-                );
+                match (increments, automatic) {
+                    (Some(n), None) => {
+                        let _ = writeln!(
+                            out,
+                            "*STATIC, DIRECT\n{}, {}",
+                            num(period / *n as f64),
+                            num(period)
+                        );
+                    }
+                    (None, Some(a)) => {
+                        let _ = writeln!(
+                            out,
+                            "*STATIC\n{}, {}, {}, {}",
+                            num(a.initial * period),
+                            num(period),
+                            num(a.min * period),
+                            num(a.max * period)
+                        );
+                    }
+                    _ => {
+                        return Err(format!(
+                            "steps[{i}]: give exactly one of increments and automatic"
+                        ));
+                    }
+                }
             }
             ModelStepSpec::Dynamic {
                 duration,

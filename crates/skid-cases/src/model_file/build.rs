@@ -16,7 +16,7 @@ use skid_fem::rigid::RigidBody;
 use skid_integrator::BodyMotion;
 use skid_integrator::settings::{ContactSolve, NewtonSettings};
 use skid_integrator::settings::{CutbackSettings, Settings};
-use skid_integrator::stepper::{Adaptive, HeldMotion, Step, StepKind};
+use skid_integrator::stepper::{Adaptive, HeldMotion, StaticIncrements, Step, StepKind};
 use skid_integrator::{ContactPair, Model, Section, SolidPart, Tie};
 
 mod loads;
@@ -764,19 +764,45 @@ fn step<const D: usize>(
     let kind = match spec {
         ModelStepSpec::Static {
             increments,
+            automatic,
             regularization_time,
             time_period,
             ..
         } => {
-            if *increments == 0 {
-                return fail(f("increments"), "expected at least 1");
-            }
+            let increments = match (increments, automatic) {
+                (Some(0), None) => return fail(f("increments"), "expected at least 1"),
+                (Some(n), None) => StaticIncrements::Fixed(*n),
+                (None, Some(a)) => {
+                    let ok = a.min > 0.0 && a.min <= a.initial && a.initial <= a.max;
+                    if !(ok && a.max <= 1.0) {
+                        return fail(
+                            f("automatic"),
+                            format!(
+                                "expected 0 < min <= initial <= max <= 1, got min {}, initial \
+                                 {}, max {}",
+                                a.min, a.initial, a.max
+                            ),
+                        );
+                    }
+                    StaticIncrements::Automatic {
+                        initial: a.initial,
+                        min: a.min,
+                        max: a.max,
+                    }
+                }
+                _ => {
+                    return fail(
+                        f("increments"),
+                        "expected exactly one of increments (fixed) and automatic",
+                    );
+                }
+            };
             positive(&f("regularization_time"), *regularization_time)?;
             if let Some(period) = time_period {
                 positive(&f("time_period"), *period)?;
             }
             StepKind::Static {
-                increments: *increments,
+                increments,
                 regularization_time: *regularization_time,
             }
         }

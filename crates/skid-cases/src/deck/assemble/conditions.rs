@@ -349,7 +349,30 @@ pub(super) fn step_spec(
         ));
     };
     Ok(match procedure {
-        Procedure::Static { initial, period } => {
+        Procedure::Static {
+            initial,
+            period,
+            automatic: Some([min, max]),
+        } => ModelStepSpec::Static {
+            name: step.name.clone(),
+            increments: None,
+            automatic: Some(AutomaticIncrementsSpec {
+                initial: initial / period,
+                min: min / period,
+                max: max / period,
+            }),
+            regularization_time: default_regularization_time(),
+            time_period: (*period != 1.0).then_some(*period),
+            default_amplitude: step
+                .default_amplitude
+                .filter(|&a| a == DefaultAmplitude::Step),
+            boundary,
+        },
+        Procedure::Static {
+            initial,
+            period,
+            automatic: None,
+        } => {
             let count = period / initial;
             let increments = count.round();
             if !(initial > &0.0 && period > &0.0)
@@ -359,14 +382,15 @@ pub(super) fn step_spec(
                 return Err(error(
                     location,
                     format!(
-                        "*STATIC: the period {period} must be a whole number (at most 1e7) of \
-                         increments {initial} (skid's static steps take fixed increments)"
+                        "*STATIC, DIRECT: the period {period} must be a whole number (at most \
+                         1e7) of increments {initial}"
                     ),
                 ));
             }
             ModelStepSpec::Static {
                 name: step.name.clone(),
-                increments: increments as usize,
+                increments: Some(increments as usize),
+                automatic: None,
                 regularization_time: default_regularization_time(),
                 time_period: (*period != 1.0).then_some(*period),
                 default_amplitude: step
