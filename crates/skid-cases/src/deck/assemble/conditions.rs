@@ -352,45 +352,23 @@ pub(super) fn step_spec(
         Procedure::Static {
             initial,
             period,
-            automatic: Some([min, max]),
-        } => ModelStepSpec::Static {
-            name: step.name.clone(),
-            increments: None,
-            automatic: Some(AutomaticIncrementsSpec {
-                initial: initial / period,
-                min: min / period,
-                max: max / period,
-            }),
-            regularization_time: default_regularization_time(),
-            time_period: (*period != 1.0).then_some(*period),
-            default_amplitude: step
-                .default_amplitude
-                .filter(|&a| a == DefaultAmplitude::Step),
-            boundary,
-        },
-        Procedure::Static {
-            initial,
-            period,
-            automatic: None,
+            automatic,
         } => {
-            let count = period / initial;
-            let increments = count.round();
-            if !(initial > &0.0 && period > &0.0)
-                || (count - increments).abs() > 1e-9 * count
-                || increments > 1e7
-            {
-                return Err(error(
-                    location,
-                    format!(
-                        "*STATIC, DIRECT: the period {period} must be a whole number (at most \
-                         1e7) of increments {initial}"
-                    ),
-                ));
-            }
+            let (increments, automatic) = match automatic {
+                Some([min, max]) => (
+                    None,
+                    Some(AutomaticIncrementsSpec {
+                        initial: initial / period,
+                        min: min / period,
+                        max: max / period,
+                    }),
+                ),
+                None => (Some(direct_increments(*initial, *period, location)?), None),
+            };
             ModelStepSpec::Static {
                 name: step.name.clone(),
-                increments: Some(increments as usize),
-                automatic: None,
+                increments,
+                automatic,
                 regularization_time: default_regularization_time(),
                 time_period: (*period != 1.0).then_some(*period),
                 default_amplitude: step
@@ -411,6 +389,25 @@ pub(super) fn step_spec(
                 .filter(|&a| a == DefaultAmplitude::Ramp),
         },
     })
+}
+
+/// The number of increments of `*STATIC, DIRECT`: the period must be a whole number of them.
+fn direct_increments(initial: f64, period: f64, location: &Location) -> Result<usize, DeckError> {
+    let count = period / initial;
+    let increments = count.round();
+    if !(initial > 0.0 && period > 0.0)
+        || (count - increments).abs() > 1e-9 * count
+        || increments > 1e7
+    {
+        return Err(error(
+            location,
+            format!(
+                "*STATIC, DIRECT: the period {period} must be a whole number (at most 1e7) of \
+                 increments {initial}"
+            ),
+        ));
+    }
+    Ok(increments as usize)
 }
 
 /// The model's field interval from the steps' `*OUTPUT, FIELD` requests (skid writes one
