@@ -13,6 +13,7 @@
 //! - [`newton`]: the Newton residuals of every increment (`newton.csv`);
 //! - [`atomic`]: output files that are complete or absent (written aside, then renamed);
 //! - [`csv_out`]: CSV tables, written quoted and complete-or-absent, read by column name;
+//! - [`spin_down`]: stop time, deceleration and post-stop motion from a body's rotation;
 //! - [`summary`]: stop time, spin-down straightness, post-stop motion, energy balance;
 //! - [`fields`]: ParaView field output (VTU frames and a PVD collection);
 //! - [`scene`]: any input read and built into the scene that is run;
@@ -46,6 +47,7 @@ pub mod restart;
 pub mod runner;
 pub mod scene;
 pub mod schema;
+pub mod spin_down;
 pub mod summary;
 pub mod sweep;
 pub mod validate;

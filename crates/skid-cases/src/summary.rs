@@ -7,6 +7,7 @@ use skid_integrator::{RunError, RunStatistics};
 use crate::history::Sample;
 use crate::model_file::summary::{RunCost, dissipation_warning};
 use crate::schema::Case;
+use crate::spin_down::{SpinDown, SpinPoint, window};
 
 /// `summary.json`.
 #[derive(Clone, Debug, Serialize, PartialEq)]
@@ -71,34 +72,6 @@ pub struct Summary {
     pub max_sliding_separation_m: f64,
 }
 
-/// Linear interpolation of `f` at the first time `omega` crosses zero (from the sign of omega0).
-fn first_stop(samples: &[&Sample], omega0: f64) -> Option<(f64, f64)> {
-    let sign = omega0.signum();
-    samples.windows(2).find_map(|w| {
-        let (a, b) = (w[0], w[1]);
-        (a.omega * sign > 0.0 && b.omega * sign <= 0.0).then(|| {
-            let s = a.omega / (a.omega - b.omega);
-            (
-                a.time + s * (b.time - a.time),
-                a.angle + s * (b.angle - a.angle),
-            )
-        })
-    })
-}
-
-/// Least-squares slope of omega(t).
-fn slope(samples: &[&Sample]) -> Option<f64> {
-    let n = samples.len() as f64;
-    if samples.len() < 2 {
-        return None;
-    }
-    let mt = samples.iter().map(|s| s.time).sum::<f64>() / n;
-    let mw = samples.iter().map(|s| s.omega).sum::<f64>() / n;
-    let sxy: f64 = samples.iter().map(|s| (s.time - mt) * (s.omega - mw)).sum();
-    let sxx: f64 = samples.iter().map(|s| (s.time - mt).powi(2)).sum();
-    (sxx > 0.0).then(|| sxy / sxx)
-}
-
 /// Computes the summary from the recorded samples and run statistics; `error` is why the run
 /// stopped early, if it did.
 pub fn summarize(
@@ -123,40 +96,33 @@ pub fn summarize(
         None => Vec::new(),
     };
     let t0 = dynamic.first().map_or(0.0, |s| s.time);
-    let stop = first_stop(&dynamic, omega0);
-    let t_stop = stop.map(|(t, _)| t - t0);
-    let window = |lo: f64, hi: f64| -> Vec<&Sample> {
-        dynamic
-            .iter()
-            .copied()
-            .filter(|s| s.time - t0 >= lo && s.time - t0 <= hi)
-            .collect()
-    };
-    let sliding = match t_stop {
-        Some(ts) => window(0.1 * ts, 0.9 * ts),
-        None => dynamic.clone(),
-    };
-    let deceleration = slope(&sliding).map(|s| -s * omega0.signum());
+    let points: Vec<SpinPoint> = dynamic
+        .iter()
+        .map(|s| SpinPoint {
+            time: s.time,
+            angle: s.angle,
+            omega: s.omega,
+        })
+        .collect();
+    let spin = SpinDown::measure(&points, omega0);
+    let t_stop = spin.t_stop;
     let e_slide_analytic = t_stop.map(|ts| {
-        window(0.0, 0.9 * ts)
+        window(&points, 0.0, 0.9 * ts)
             .iter()
-            .map(|s| {
-                let reference = omega0 - omega0.signum() * decel_analytic * (s.time - t0);
-                (s.omega - reference).abs() / omega0.abs()
+            .map(|p| {
+                let reference = omega0 - omega0.signum() * decel_analytic * (p.time - t0);
+                (p.omega - reference).abs() / omega0.abs()
             })
             .fold(0.0, f64::max)
     });
-    let after: Vec<&Sample> = match stop {
-        Some((ts, _)) => dynamic.iter().copied().filter(|s| s.time > ts).collect(),
-        None => Vec::new(),
-    };
-    let post_omega = stop.map(|_| after.iter().map(|s| s.omega.abs()).fold(0.0, f64::max));
-    let post_angle = stop.map(|(_, angle)| {
-        after
+    let sliding: Vec<&Sample> = match t_stop {
+        Some(ts) => dynamic
             .iter()
-            .map(|s| (s.angle - angle).abs())
-            .fold(0.0, f64::max)
-    });
+            .copied()
+            .filter(|s| s.time - t0 >= 0.1 * ts && s.time - t0 <= 0.9 * ts)
+            .collect(),
+        None => dynamic.clone(),
+    };
     let mean_normal = (!sliding.is_empty() && t_stop.is_some())
         .then(|| sliding.iter().map(|s| s.normal_force).sum::<f64>() / sliding.len() as f64);
 
@@ -211,11 +177,11 @@ pub fn summarize(
         failure: error.map(|e| e.kind().to_string()),
         t_stop,
         omega0,
-        deceleration,
+        deceleration: spin.deceleration,
         deceleration_analytic: decel_analytic,
         e_slide_analytic,
-        post_stop_max_abs_omega: post_omega,
-        post_stop_max_angle_change: post_angle,
+        post_stop_max_abs_omega: spin.post_stop_max_abs_omega,
+        post_stop_max_angle_change: spin.post_stop_max_angle_change,
         mean_normal_force_sliding: mean_normal,
         final_time: samples.last().map_or(0.0, |s| s.time),
         cost: RunCost::from(stats),

@@ -2,7 +2,8 @@
 //! error, made from the outputs that runs wrote (this crate reads them; it runs nothing but the
 //! bench's own ladder of runs).
 //!
-//! The validation report reads runs (`<dir>/*/summary.json`, `history.csv`, `case.json`) and
+//! The validation report reads runs (`<dir>/*/summary.json`, `history.csv`, `case.json`; model
+//! runs of the drum scene through [`model_run`]) and
 //! writes a markdown report with SVG plots next to it. Its sections, each from its own
 //! directory of runs:
 //!
@@ -30,6 +31,7 @@ pub mod format;
 pub mod hard;
 pub mod hertz;
 pub mod markdown;
+pub mod model_run;
 pub mod moved_block;
 pub mod plot;
 pub mod scaling;
@@ -46,7 +48,7 @@ use format::Counts;
 
 use skid_cases::atomic::write_atomic;
 use skid_cases::csv_out::{CsvError, CsvTable};
-use skid_cases::runner::CASE_JSON;
+use skid_cases::runner::{CASE_JSON, MODEL_JSON};
 use skid_cases::schema::Case;
 
 /// The run used as reference when none is requested.
@@ -125,8 +127,9 @@ pub struct RunSummary {
     pub omega0: f64,
     /// Least-squares deceleration over `[0.1, 0.9] t_stop`, rad/s^2.
     pub deceleration: Option<f64>,
-    /// Deceleration of the analytic estimate, rad/s^2.
-    pub deceleration_analytic: f64,
+    /// Deceleration of the analytic estimate, rad/s^2 (a drum case's; `None` for a model run).
+    #[serde(default)]
+    pub deceleration_analytic: Option<f64>,
     /// Largest `|omega|` after the stop, rad/s.
     pub post_stop_max_abs_omega: Option<f64>,
     /// Largest angle change after the stop, rad.
@@ -183,23 +186,29 @@ pub struct Run {
 /// steps take no time, so their rows drop out. Rows beyond the shorter slice are ignored.
 pub fn dynamic_part(time: &[f64], omega: &[f64]) -> History {
     let n = time.len().min(omega.len());
-    let (time, omega) = (&time[..n], &omega[..n]);
-    let mut out = History::default();
+    let rows = dynamic_rows(&time[..n]);
+    let t0 = rows.first().map_or(0.0, |&r| time[r]);
+    History {
+        time: rows.iter().map(|&r| time[r] - t0).collect(),
+        omega: rows.iter().map(|&r| omega[r]).collect(),
+        non_finite: 0,
+    }
+}
+
+/// The rows [`dynamic_part`] keeps (none if time never advances).
+pub(crate) fn dynamic_rows(time: &[f64]) -> Vec<usize> {
     let Some(first) = time.windows(2).position(|w| w[1] > w[0]) else {
-        return out;
+        return Vec::new();
     };
-    let t0 = time[first];
-    out.time.push(0.0);
-    out.omega.push(omega[first]);
-    let mut last = t0;
-    for (&t, &w) in time.iter().zip(omega).skip(first + 1) {
+    let mut rows = vec![first];
+    let mut last = time[first];
+    for (r, &t) in time.iter().enumerate().skip(first + 1) {
         if t > last {
-            out.time.push(t - t0);
-            out.omega.push(w);
+            rows.push(r);
             last = t;
         }
     }
-    out
+    rows
 }
 
 /// Reads `history.csv` text ([`CsvTable`]: columns found by name, `time` and `drum_omega`) and
@@ -284,11 +293,15 @@ pub(crate) fn read(path: &Path) -> Result<String, ReportError> {
     })
 }
 
-/// Reads one run directory.
+/// Reads one run directory: a drum case's run, or a model run (`model.json`, no `case.json`:
+/// a model file or deck of the drum scene, see [`model_run`]).
 ///
 /// # Errors
 /// [`ReportError`] naming the file that is missing or malformed.
 pub fn load_run(dir: &Path) -> Result<Run, ReportError> {
+    if !dir.join(CASE_JSON).is_file() && dir.join(MODEL_JSON).is_file() {
+        return model_run::load(dir);
+    }
     let summary_path = dir.join("summary.json");
     let summary: RunSummary =
         serde_json::from_str(&read(&summary_path)?).map_err(|e| ReportError::Parse {
@@ -547,7 +560,7 @@ pub(crate) mod test_runs {
                 t_stop: (decel > 0.0).then(|| 60.0 / decel),
                 omega0: 60.0,
                 deceleration: Some(decel),
-                deceleration_analytic: 600.0,
+                deceleration_analytic: Some(600.0),
                 post_stop_max_abs_omega: Some(2.0),
                 post_stop_max_angle_change: Some(0.01),
                 energy_balance_error: Some(1e-3),

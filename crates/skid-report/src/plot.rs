@@ -154,11 +154,12 @@ pub fn plot_omega(runs: &[Run], reference: &Run, path: &Path) -> Result<(), Repo
             dashed: false,
         })
         .collect();
-    let (w0, decel) = (
-        reference.summary.omega0,
-        reference.summary.deceleration_analytic,
-    );
-    if decel.abs() > 0.0 {
+    let w0 = reference.summary.omega0;
+    if let Some(decel) = reference
+        .summary
+        .deceleration_analytic
+        .filter(|d| d.abs() > 0.0)
+    {
         curves.push(Curve {
             label: format!("analytic {w0} - {decel:.0} t"),
             points: vec![(0.0, w0), (w0 / decel, 0.0)],
