@@ -257,3 +257,44 @@ fn automatic_static_increments_grow_and_land_on_the_step_end() {
         );
     }
 }
+
+/// An automatic static step whose increments cannot converge (one Newton iteration allowed)
+/// is cut back by the settings' factor until the next size would fall below its minimum, and
+/// then fails with the size it last tried, rather than crawl on.
+#[test]
+fn automatic_static_increments_stop_at_their_minimum() {
+    let (model, _) = cantilever(Variation::PerStep(vec![ramp(0.0, 2.0)]));
+    let mut settings = Settings::default();
+    settings.newton.max_iterations = 1;
+    let step = Step {
+        name: "load".into(),
+        kind: StepKind::Static {
+            increments: StaticIncrements::Automatic {
+                initial: 0.5,
+                min: 0.1,
+                max: 1.0,
+            },
+            regularization_time: 1.0,
+        },
+        held: vec![],
+    };
+    let (_, result) = run(&model, &[step], &settings, &mut Record::default());
+    let factor = settings.cutback.factor;
+    let mut tried = vec![0.5];
+    while tried[tried.len() - 1] * factor >= 0.1 {
+        tried.push(tried[tried.len() - 1] * factor);
+    }
+    match result {
+        Err(RunError::StepFailed {
+            increment,
+            size,
+            cutbacks,
+            ..
+        }) => {
+            assert_eq!(increment, 1);
+            assert_eq!(size, tried[tried.len() - 1], "sizes tried {tried:?}");
+            assert_eq!(cutbacks, tried.len() - 1);
+        }
+        other => panic!("expected the step to fail at its minimum, got {other:?}"),
+    }
+}
