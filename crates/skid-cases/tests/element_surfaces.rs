@@ -65,7 +65,8 @@ fn ground(model: &ModelSpec) -> &RigidSurfaceSpec {
 
 /// A floor that runs flat then ramps up: as a bent `SEGMENTS` profile and as a chain of `R2D2`
 /// lines it is the same open polyline, its points in the body frame listed against the deck's
-/// direction of travel (a polyline's outside is on its right); the block pressed on it runs.
+/// direction of travel (a polyline's outside is on its right); the block pressed on it runs. A
+/// closed profile is a closed polyline, refused if it faces inwards.
 #[test]
 fn a_bent_profile_and_a_chain_of_rigid_lines_are_one_polyline() {
     let profile = "\
@@ -96,6 +97,30 @@ ground-lines, SPOS
     let dir = tempfile::tempdir().expect("tempdir");
     let summary = run_model(&from_lines, Path::new("block.inp"), dir.path()).expect("runs");
     assert!(summary.error.is_none(), "{:?}", summary.error);
+    // a closed profile: traversed clockwise it faces outwards, counter-clockwise inwards
+    let square = |ends: &str| {
+        block_2d(&format!(
+            "*Surface, name=ground, type=segments\nSTART, -1., -2.\n{ends}\n\
+             *Rigid Body, ref node=ground, analytical surface=ground"
+        ))
+    };
+    let clockwise = read_deck_text(&square(
+        "LINE, -1., -0.5\nLINE, 1., -0.5\nLINE, 1., -2.\nLINE, -1., -2.",
+    ))
+    .expect("clockwise square");
+    assert_eq!(
+        ground(&clockwise),
+        &RigidSurfaceSpec::Polyline {
+            points: vec![[1.0, -2.0], [1.0, -0.5], [-1.0, -0.5], [-1.0, -2.0]],
+            closed: true,
+        }
+    );
+    let inwards = square("LINE, 1., -2.\nLINE, 1., -0.5\nLINE, -1., -0.5\nLINE, -1., -2.");
+    assert_refused_at(
+        &inwards,
+        "*Surface, name=ground, type=segments",
+        "faces inwards",
+    );
 }
 
 /// Lines that loop back into themselves, merge, branch, fall into two chains, or face inwards

@@ -327,17 +327,15 @@ impl AnalyticalSurface {
         if closed {
             points.pop();
         }
-        Ok(RigidSurfaceSpec::Polyline {
-            points: points
-                .iter()
-                .rev()
-                .map(|p| {
-                    let y = self.global(p) - reference;
-                    [y.x, y.y]
-                })
-                .collect(),
-            closed,
-        })
+        let points = points
+            .iter()
+            .rev()
+            .map(|p| {
+                let y = self.global(p) - reference;
+                [y.x, y.y]
+            })
+            .collect();
+        outward_polyline(points, closed)
     }
 
     fn revolution(&self, reference: &Vector3<f64>) -> Result<RigidSurfaceSpec, String> {
@@ -664,22 +662,25 @@ pub fn chain(segments: &[[Vector3<f64>; 2]]) -> Result<RigidSurfaceSpec, String>
             segments.len()
         ));
     }
-    // a closed chain runs counter-clockwise (positive area) to face outwards
+    outward_polyline(points.iter().map(|p| [p.x, p.y]).collect(), closed)
+}
+
+/// The polyline through `points` (body frame), refused if it is closed and faces inwards
+/// (clockwise, negative area): a deck's closed rigid surfaces are contacted from outside.
+fn outward_polyline(points: Vec<[f64; 2]>, closed: bool) -> Result<RigidSurfaceSpec, String> {
     let area: f64 = (0..points.len())
         .map(|k| {
             let (a, b) = (points[k], points[(k + 1) % points.len()]);
-            a.x * b.y - b.x * a.y
+            a[0] * b[1] - b[0] * a[1]
         })
         .sum();
     if closed && area < 0.0 {
         return Err(
             "the closed chain of rigid lines faces inwards: skid's closed rigid surfaces are \
-             contacted from outside (use the other side, SPOS or SNEG)"
+             contacted from outside (traverse it the other way, or use the other side, SPOS or \
+             SNEG)"
                 .into(),
         );
     }
-    Ok(RigidSurfaceSpec::Polyline {
-        points: points.iter().map(|p| [p.x, p.y]).collect(),
-        closed,
-    })
+    Ok(RigidSurfaceSpec::Polyline { points, closed })
 }

@@ -437,45 +437,45 @@ pub(super) fn facets_surface(
         }
         facets.push(corners);
     }
-    let regular = if facets.iter().all(|f| f.len() == 2 || f.len() == 4) {
-        prism(&facets, dim)
-    } else {
-        Err(String::new())
-    };
-    regular.or_else(|regular| {
-        // a regular prism facing its axis is refused, not read as a general surface
+    // why the facets are no regular prism, if they are lines or quadrilaterals
+    let mut not_prism = None;
+    if facets.iter().all(|f| f.len() == 2 || f.len() == 4) {
         let reversed: Vec<Vec<Vector3<f64>>> = facets
             .iter()
             .map(|f| f.iter().rev().copied().collect())
             .collect();
-        if !regular.is_empty() && prism(&reversed, dim).is_ok() {
-            return Err(regular);
+        match prism(&facets, dim) {
+            Ok(found) => return Ok(found),
+            // a regular prism facing its axis is refused, not read as a general surface
+            Err(why) if prism(&reversed, dim).is_ok() => return Err(why),
+            Err(why) => not_prism = Some(why),
         }
-        let general = if dim == 2 {
-            let segments: Vec<[Vector3<f64>; 2]> = facets.iter().map(|f| [f[0], f[1]]).collect();
-            chain(&segments)
-        } else {
-            let mut corners: Vec<Vector3<f64>> = Vec::new();
-            let mut list = Vec::new();
-            for f in &facets {
-                let at = corners.len();
-                corners.extend(f.iter().copied());
-                list.push([at, at + 1, at + 2]);
-                if f.len() == 4 {
-                    list.push([at, at + 2, at + 3]);
-                }
+    }
+    let general = if dim == 2 {
+        let segments: Vec<[Vector3<f64>; 2]> = facets.iter().map(|f| [f[0], f[1]]).collect();
+        chain(&segments)
+    } else {
+        let mut corners: Vec<Vector3<f64>> = Vec::new();
+        let mut list = Vec::new();
+        for f in &facets {
+            let at = corners.len();
+            corners.extend(f.iter().copied());
+            list.push([at, at + 1, at + 2]);
+            if f.len() == 4 {
+                list.push([at, at + 2, at + 3]);
             }
-            let (vertices, list) = merge_corners(&corners, &list);
-            triangles(vertices, list, free_axis(dim, body))
-        };
-        general.map(|s| (s, None)).map_err(|general| {
-            if regular.is_empty() || dim == 2 {
-                general
-            } else {
-                format!("{general} (nor do the facets form a regular prism: {regular})")
+        }
+        let (vertices, list) = merge_corners(&corners, &list);
+        triangles(vertices, list, free_axis(dim, body))
+    };
+    general
+        .map(|s| (s, None))
+        .map_err(|general| match not_prism {
+            Some(why) if dim == 3 => {
+                format!("{general} (nor do the facets form a regular prism: {why})")
             }
+            _ => general,
         })
-    })
 }
 
 /// The distinct points of `corners` (equal bits; corners of one node are), numbered in order of
