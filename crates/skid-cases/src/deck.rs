@@ -46,7 +46,9 @@
 //!   quadrilaterals (split along their 1-3 diagonal: exact when flat) and triangles a triangle
 //!   mesh whose surface coordinates are read on its plane if it is flat, else on a cylinder
 //!   about its body's one free rotation (see [`rigid`]); a bent `SEGMENTS` profile of lines
-//!   is a polyline, a straight one the unbounded line through its reference node;
+//!   is a polyline, a straight one the unbounded line through its reference node; a revolved
+//!   profile of lines at one radius is a cylinder, any other a surface of revolution (its axis
+//!   through the reference node);
 //! - a point rotary inertia counts about its body's one free rotation axis;
 //! - general contact makes every node of the part's exterior faces a candidate;
 //! - `*OUTPUT, FIELD` with `TIME INTERVAL=t` or `NUMBER INTERVAL=n` (the step's period over n)

@@ -255,6 +255,24 @@ pub enum RigidSurfaceSpec {
         #[serde(default)]
         closed: bool,
     },
+    /// A surface of revolution (3D): the `profile` of points `(r, z)` (`r >= 0` the distance
+    /// from `axis`, `z` the position along it; back to the first point if `closed`) revolved
+    /// about `axis` through the origin. Its outside is on the right walking along the profile
+    /// with `r` to the right and `z` up (the cylinder `r = R` is walked towards `+z`). The
+    /// surface coordinates are the angle about the axis times `radius` and the profile's arc
+    /// length, so that slip is a length where `r = radius`.
+    Revolution {
+        /// Axis direction.
+        axis: [f64; 3],
+        /// Profile points `[r, z]`, m.
+        profile: Vec<[f64; 2]>,
+        /// Whether the last point joins the first.
+        #[serde(default)]
+        closed: bool,
+        /// Radius of the circumferential coordinate, m (absent: the profile's largest `r`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        radius: Option<f64>,
+    },
     /// Triangles (3D), counter-clockwise seen from outside, with surface coordinates read on
     /// the `chart` at each closest point. Beyond an open mesh's boundary the gap is the signed
     /// distance to the boundary.

@@ -5,6 +5,7 @@
 //!   projections giving the signed gap and convected (arc-length, axial) coordinates.
 //! * [`plane`]: the analytical rigid plane (a line in 2D).
 //! * [`polyline`]: the rigid polyline in 2D (rigid line elements in a chain, open or closed).
+//! * [`revolution`]: a profile of straight segments revolved about an axis (3D).
 //! * [`facets`]: the faceted cylinder (rigid line, quad, membrane or shell facets of a drum).
 //! * [`triangles`]: triangulated surfaces (exterior faces of a tetrahedral drum).
 //! * [`kinematics`]: gap, convected coordinates and their exact first derivatives for a slave node
@@ -21,6 +22,7 @@ pub mod facets;
 pub mod kinematics;
 pub mod plane;
 pub mod polyline;
+pub mod revolution;
 pub mod surface;
 pub mod triangles;
 
@@ -36,5 +38,6 @@ pub use kinematics::{
 };
 pub use plane::RigidPlane;
 pub use polyline::RigidPolyline;
+pub use revolution::RigidRevolution;
 pub use surface::{AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, SurfaceShape};
 pub use triangles::{CylinderChart, SurfaceChart, TriangulatedSurface};

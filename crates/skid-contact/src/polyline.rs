@@ -226,6 +226,20 @@ impl RigidPolyline {
     }
 }
 
+impl RigidPolyline {
+    /// The segment whose interior holds the closest point to `q`, with its outward normal;
+    /// `None` where the closest point is a vertex (or `q` is not finite).
+    pub(crate) fn interior_segment(&self, q: &Vector2<f64>) -> Option<(usize, Vector2<f64>)> {
+        if !q.iter().all(|c| c.is_finite()) {
+            return None;
+        }
+        let tiny = 64.0 * f64::EPSILON * (self.scale + q.norm());
+        let closest = self.nearest(q, tiny)?;
+        matches!(closest.feature, Feature::Interior(_))
+            .then(|| (closest.segment, self.segments[closest.segment].normal))
+    }
+}
+
 /// `(v_x, v_y, 0)`.
 fn lift(v: &Vector2<f64>) -> Vector3<f64> {
     Vector3::new(v.x, v.y, 0.0)

@@ -61,6 +61,19 @@ pub enum SurfaceShape {
         /// Whether the last vertex joins the first.
         closed: bool,
     },
+    /// The `(r, z)` profile `profile` (back to its first point if `closed`) revolved about the
+    /// unit `axis`; `reference` is the unit direction perpendicular to the axis where the
+    /// angle is zero.
+    Revolution {
+        /// Unit axis `e`.
+        axis: Vector3<f64>,
+        /// Unit reference direction `b1`, perpendicular to `e`.
+        reference: Vector3<f64>,
+        /// Profile points `(r, z)`.
+        profile: Vec<Vector2<f64>>,
+        /// Whether the last point joins the first.
+        closed: bool,
+    },
     /// Triangles by their corners, counter-clockwise seen from outside.
     Triangles(Vec<[Vector3<f64>; 3]>),
 }

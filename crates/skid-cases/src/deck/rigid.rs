@@ -338,42 +338,64 @@ impl AnalyticalSurface {
         outward_polyline(points, closed)
     }
 
+    /// A revolved profile of lines: at one radius `r = R`, running from high to low `z`, the
+    /// [`RigidSurfaceSpec::Cylinder`]; any other the [`RigidSurfaceSpec::Revolution`] of its
+    /// points (in reverse, as a polyline's), closed if it ends where it starts, refused if it is
+    /// closed and faces inwards. The axis must pass through the reference node.
     fn revolution(&self, reference: &Vector3<f64>) -> Result<RigidSurfaceSpec, String> {
-        let radius = self.start.x;
         let tol = 1e-9 * self.size().max(reference.norm());
-        let mut from = self.start;
-        for piece in &self.pieces {
-            let Piece::Line { end } = piece else {
-                return Err(
-                    "a revolved profile must be lines at one radius (a cylinder); \
-                            arcs are not supported"
-                        .into(),
-                );
-            };
-            if (end.x - radius).abs() > tol || end.y >= from.y - tol {
-                return Err(
-                    "a revolved profile must be lines at the one radius r = R, running \
-                            from high to low z (outward normal +r); other surfaces of revolution \
-                            are not supported"
-                        .into(),
-                );
-            }
-            from = *end;
-        }
-        if radius <= 0.0 {
-            return Err(format!("the revolved radius must be > 0, got {radius}"));
-        }
         let d = self.origin - reference;
         let offset = (d - self.ez * self.ez.dot(&d)).norm();
         if offset > tol {
             return Err(format!(
                 "the axis of revolution passes {offset:e} m from the reference node; skid's \
-                 cylinders turn about their reference node"
+                 surfaces of revolution turn about their reference node"
             ));
         }
-        Ok(RigidSurfaceSpec::Cylinder {
-            radius,
+        let mut ends = Vec::with_capacity(self.pieces.len());
+        for piece in &self.pieces {
+            let Piece::Line { end } = piece else {
+                return Err(
+                    "a revolved profile must be lines (CIRCL arcs are not supported)".into(),
+                );
+            };
+            ends.push(*end);
+        }
+        let radius = self.start.x;
+        let mut from = self.start;
+        let cylinder = ends.iter().all(|end| {
+            let down = (end.x - radius).abs() <= tol && end.y < from.y - tol;
+            from = *end;
+            down
+        });
+        if cylinder {
+            if radius <= 0.0 {
+                return Err(format!("the revolved radius must be > 0, got {radius}"));
+            }
+            return Ok(RigidSurfaceSpec::Cylinder {
+                radius,
+                axis: self.ez.into(),
+            });
+        }
+        let mut points: Vec<Vector2<f64>> = std::iter::once(self.start).chain(ends).collect();
+        let closed = (points[points.len() - 1] - points[0]).norm() <= tol;
+        if closed {
+            points.pop();
+        }
+        let shift = self.ez.dot(&d);
+        let profile: Vec<[f64; 2]> = points.iter().rev().map(|p| [p.x, p.y + shift]).collect();
+        if let Some(p) = profile.iter().find(|p| p[0] < 0.0) {
+            return Err(format!(
+                "a revolved profile lies at r >= 0, got the point r = {}, z = {}",
+                p[0], p[1]
+            ));
+        }
+        check_outward(&profile, closed)?;
+        Ok(RigidSurfaceSpec::Revolution {
             axis: self.ez.into(),
+            profile,
+            closed,
+            radius: None,
         })
     }
 
@@ -666,8 +688,16 @@ pub fn chain(segments: &[[Vector3<f64>; 2]]) -> Result<RigidSurfaceSpec, String>
 }
 
 /// The polyline through `points` (body frame), refused if it is closed and faces inwards
-/// (clockwise, negative area): a deck's closed rigid surfaces are contacted from outside.
+/// (see [`check_outward`]).
 fn outward_polyline(points: Vec<[f64; 2]>, closed: bool) -> Result<RigidSurfaceSpec, String> {
+    check_outward(&points, closed)?;
+    Ok(RigidSurfaceSpec::Polyline { points, closed })
+}
+
+/// Refuses a closed chain of `points` that faces inwards (clockwise, negative area, with the
+/// outside on the right of the travel): a deck's closed rigid surfaces are contacted from
+/// outside.
+fn check_outward(points: &[[f64; 2]], closed: bool) -> Result<(), String> {
     let area: f64 = (0..points.len())
         .map(|k| {
             let (a, b) = (points[k], points[(k + 1) % points.len()]);
@@ -682,5 +712,5 @@ fn outward_polyline(points: Vec<[f64; 2]>, closed: bool) -> Result<RigidSurfaceS
                 .into(),
         );
     }
-    Ok(RigidSurfaceSpec::Polyline { points, closed })
+    Ok(())
 }

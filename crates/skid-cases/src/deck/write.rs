@@ -775,6 +775,37 @@ fn surface_deck(
             let _ = writeln!(out, "*SURFACE, NAME={name}, TYPE=ELEMENT\n{elset}, SPOS");
             Ok(format!(", ELSET={elset}"))
         }
+        RigidSurfaceSpec::Revolution {
+            axis,
+            profile,
+            closed,
+            radius,
+        } => {
+            let largest = profile.iter().map(|p| p[0]).fold(0.0, f64::max);
+            if radius.is_some_and(|r| r != largest) {
+                return Err(format!(
+                    "rigid body {name}: the radius of a surface of revolution's circumferential \
+                     coordinate has no keyword (a deck's is the profile's largest r)"
+                ));
+            }
+            let e = Vector3::from(*axis).normalize();
+            // the deck's travel runs against the polyline's, and closes on its start
+            let mut points: Vec<&[f64; 2]> = profile.iter().rev().collect();
+            if *closed {
+                points.extend(points.first().copied());
+            }
+            let _ = writeln!(
+                out,
+                "*SURFACE, NAME={name}, TYPE=REVOLUTION\n{}, {}",
+                list(c.iter().map(|x| num(*x))),
+                list((c + e).iter().map(|x| num(*x)))
+            );
+            for (k, q) in points.iter().enumerate() {
+                let word = if k == 0 { "START" } else { "LINE" };
+                let _ = writeln!(out, "{word}, {}, {}", num(q[0]), num(q[1]));
+            }
+            Ok(format!(", ANALYTICAL SURFACE={name}"))
+        }
         RigidSurfaceSpec::Polyline { points, closed } => {
             let first = *next_node;
             let _ = writeln!(out, "*NODE");

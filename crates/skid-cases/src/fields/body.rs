@@ -112,6 +112,38 @@ fn draw(shape: &SurfaceShape, around: &[Vector3<f64>], planar: bool) -> Drawing 
                 cells: vec![vec![0, 1, 2, 3]],
             }
         }
+        SurfaceShape::Revolution {
+            axis,
+            reference,
+            profile,
+            closed,
+        } => {
+            // a ring of points per profile point, quadrilaterals between consecutive rings
+            let across = axis.cross(reference);
+            let points = profile
+                .iter()
+                .flat_map(|p| {
+                    (0..CIRCLE_SEGMENTS).map(move |k| {
+                        let (sin, cos) = (TAU * k as f64 / CIRCLE_SEGMENTS as f64).sin_cos();
+                        (reference * cos + across * sin) * p.x + axis * p.y
+                    })
+                })
+                .collect();
+            let rings = profile.len();
+            let bands = if *closed {
+                rings
+            } else {
+                rings.saturating_sub(1)
+            };
+            let at = |ring: usize, k: usize| (ring % rings) * CIRCLE_SEGMENTS + k % CIRCLE_SEGMENTS;
+            let cells = (0..bands)
+                .flat_map(|j| {
+                    (0..CIRCLE_SEGMENTS)
+                        .map(move |k| vec![at(j, k), at(j, k + 1), at(j + 1, k + 1), at(j + 1, k)])
+                })
+                .collect();
+            Drawing { points, cells }
+        }
         SurfaceShape::Polyline { vertices, closed } => {
             // a 2D-only surface: its segments as lines
             let n = vertices.len();

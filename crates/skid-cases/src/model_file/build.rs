@@ -7,6 +7,7 @@ use nalgebra::{SVector, Vector2, Vector3};
 use skid_contact::facets::FacetedCylinder;
 use skid_contact::plane::RigidPlane;
 use skid_contact::polyline::RigidPolyline;
+use skid_contact::revolution::RigidRevolution;
 use skid_contact::surface::{AnalyticCylinder, RigidSurface};
 use skid_contact::triangles::{CylinderChart, SurfaceChart, TriangulatedSurface};
 use skid_fem::cell::{embed, face_corners};
@@ -692,6 +693,23 @@ fn rigid_surface<const D: usize>(
             }
             let points = points.iter().map(|p| Vector2::from(*p)).collect();
             Box::new(RigidPolyline::new(points, *closed).map_err(invalid)?)
+        }
+        RigidSurfaceSpec::Revolution {
+            axis,
+            profile,
+            closed,
+            radius,
+        } => {
+            if D != 3 {
+                return fail(field, "a surface of revolution is a 3D surface");
+            }
+            let axis = vector3(&format!("{field}.axis"), *axis)?;
+            let points: Vec<Vector2<f64>> = profile.iter().map(|p| Vector2::from(*p)).collect();
+            let radius = match radius {
+                Some(r) => positive(&format!("{field}.radius"), *r).map(|()| *r)?,
+                None => points.iter().map(|p| p.x).fold(0.0, f64::max),
+            };
+            Box::new(RigidRevolution::new(axis, points, *closed, radius).map_err(invalid)?)
         }
         RigidSurfaceSpec::Triangles {
             vertices,

@@ -1,0 +1,297 @@
+//! Rigid surface of revolution (3D): a profile of straight segments in the `r-z` half-plane
+//! revolved about an axis through the body origin, such as a stepped drum, a cone or a roller
+//! with flanges.
+
+use nalgebra::{Matrix2x3, Matrix3, Vector2, Vector3};
+
+use crate::error::ContactError;
+use crate::polyline::RigidPolyline;
+use crate::surface::{AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, SurfaceShape};
+
+/// The surface swept by the [`RigidPolyline`] `profile` of the `r-z` half-plane (`r >= 0` the
+/// distance from the unit axis `e`, `z = e.y`; its outside on the right walking along it with
+/// `r` to the right and `z` up, so that the cylinder `r = R` is walked towards `+z`) revolved
+/// about `e` through the body origin.
+///
+/// The closest point of a body-frame point `y` lies in its meridian half-plane, so with
+/// `z = e.y`, `r = |y - z e|`, `u = (y - z e)/r` and `w = e x u`, the gap is the profile's in
+/// `(r, z)`, `g = g_p(r, z)`, and every profile function `f(r, z)` (gap, arc length) has
+/// `df/dy = f_r u + f_z e` and `d^2f/dy^2 = [u e] H_f [u e]^T + f_r w w^T / r` (`H_f` its
+/// `(r, z)` Hessian; `d^2 r/dy^2 = w w^T / r`). The coordinates are `xi_0 = R theta`, the angle
+/// about `e` scaled by the chart radius `R` as on [`AnalyticCylinder`] (so that slip is a length
+/// on the surface where `r = R`, and `r/R` of one elsewhere), and `xi_1 = s`, the profile's arc
+/// length. The projection is undefined on the axis (`r ~ 0`).
+#[derive(Clone, Debug)]
+pub struct RigidRevolution {
+    profile: RigidPolyline,
+    points: Vec<Vector2<f64>>,
+    closed: bool,
+    chart: AnalyticCylinder,
+}
+
+impl RigidRevolution {
+    /// The revolution of the profile `points` (`(r, z)`, `r >= 0`; closed if `closed`) about
+    /// `axis`, with the chart radius `radius` of the circumferential coordinate.
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidSurface`] for an invalid profile (see [`RigidPolyline::new`]), a
+    /// negative or non-finite `r`, or an invalid axis or radius.
+    pub fn new(
+        axis: Vector3<f64>,
+        points: Vec<Vector2<f64>>,
+        closed: bool,
+        radius: f64,
+    ) -> Result<Self, ContactError> {
+        if let Some(p) = points.iter().find(|p| p.x < 0.0 || p.x.is_nan()) {
+            return Err(ContactError::InvalidSurface(format!(
+                "a profile of revolution lies at r >= 0, got the point {p:?}"
+            )));
+        }
+        Ok(Self {
+            profile: RigidPolyline::new(points.clone(), closed)?,
+            points,
+            closed,
+            chart: AnalyticCylinder::new(radius, axis)?,
+        })
+    }
+}
+
+impl RigidSurface for RigidRevolution {
+    fn shape(&self) -> SurfaceShape {
+        SurfaceShape::Revolution {
+            axis: self.chart.axis(),
+            reference: self.chart.reference_direction(),
+            profile: self.points.clone(),
+            closed: self.closed,
+        }
+    }
+
+    fn project(&self, y: &Vector3<f64>) -> Option<Projection> {
+        // the angle and its derivatives, and r > 0, from the chart cylinder
+        let around = self.chart.project(y)?;
+        let e = self.chart.axis();
+        let z = e.dot(y);
+        let radial = y - e * z;
+        let r = radial.norm();
+        let (u, w) = (radial / r, e.cross(&(radial / r)));
+        let meridian = self.profile.project(&Vector3::new(r, z, 0.0))?;
+        // [u e]^T: rows u and e map (r, z) derivatives to y
+        let frame = Matrix2x3::from_rows(&[u.transpose(), e.transpose()]);
+        let lift = |gradient: &Vector3<f64>, hessian: &Matrix3<f64>| {
+            let g2 = gradient.xy();
+            let h2 = hessian.fixed_view::<2, 2>(0, 0).into_owned();
+            (
+                frame.transpose() * g2,
+                frame.transpose() * h2 * frame + w * w.transpose() * (g2.x / r),
+            )
+        };
+        let (gap_gradient, gap_hessian) = lift(&meridian.gap_gradient, &meridian.gap_hessian);
+        let (arc_gradient, arc_hessian) =
+            lift(&meridian.coords_gradient[0], &meridian.coords_hessian[0]);
+        Some(Projection {
+            gap: meridian.gap,
+            gap_gradient,
+            coords: Vector2::new(around.coords[0], meridian.coords[0]),
+            coords_gradient: [around.coords_gradient[0], arc_gradient],
+            gap_hessian,
+            coords_hessian: [around.coords_hessian[0], arc_hessian],
+        })
+    }
+
+    fn coords_period(&self) -> [Option<f64>; 2] {
+        [
+            self.chart.coords_period()[0],
+            self.profile.coords_period()[0],
+        ]
+    }
+
+    /// Where both points are closest to the interior of one profile segment, of outward normal
+    /// `n = (n_r, n_z)`, the gap is `n_r r + n_z z` plus a constant, and with the cylinder's
+    /// `r_end - r_start = (y_perp,start + y_perp,end)/S . (y_end - y_start)`
+    /// (`S = r_start + r_end`) `G = n_r (y_perp,start + y_perp,end)/S + n_z e`, with
+    /// `dG/dy_end` `n_r` times the cylinder's (see [`AnalyticCylinder`]). Elsewhere (a vertex
+    /// between them) `None`. The gap is invariant under rotations about the surface's own axis
+    /// only.
+    fn gap_discrete_gradient(
+        &self,
+        y_start: &Vector3<f64>,
+        y_end: &Vector3<f64>,
+        rotation_axis: &Vector3<f64>,
+    ) -> Option<DiscreteGradient> {
+        let e = self.chart.axis();
+        if e.cross(rotation_axis).norm() > 1e-12 {
+            return None;
+        }
+        let perp = |y: &Vector3<f64>| y - e * e.dot(y);
+        let (start, end) = (perp(y_start), perp(y_end));
+        let meridian =
+            |y: &Vector3<f64>, radial: &Vector3<f64>| Vector2::new(radial.norm(), e.dot(y));
+        let (k, normal) = self.profile.interior_segment(&meridian(y_start, &start))?;
+        let (k_end, _) = self.profile.interior_segment(&meridian(y_end, &end))?;
+        if k != k_end {
+            return None;
+        }
+        let sum = start.norm() + end.norm();
+        let radial = (start + end) / sum;
+        let gradient = radial * normal.x + e * normal.y;
+        let across = Matrix3::identity() - e * e.transpose();
+        let pull = radial * (end / end.norm()).transpose();
+        let jacobian = (across - (pull + pull.transpose()) * 0.5) * normal.x / sum;
+        (sum > 0.0
+            && gradient
+                .iter()
+                .chain(jacobian.iter())
+                .all(|c| c.is_finite()))
+        .then_some(DiscreteGradient { gradient, jacobian })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::facets::tests::check_gradients;
+
+    fn project(surface: &dyn RigidSurface, y: &Vector3<f64>) -> Projection {
+        surface.project(y).expect("projection defined")
+    }
+
+    /// A drum with a step and a cone: r = 0.2 for z in [-0.1, 0], a cone out to r = 0.25 at
+    /// z = 0.05, then r = 0.25 to z = 0.1; walked towards +z so that the outside is at larger r.
+    fn stepped() -> RigidRevolution {
+        RigidRevolution::new(
+            Vector3::new(0.0, 0.0, 2.0),
+            vec![
+                Vector2::new(0.2, -0.1),
+                Vector2::new(0.2, 0.0),
+                Vector2::new(0.25, 0.05),
+                Vector2::new(0.25, 0.1),
+            ],
+            false,
+            0.2,
+        )
+        .expect("profile")
+    }
+
+    /// The straight profile r = R is the analytical cylinder: the same gap, coordinates (the
+    /// axial one from the profile's first point) and derivatives.
+    #[test]
+    fn a_straight_profile_is_the_cylinder() -> Result<(), ContactError> {
+        let axis = Vector3::new(0.3, -0.2, 1.0);
+        let cylinder = AnalyticCylinder::new(0.2, axis)?;
+        let revolution = RigidRevolution::new(
+            axis,
+            vec![Vector2::new(0.2, -1.0), Vector2::new(0.2, 1.0)],
+            false,
+            0.2,
+        )?;
+        for y in [
+            Vector3::new(0.21, 0.03, 0.05),
+            Vector3::new(-0.1, 0.19, -0.2),
+            Vector3::new(0.0, -0.15, 0.3),
+        ] {
+            let (a, b) = (project(&cylinder, &y), project(&revolution, &y));
+            assert!((a.gap - b.gap).abs() < 1e-15);
+            assert!((a.coords[0] - b.coords[0]).abs() < 1e-15);
+            assert!((a.coords[1] - (b.coords[1] - 1.0)).abs() < 1e-14);
+            assert!((a.gap_gradient - b.gap_gradient).norm() < 1e-14);
+            assert!((a.gap_hessian - b.gap_hessian).norm() < 1e-12);
+            for k in 0..2 {
+                assert!((a.coords_gradient[k] - b.coords_gradient[k]).norm() < 1e-14);
+                assert!((a.coords_hessian[k] - b.coords_hessian[k]).norm() < 1e-12);
+            }
+        }
+        Ok(())
+    }
+
+    /// On one profile segment the discrete gradient gives the change of the gap exactly (the
+    /// cone's points turned about the axis as well); across a vertex, or for a rotation about
+    /// another axis, there is none; on a straight profile it is the cylinder's.
+    #[test]
+    fn the_discrete_gradient_gives_the_change_of_the_gap() -> Result<(), ContactError> {
+        let surface = stepped();
+        let e = Vector3::z();
+        let (start, end) = (
+            Vector3::new(0.0, 0.25, 0.0),
+            Vector3::new(0.18, 0.17, 0.012),
+        );
+        let d = surface
+            .gap_discrete_gradient(&start, &end, &e)
+            .expect("both on the cone");
+        let change = project(&surface, &end).gap - project(&surface, &start).gap;
+        assert!(
+            (d.gradient.dot(&(end - start)) - change).abs() < 1e-16,
+            "{change}"
+        );
+        let across = Vector3::new(0.21, 0.0, -0.05);
+        assert!(surface.gap_discrete_gradient(&start, &across, &e).is_none());
+        assert!(
+            surface
+                .gap_discrete_gradient(&start, &end, &Vector3::x())
+                .is_none()
+        );
+        let axis = Vector3::new(0.3, -0.2, 1.0);
+        let cylinder = AnalyticCylinder::new(0.2, axis)?;
+        let straight = RigidRevolution::new(
+            axis,
+            vec![Vector2::new(0.2, -1.0), Vector2::new(0.2, 1.0)],
+            false,
+            0.2,
+        )?;
+        let (a, b) = (
+            Vector3::new(0.21, 0.03, 0.05),
+            Vector3::new(0.2, 0.06, 0.04),
+        );
+        let (c, r) = (
+            cylinder
+                .gap_discrete_gradient(&a, &b, &axis)
+                .expect("cylinder"),
+            straight
+                .gap_discrete_gradient(&a, &b, &axis)
+                .expect("revolution"),
+        );
+        assert_eq!((c.gradient, c.jacobian), (r.gradient, r.jacobian));
+        Ok(())
+    }
+
+    /// Gap and coordinates against finite differences on the cylinder, the cone, beyond its
+    /// convex corner and inside the surface.
+    #[test]
+    fn gradients_match_finite_differences() {
+        let surface = stepped();
+        for y in [
+            Vector3::new(0.21, 0.02, -0.05),
+            Vector3::new(0.05, 0.22, 0.03),
+            Vector3::new(-0.26, 0.02, 0.06),
+            Vector3::new(0.18, -0.05, 0.09),
+            Vector3::new(0.15, 0.1, -0.02),
+        ] {
+            check_gradients(&surface, &y, 1e-6);
+        }
+    }
+
+    /// On the cone the gap is the distance to it in the meridian half-plane, its normal the
+    /// profile's normal turned about the axis; the axis itself has no projection.
+    #[test]
+    fn the_gap_is_measured_in_the_meridian_plane() {
+        let surface = stepped();
+        // the cone's outward normal in (r, z): (0.05, 0.05) turned clockwise, (1, -1)/sqrt 2
+        let y = Vector3::new(0.0, 0.25, 0.0);
+        let p = project(&surface, &y);
+        let along = (Vector2::new(0.25, 0.0) - Vector2::new(0.2, 0.0))
+            .dot(&(Vector2::new(1.0, -1.0) / 2f64.sqrt()));
+        assert!((p.gap - along).abs() < 1e-15, "{} vs {along}", p.gap);
+        let normal = Vector3::new(0.0, 1.0, -1.0) / 2f64.sqrt();
+        assert!((p.gap_gradient - normal).norm() < 1e-15);
+        assert!(surface.project(&Vector3::new(0.0, 0.0, 0.3)).is_none());
+        assert_eq!(surface.coords_period()[1], None);
+        assert!(
+            RigidRevolution::new(
+                Vector3::z(),
+                vec![Vector2::new(-0.1, 0.0), Vector2::new(0.2, 0.0)],
+                false,
+                0.2
+            )
+            .is_err()
+        );
+    }
+}
