@@ -9,6 +9,12 @@ use std::path::{Path, PathBuf};
 mod deck_text;
 use deck_text::{assert_refused_at, read_deck_text};
 
+// this test reads a frame's geometry, not its data
+#[allow(dead_code)]
+mod common;
+use common::Vtu;
+use vtkio::model::CellType;
+
 use skid_cases::csv_out::CsvTable;
 use skid_cases::deck::write::write_deck;
 use skid_cases::drum::model_spec;
@@ -22,12 +28,11 @@ fn repo(path: &str) -> PathBuf {
         .join(path)
 }
 
-/// The drum's omega over the first 10 ms of the spin-down of `model`.
-fn omega(model: &ModelSpec) -> Vec<f64> {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let summary = run_model(model, Path::new("drum.json"), dir.path()).expect("runs");
+/// The drum's omega over the spin-down of `model`, run into `dir`.
+fn omega(model: &ModelSpec, dir: &Path) -> Vec<f64> {
+    let summary = run_model(model, Path::new("drum.json"), dir).expect("runs");
     assert!(summary.error.is_none(), "{:?}", summary.error);
-    let path = dir.path().join("history.csv");
+    let path = dir.join("history.csv");
     let text = std::fs::read_to_string(&path).expect("history");
     let table = CsvTable::new(&text, &path).expect("table");
     let column = table.column("drum.omega").expect("drum.omega");
@@ -59,11 +64,37 @@ fn the_drum_as_a_revolved_line_spins_down_as_the_cylinder() {
         closed: false,
         radius: None,
     });
-    let (a, b) = (omega(&cylinder), omega(&revolved));
+    revolved.output.field_interval = Some(0.01);
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (a, b) = (
+        omega(&cylinder, tempfile::tempdir().expect("tempdir").path()),
+        omega(&revolved, dir.path()),
+    );
     assert!(a.len() > 100, "{} rows", a.len());
     // the same gap, normal, curvature and discrete gradient, bit for bit
     assert_eq!(a, b);
     assert!(a[a.len() - 1] < 59.0, "the drum slows: {}", a[a.len() - 1]);
+    // drawn as one band of quadrilaterals between the profile's two rings, on the cylinder
+    let fields = dir.path().join("fields");
+    let mut drawn: Vec<PathBuf> = std::fs::read_dir(&fields)
+        .expect("fields")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| {
+            p.file_name()
+                .is_some_and(|n| n.to_string_lossy().starts_with("drum_"))
+        })
+        .collect();
+    drawn.sort();
+    let drum = Vtu::read(drawn.last().expect("a drum frame"));
+    assert_eq!((drum.points.len(), drum.cells.len()), (288, 144));
+    assert!(drum.types.iter().all(|t| *t == CellType::Quad));
+    for p in &drum.points {
+        let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
+        assert!(
+            (r - radius).abs() < 1e-12 && (p[2].abs() - 1.0).abs() < 1e-12,
+            "{p:?}"
+        );
+    }
 }
 
 /// The 3D verification block's ground replaced by an analytical surface of revolution.
