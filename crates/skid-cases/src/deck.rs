@@ -45,10 +45,11 @@
 //!   other lines must form one chain (a polyline; closed, it must face outwards), other
 //!   quadrilaterals (split along their 1-3 diagonal: exact when flat) and triangles a triangle
 //!   mesh whose surface coordinates are read on its plane if it is flat, else on a cylinder
-//!   about its body's one free rotation (see [`rigid`]); a bent `SEGMENTS` profile of lines
-//!   is a polyline, a straight one the unbounded line through its reference node; a revolved
-//!   profile of lines at one radius is a cylinder, any other a surface of revolution (its axis
-//!   through the reference node);
+//!   about its body's one free rotation (see [`rigid`]); an analytical profile of lines that
+//!   runs straight through the reference node is the unbounded line or plane through it, any
+//!   other a polyline (`SEGMENTS`) or its extrusion along the generator (`CYLINDER`); a
+//!   revolved profile of lines at one radius is a cylinder, any other a surface of revolution
+//!   (its axis through the reference node);
 //! - a point rotary inertia counts about its body's one free rotation axis;
 //! - general contact makes every node of the part's exterior faces a candidate;
 //! - `*OUTPUT, FIELD` with `TIME INTERVAL=t` or `NUMBER INTERVAL=n` (the step's period over n)

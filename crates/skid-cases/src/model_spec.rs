@@ -255,6 +255,23 @@ pub enum RigidSurfaceSpec {
         #[serde(default)]
         closed: bool,
     },
+    /// An extruded profile (3D): the `profile` of points `(u, v)` in the plane through the origin
+    /// spanned by `reference` (made perpendicular to `axis`, the `u` direction) and
+    /// `axis x reference` (`v`), swept along `axis` without end (back to the first point if
+    /// `closed`). Its outside is on the right walking along the profile with `u` to the right
+    /// and `v` up; the surface coordinates are the profile's arc length and the position along
+    /// `axis`.
+    Extrusion {
+        /// Sweep direction.
+        axis: [f64; 3],
+        /// First direction of the profile's plane.
+        reference: [f64; 3],
+        /// Profile points `[u, v]`, m.
+        profile: Vec<[f64; 2]>,
+        /// Whether the last point joins the first.
+        #[serde(default)]
+        closed: bool,
+    },
     /// A surface of revolution (3D): the `profile` of points `(r, z)` (`r >= 0` the distance
     /// from `axis`, `z` the position along it; back to the first point if `closed`) revolved
     /// about `axis` through the origin. Its outside is on the right walking along the profile

@@ -6,6 +6,7 @@
 //! * [`plane`]: the analytical rigid plane (a line in 2D).
 //! * [`polyline`]: the rigid polyline in 2D (rigid line elements in a chain, open or closed).
 //! * [`revolution`]: a profile of straight segments revolved about an axis (3D).
+//! * [`extrusion`]: a profile of straight segments swept along an axis (3D).
 //! * [`facets`]: the faceted cylinder (rigid line, quad, membrane or shell facets of a drum).
 //! * [`triangles`]: triangulated surfaces (exterior faces of a tetrahedral drum).
 //! * [`kinematics`]: gap, convected coordinates and their exact first derivatives for a slave node
@@ -18,6 +19,7 @@
 
 pub mod coulomb;
 pub mod error;
+pub mod extrusion;
 pub mod facets;
 pub mod kinematics;
 pub mod plane;
@@ -31,6 +33,7 @@ pub use coulomb::{
     solve_coulomb,
 };
 pub use error::ContactError;
+pub use extrusion::RigidExtrusion;
 pub use facets::FacetedCylinder;
 pub use kinematics::{
     ContactKinematics, IncrementStart, MAX_COLUMN_LEVER, MIN_SECANT_TURN, RotatingFrame, evaluate,

@@ -74,6 +74,18 @@ pub enum SurfaceShape {
         /// Whether the last point joins the first.
         closed: bool,
     },
+    /// The profile `profile` (back to its first point if `closed`) of the plane of `reference`
+    /// and `axis x reference`, swept along the unit `axis` without end.
+    Extrusion {
+        /// Unit sweep direction `e`.
+        axis: Vector3<f64>,
+        /// Unit first direction `a` of the profile's plane, perpendicular to `e`.
+        reference: Vector3<f64>,
+        /// Profile points `(a.y, (e x a).y)`.
+        profile: Vec<Vector2<f64>>,
+        /// Whether the last point joins the first.
+        closed: bool,
+    },
     /// Triangles by their corners, counter-clockwise seen from outside.
     Triangles(Vec<[Vector3<f64>; 3]>),
 }

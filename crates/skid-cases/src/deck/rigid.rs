@@ -224,10 +224,8 @@ impl AnalyticalSurface {
             let normal = self.ez.cross(&t);
             let distance = normal.dot(&(self.global(&self.start) - reference));
             if distance.abs() > tol {
-                return Err(format!(
-                    "the line lies {distance:e} m from the reference node along its normal; \
-                     skid's rigid planes pass through their reference node"
-                ));
+                // not a plane through the reference node: the segment itself
+                return self.polyline(reference, &lines);
             }
             return Ok(RigidSurfaceSpec::Plane {
                 normal: normal.into(),
@@ -303,22 +301,17 @@ impl AnalyticalSurface {
         })
     }
 
-    /// A bent profile of lines in 2D (`SEGMENTS`) as a [`RigidSurfaceSpec::Polyline`] in the
-    /// body frame, closed if it ends where it starts. Its points are taken in reverse: the
-    /// deck's outward normal is the direction of travel turned counter-clockwise, the
-    /// polyline's turned clockwise.
+    /// A profile of lines other than a straight line through the reference node, in the body
+    /// frame: in 2D (`SEGMENTS`) a [`RigidSurfaceSpec::Polyline`], in 3D (`CYLINDER`) the
+    /// [`RigidSurfaceSpec::Extrusion`] of the profile along the generator, closed if it ends
+    /// where it starts and refused if it is then traversed inwards. Its points are taken in
+    /// reverse: the deck's outward normal is the direction of travel turned counter-clockwise,
+    /// the polyline's turned clockwise.
     fn polyline(
         &self,
         reference: &Vector3<f64>,
         ends: &[Vector2<f64>],
     ) -> Result<RigidSurfaceSpec, String> {
-        if self.kind != AnalyticalKind::Segments {
-            return Err(
-                "a bent profile of lines is read in 2D (TYPE=SEGMENTS); in 3D give the \
-                 surface as rigid elements (R3D4 or R3D3)"
-                    .into(),
-            );
-        }
         let tol = 1e-9 * self.size().max(reference.norm());
         let mut points: Vec<Vector2<f64>> = std::iter::once(self.start)
             .chain(ends.iter().copied())
@@ -327,15 +320,24 @@ impl AnalyticalSurface {
         if closed {
             points.pop();
         }
-        let points = points
+        let points: Vec<[f64; 2]> = points
             .iter()
             .rev()
             .map(|p| {
                 let y = self.global(p) - reference;
-                [y.x, y.y]
+                [self.ex.dot(&y), self.ey.dot(&y)]
             })
             .collect();
-        outward_polyline(points, closed)
+        check_outward(&points, closed)?;
+        Ok(match self.kind {
+            AnalyticalKind::Cylinder => RigidSurfaceSpec::Extrusion {
+                axis: self.ez.into(),
+                reference: self.ex.into(),
+                profile: points,
+                closed,
+            },
+            _ => RigidSurfaceSpec::Polyline { points, closed },
+        })
     }
 
     /// A revolved profile of lines: at one radius `r = R`, running from high to low `z`, the

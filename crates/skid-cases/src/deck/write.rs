@@ -775,6 +775,25 @@ fn surface_deck(
             let _ = writeln!(out, "*SURFACE, NAME={name}, TYPE=ELEMENT\n{elset}, SPOS");
             Ok(format!(", ELSET={elset}"))
         }
+        RigidSurfaceSpec::Extrusion {
+            axis,
+            reference,
+            profile,
+            closed,
+        } => {
+            let e = Vector3::from(*axis).normalize();
+            let a = Vector3::from(*reference);
+            let a = (a - e * e.dot(&a)).normalize();
+            let _ = writeln!(
+                out,
+                "*SURFACE, NAME={name}, TYPE=CYLINDER\n{}, {}\n{}",
+                list(c.iter().map(|x| num(*x))),
+                list((c + a).iter().map(|x| num(*x))),
+                list((c + e).iter().map(|x| num(*x)))
+            );
+            profile_lines(out, profile, *closed);
+            Ok(format!(", ANALYTICAL SURFACE={name}"))
+        }
         RigidSurfaceSpec::Revolution {
             axis,
             profile,
@@ -789,21 +808,13 @@ fn surface_deck(
                 ));
             }
             let e = Vector3::from(*axis).normalize();
-            // the deck's travel runs against the polyline's, and closes on its start
-            let mut points: Vec<&[f64; 2]> = profile.iter().rev().collect();
-            if *closed {
-                points.extend(points.first().copied());
-            }
             let _ = writeln!(
                 out,
                 "*SURFACE, NAME={name}, TYPE=REVOLUTION\n{}, {}",
                 list(c.iter().map(|x| num(*x))),
                 list((c + e).iter().map(|x| num(*x)))
             );
-            for (k, q) in points.iter().enumerate() {
-                let word = if k == 0 { "START" } else { "LINE" };
-                let _ = writeln!(out, "{word}, {}, {}", num(q[0]), num(q[1]));
-            }
+            profile_lines(out, profile, *closed);
             Ok(format!(", ANALYTICAL SURFACE={name}"))
         }
         RigidSurfaceSpec::Polyline { points, closed } => {
@@ -885,6 +896,20 @@ fn surface_deck(
             );
             Ok(format!(", ELSET={elset}"))
         }
+    }
+}
+
+/// The `START` and `LINE` lines of an analytical profile given as a polyline: the deck's travel
+/// runs against the polyline's (its outward normal is the travel turned counter-clockwise),
+/// and a closed profile ends on its start.
+fn profile_lines(out: &mut String, profile: &[[f64; 2]], closed: bool) {
+    let mut points: Vec<&[f64; 2]> = profile.iter().rev().collect();
+    if closed {
+        points.extend(points.first().copied());
+    }
+    for (k, q) in points.iter().enumerate() {
+        let word = if k == 0 { "START" } else { "LINE" };
+        let _ = writeln!(out, "{word}, {}, {}", num(q[0]), num(q[1]));
     }
 }
 

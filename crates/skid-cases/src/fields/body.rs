@@ -84,9 +84,21 @@ fn draw(shape: &SurfaceShape, around: &[Vector3<f64>], planar: bool) -> Drawing 
                     (reference * cos + across * sin) * *radius
                 })
                 .collect();
-            extrude(ring, axis, around, planar)
+            extrude(ring, axis, around, planar, true)
         }
-        SurfaceShape::Prism { axis, vertices } => extrude(vertices.clone(), axis, around, planar),
+        SurfaceShape::Prism { axis, vertices } => {
+            extrude(vertices.clone(), axis, around, planar, true)
+        }
+        SurfaceShape::Extrusion {
+            axis,
+            reference,
+            profile,
+            closed,
+        } => {
+            let up = axis.cross(reference);
+            let section = profile.iter().map(|p| reference * p.x + up * p.y).collect();
+            extrude(section, axis, around, planar, *closed)
+        }
         SurfaceShape::Plane { normal, tangents } if planar => {
             // the in-plane direction whose clockwise turn is the normal
             let along = Vector3::z()
@@ -145,13 +157,7 @@ fn draw(shape: &SurfaceShape, around: &[Vector3<f64>], planar: bool) -> Drawing 
             Drawing { points, cells }
         }
         SurfaceShape::Polyline { vertices, closed } => {
-            // a 2D-only surface: its segments as lines
-            let n = vertices.len();
-            let segments = if *closed { n } else { n.saturating_sub(1) };
-            Drawing {
-                points: vertices.clone(),
-                cells: (0..segments).map(|k| vec![k, (k + 1) % n]).collect(),
-            }
+            extrude(vertices.clone(), &Vector3::z(), around, true, *closed)
         }
         SurfaceShape::Triangles(triangles) => {
             // shared corners become shared points
@@ -176,20 +182,23 @@ fn draw(shape: &SurfaceShape, around: &[Vector3<f64>], planar: bool) -> Drawing 
     }
 }
 
-/// The closed polygon `ring` (counter-clockwise about `axis`): in 2D its lines; in 3D the band
-/// of quadrilaterals between its copies at both ends of the span of `around` along `axis`.
+/// The polygon `ring` (closed if `closed`; counter-clockwise about `axis` when it is): in 2D
+/// its lines; in 3D the band of quadrilaterals between its copies at both ends of the span of
+/// `around` along `axis`.
 fn extrude(
     ring: Vec<Vector3<f64>>,
     axis: &Vector3<f64>,
     around: &[Vector3<f64>],
     planar: bool,
+    closed: bool,
 ) -> Drawing {
     let n = ring.len();
     let next = |k: usize| (k + 1) % n;
+    let sides = if closed { n } else { n.saturating_sub(1) };
     if planar {
         return Drawing {
             points: ring,
-            cells: (0..n).map(|k| vec![k, next(k)]).collect(),
+            cells: (0..sides).map(|k| vec![k, next(k)]).collect(),
         };
     }
     let [low, high] = span(around, axis);
@@ -199,7 +208,7 @@ fn extrude(
         .collect();
     Drawing {
         points,
-        cells: (0..n)
+        cells: (0..sides)
             .map(|k| vec![k, next(k), n + next(k), n + k])
             .collect(),
     }

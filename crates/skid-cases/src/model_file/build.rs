@@ -4,6 +4,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use nalgebra::{SVector, Vector2, Vector3};
+use skid_contact::extrusion::RigidExtrusion;
 use skid_contact::facets::FacetedCylinder;
 use skid_contact::plane::RigidPlane;
 use skid_contact::polyline::RigidPolyline;
@@ -693,6 +694,29 @@ fn rigid_surface<const D: usize>(
             }
             let points = points.iter().map(|p| Vector2::from(*p)).collect();
             Box::new(RigidPolyline::new(points, *closed).map_err(invalid)?)
+        }
+        RigidSurfaceSpec::Extrusion {
+            axis,
+            reference,
+            profile,
+            closed,
+        } => {
+            if D != 3 {
+                return fail(
+                    field,
+                    "an extrusion is a 3D surface (in 2D give a polyline)",
+                );
+            }
+            let points = profile.iter().map(|p| Vector2::from(*p)).collect();
+            Box::new(
+                RigidExtrusion::new(
+                    vector3(&format!("{field}.axis"), *axis)?,
+                    vector3(&format!("{field}.reference"), *reference)?,
+                    points,
+                    *closed,
+                )
+                .map_err(invalid)?,
+            )
         }
         RigidSurfaceSpec::Revolution {
             axis,

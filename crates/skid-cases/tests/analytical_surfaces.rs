@@ -1,7 +1,10 @@
-//! Surfaces of revolution: the 3D drum as the revolution of the straight profile `r = R` spins
-//! down as the analytical cylinder does, bit for bit; a deck's revolved profile of lines that is no cylinder
-//! reads to the surface of revolution (its profile in the body frame, listed as a polyline's),
-//! which the deck writer writes back; arcs and inward closed profiles are refused.
+//! Analytical surfaces beyond the drum's: surfaces of revolution (the 3D drum as the revolution
+//! of the straight profile `r = R` spins down as the analytical cylinder does, bit for bit) and
+//! extruded profiles (the pushed block on an extruded straight profile slides as on the plane);
+//! a deck's revolved profile of lines that is no cylinder, and its `TYPE=CYLINDER` profile of
+//! lines that is no plane through the reference node, read to them (profiles in the body frame,
+//! listed as a polyline's), which the deck writer writes back; arcs and inward closed profiles
+//! are refused.
 
 use std::path::{Path, PathBuf};
 
@@ -19,6 +22,7 @@ use skid_cases::csv_out::CsvTable;
 use skid_cases::deck::write::write_deck;
 use skid_cases::drum::model_spec;
 use skid_cases::load_case;
+use skid_cases::model_file::parse_model;
 use skid_cases::model_spec::{ModelSpec, RigidSurfaceSpec};
 use skid_cases::runner::run_model;
 
@@ -146,4 +150,90 @@ fn a_revolved_profile_of_lines_is_a_surface_of_revolution() {
         "START, 0.5, 1.0\nLINE, 0.6, 1.0\nLINE, 0.6, 2.0\nLINE, 0.5, 2.0\nLINE, 0.5, 1.0",
     );
     assert_refused_at(&deck_with(&inward), at, "faces inwards");
+}
+
+#[test]
+fn a_profile_of_lines_swept_along_its_generator_is_an_extrusion() {
+    // a step down along x, swept along z through the ground's reference node: local x =
+    // global x, generator z, local y = z x x = y; traversed towards +x so that its normal
+    // (travel turned counter-clockwise) points up
+    let surface = "*SURFACE, NAME=ground, TYPE=CYLINDER\n\
+                   0.0, 0.0, 0.0, 1.0, 0.0, 0.0\n0.0, 0.0, 1.0\n\
+                   START, -2.0, 0.0\nLINE, 0.015, 0.0\nLINE, 0.02, -0.001\nLINE, 2.0, -0.001\n\
+                   *RIGID BODY, REF NODE=ground, ANALYTICAL SURFACE=ground";
+    let model = read_deck_text(&deck_with(surface)).expect("extrusion");
+    let ground = model
+        .rigid_bodies
+        .iter()
+        .find(|b| b.name == "ground")
+        .expect("ground");
+    assert_eq!(
+        ground.surface,
+        Some(RigidSurfaceSpec::Extrusion {
+            axis: [0.0, 0.0, 1.0],
+            reference: [1.0, 0.0, 0.0],
+            profile: vec![[2.0, -0.001], [0.02, -0.001], [0.015, 0.0], [-2.0, 0.0]],
+            closed: false,
+        })
+    );
+    let written = write_deck(&model, &Default::default()).expect("written");
+    let read = read_deck_text(&written).expect("read back");
+    assert_eq!(read.rigid_bodies, model.rigid_bodies);
+    let arc = surface.replace("LINE, 0.015, 0.0", "CIRCL, 0.015, 0.0, -0.9925, 0.0");
+    assert_refused_at(
+        &deck_with(&arc),
+        "*SURFACE, NAME=ground, TYPE=CYLINDER",
+        "mixing LINE and CIRCL",
+    );
+}
+
+/// The pushed block of `3d-block-pushed-on-flat.json` on the extrusion of a straight profile
+/// of two segments instead of the plane y = 0: the same run to round-off.
+#[test]
+fn the_pushed_block_slides_on_an_extruded_line_as_on_the_plane() {
+    let path = repo("cases/verification/3d-block-pushed-on-flat.json");
+    let text = std::fs::read_to_string(&path).expect("scene");
+    let plane = parse_model(&text, &path, &["steps[0].duration=0.03".to_string()]).expect("model");
+    let mut extruded = plane.clone();
+    let ground = extruded
+        .rigid_bodies
+        .iter_mut()
+        .find(|b| b.name == "ground")
+        .expect("ground");
+    assert!(matches!(
+        ground.surface,
+        Some(RigidSurfaceSpec::Plane { .. })
+    ));
+    ground.surface = Some(RigidSurfaceSpec::Extrusion {
+        axis: [0.0, 0.0, 1.0],
+        reference: [1.0, 0.0, 0.0],
+        // walked towards -x: the outside (on the right) is up
+        profile: vec![[2.0, 0.0], [0.0025, 0.0], [-2.0, 0.0]],
+        closed: false,
+    });
+    let column = |model: &ModelSpec, name: &str| {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let summary = run_model(model, Path::new("block.json"), dir.path()).expect("runs");
+        assert!(summary.error.is_none(), "{:?}", summary.error);
+        let path = dir.path().join("history.csv");
+        let text = std::fs::read_to_string(&path).expect("history");
+        let table = CsvTable::new(&text, &path).expect("table");
+        let c = table.column(name).expect("column");
+        table
+            .map(|row| row.expect("row").number::<f64>(c).expect("number"))
+            .collect::<Vec<f64>>()
+    };
+    for name in ["plate.u_x", "block-ground.tangential_force_1"] {
+        let (a, b) = (column(&plane, name), column(&extruded, name));
+        assert_eq!(a.len(), b.len());
+        let scale = a.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        assert!(scale > 0.0, "{name} moves");
+        // the extrusion's first coordinate runs along -x, the plane's along +x
+        for (x, y) in a.iter().zip(&b) {
+            assert!(
+                (x.abs() - y.abs()).abs() <= 1e-9 * scale,
+                "{name}: {x} against {y}"
+            );
+        }
+    }
 }
