@@ -230,6 +230,7 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
         description: case.description.clone(),
         dimension: D,
         part,
+        parts: Vec::new(),
         rigid_bodies: vec![drum, plate],
         boundary: vec![fixed(DRUM, &[Dof::Rz]), fixed(BACK_PLATE, &[Dof::Y])],
         ties: vec![TieSpec {

@@ -5,6 +5,7 @@
 //!   steps and settings), each problem reported with its field path;
 //! - [`history`]: the generic `history.csv` (every body's motions, every pair's resultants,
 //!   the energy ledger);
+//! - [`parts`]: several deformable parts merged into the one mesh the solver integrates;
 //! - [`summary`]: the generic `summary.json`;
 //! - [`contact_nodes`]: every contact candidate's position and forces at the end of the run
 //!   (`contact_nodes.csv`).
@@ -15,23 +16,31 @@
 pub mod build;
 pub mod contact_nodes;
 pub mod history;
+pub mod parts;
 pub mod summary;
 
 use std::path::Path;
 
 pub use build::{Scene, SpecError, build};
+pub use parts::merge_parts;
 
 use crate::model_spec::ModelSpec;
 use crate::validate::{CaseError, parse_document};
 
-/// Parses model-file text with `overrides` applied (`path` is only used in messages). Names
-/// and values are checked when the scene is built ([`build()`]).
+/// Parses model-file text with `overrides` applied (`path` is only used in messages), its
+/// `parts` merged into `part` ([`merge_parts`]). Names and values are checked when the scene is
+/// built ([`build()`]).
 ///
 /// # Errors
 /// [`CaseError::Parse`] for text that is not JSON or not of the format, naming the line or the
-/// field.
+/// field; [`CaseError::Invalid`] for parts that cannot be merged.
 pub fn parse_model(text: &str, path: &Path, overrides: &[String]) -> Result<ModelSpec, CaseError> {
-    parse_document(text, path, overrides)
+    let spec: ModelSpec = parse_document(text, path, overrides)?;
+    merge_parts(spec).map_err(|e| CaseError::Invalid {
+        path: path.to_path_buf(),
+        field: e.field,
+        message: e.message,
+    })
 }
 
 /// The model file's text: pretty JSON whose numbers read back to the same bits.

@@ -25,7 +25,7 @@ pub fn declares_model(text: &str) -> bool {
     serde_json::from_str::<serde_json::Value>(text).is_ok_and(|v| v.get("skid_model").is_some())
 }
 
-/// A whole scene: one deformable part, rigid bodies, constraints, loads, contact, steps.
+/// A whole scene: deformable parts, rigid bodies, constraints, loads, contact, steps.
 #[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
@@ -38,8 +38,16 @@ pub struct ModelSpec {
     pub description: String,
     /// 2 (plane strain) or 3.
     pub dimension: usize,
-    /// The deformable part.
+    /// The deformable part (the first, if `parts` names more).
     pub part: PartSpec,
+    /// Further deformable parts, merged with `part` into the one mesh the solver integrates:
+    /// their nodes and elements numbered after those before, their sets and surfaces named
+    /// `<part>.<set>`, and the node and element set `<part>` holding all of theirs; their
+    /// section's material and density become the material of the element set `<part>`, and
+    /// its thickness, hourglass scale and quasi-static setting must be the first part's. A
+    /// model as run holds the merged `part`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub parts: Vec<PartSpec>,
     /// Rigid bodies; each moves in all its degrees of freedom unless `boundary` fixes some.
     #[serde(default)]
     pub rigid_bodies: Vec<RigidBodySpec>,

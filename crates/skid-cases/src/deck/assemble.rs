@@ -252,6 +252,7 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
         description: defs.heading.clone(),
         dimension: dim,
         part: part_spec,
+        parts: Vec::new(),
         rigid_bodies: rigid_specs,
         boundary: spec_boundary,
         ties,

@@ -68,6 +68,13 @@ pub fn write_deck(
     spec: &ModelSpec,
     rigid: &BTreeMap<String, RigidElements>,
 ) -> Result<String, String> {
+    if !spec.parts.is_empty() {
+        return Err(
+            "parts: a deck holds one mesh; merge the parts into `part` first (reading a model \
+             file does, see `model_file::merge_parts`)"
+                .into(),
+        );
+    }
     let dim = spec.dimension;
     let part = &spec.part;
     let mut out = String::new();

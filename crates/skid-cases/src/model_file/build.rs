@@ -99,6 +99,9 @@ fn vector3(field: &str, v: [f64; 3]) -> Result<Vector3<f64>, SpecError> {
 /// # Errors
 /// The first problem found, as a [`SpecError`].
 pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
+    if !spec.parts.is_empty() {
+        return build::<D>(&super::merge_parts(spec.clone())?);
+    }
     if spec.skid_model != MODEL_FORMAT_VERSION {
         return fail(
             "skid_model",
