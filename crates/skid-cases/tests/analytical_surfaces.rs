@@ -101,6 +101,12 @@ fn the_drum_as_a_revolved_line_spins_down_as_the_cylinder() {
     }
 }
 
+/// The surface of the rigid body `ground`.
+fn ground(model: &ModelSpec) -> Option<&RigidSurfaceSpec> {
+    let body = model.rigid_bodies.iter().find(|b| b.name == "ground");
+    body.expect("ground").surface.as_ref()
+}
+
 /// The 3D verification block's ground replaced by an analytical surface of revolution.
 fn deck_with(surface: &str) -> String {
     let deck = std::fs::read_to_string(repo(
@@ -122,14 +128,9 @@ fn a_revolved_profile_of_lines_is_a_surface_of_revolution() {
                    START, 0.6, 2.0\nLINE, 0.6, 1.0\nLINE, 0.5, 0.5\nLINE, 0.5, -2.0\n\
                    *RIGID BODY, REF NODE=ground, ANALYTICAL SURFACE=ground";
     let model = read_deck_text(&deck_with(surface)).expect("revolution");
-    let ground = model
-        .rigid_bodies
-        .iter()
-        .find(|b| b.name == "ground")
-        .expect("ground");
     assert_eq!(
-        ground.surface,
-        Some(RigidSurfaceSpec::Revolution {
+        ground(&model),
+        Some(&RigidSurfaceSpec::Revolution {
             axis: [1.0, 0.0, 0.0],
             profile: vec![[0.5, -2.0], [0.5, 0.5], [0.6, 1.0], [0.6, 2.0]],
             closed: false,
@@ -162,14 +163,9 @@ fn a_profile_of_lines_swept_along_its_generator_is_an_extrusion() {
                    START, -2.0, 0.0\nLINE, 0.015, 0.0\nLINE, 0.02, -0.001\nLINE, 2.0, -0.001\n\
                    *RIGID BODY, REF NODE=ground, ANALYTICAL SURFACE=ground";
     let model = read_deck_text(&deck_with(surface)).expect("extrusion");
-    let ground = model
-        .rigid_bodies
-        .iter()
-        .find(|b| b.name == "ground")
-        .expect("ground");
     assert_eq!(
-        ground.surface,
-        Some(RigidSurfaceSpec::Extrusion {
+        ground(&model),
+        Some(&RigidSurfaceSpec::Extrusion {
             axis: [0.0, 0.0, 1.0],
             reference: [1.0, 0.0, 0.0],
             profile: vec![[2.0, -0.001], [0.02, -0.001], [0.015, 0.0], [-2.0, 0.0]],

@@ -118,10 +118,8 @@ impl RigidSurface for RigidRevolution {
         y_end: &Vector3<f64>,
         rotation_axis: &Vector3<f64>,
     ) -> Option<DiscreteGradient> {
+        // (the chart cylinder refuses another rotation axis)
         let e = self.chart.axis();
-        if e.cross(rotation_axis).norm() > 1e-12 {
-            return None;
-        }
         let perp = |y: &Vector3<f64>| y - e * e.dot(y);
         let (start, end) = (perp(y_start), perp(y_end));
         let meridian =
@@ -131,18 +129,14 @@ impl RigidSurface for RigidRevolution {
         if k != k_end {
             return None;
         }
-        let sum = start.norm() + end.norm();
-        let radial = (start + end) / sum;
-        let gradient = radial * normal.x + e * normal.y;
-        let across = Matrix3::identity() - e * e.transpose();
-        let pull = radial * (end / end.norm()).transpose();
-        let jacobian = (across - (pull + pull.transpose()) * 0.5) * normal.x / sum;
-        (sum > 0.0
-            && gradient
-                .iter()
-                .chain(jacobian.iter())
-                .all(|c| c.is_finite()))
-        .then_some(DiscreteGradient { gradient, jacobian })
+        // the radial part is the chart cylinder's discrete gradient of r
+        let radial = self
+            .chart
+            .gap_discrete_gradient(y_start, y_end, rotation_axis)?;
+        Some(DiscreteGradient {
+            gradient: radial.gradient * normal.x + e * normal.y,
+            jacobian: radial.jacobian * normal.x,
+        })
     }
 }
 
