@@ -293,6 +293,21 @@ pub(crate) fn read(path: &Path) -> Result<String, ReportError> {
     })
 }
 
+/// The JSON file `path` read as a `T`; `expected` says what it should be in the message of a
+/// file that is not.
+///
+/// # Errors
+/// [`ReportError::Read`], or [`ReportError::Parse`] naming the file.
+pub(crate) fn read_json<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    expected: &str,
+) -> Result<T, ReportError> {
+    serde_json::from_str(&read(path)?).map_err(|e| ReportError::Parse {
+        path: path.to_path_buf(),
+        message: format!("expected {expected}: {e}"),
+    })
+}
+
 /// Reads one run directory: a drum case's run, or a model run (`model.json`, no `case.json`:
 /// a model file or deck of the drum scene, see [`model_run`]).
 ///
@@ -302,21 +317,15 @@ pub fn load_run(dir: &Path) -> Result<Run, ReportError> {
     if !dir.join(CASE_JSON).is_file() && dir.join(MODEL_JSON).is_file() {
         return model_run::load(dir);
     }
-    let summary_path = dir.join("summary.json");
-    let summary: RunSummary =
-        serde_json::from_str(&read(&summary_path)?).map_err(|e| ReportError::Parse {
-            path: summary_path.clone(),
-            message: format!("expected a skid run summary: {e}"),
-        })?;
+    let summary: RunSummary = read_json(&dir.join("summary.json"), "a skid run summary")?;
     let history_path = dir.join("history.csv");
     let history = parse_history(&read(&history_path)?, &history_path)?;
     let case_path = dir.join(CASE_JSON);
     let case = if case_path.is_file() {
-        let case = serde_json::from_str(&read(&case_path)?).map_err(|e| ReportError::Parse {
-            path: case_path.clone(),
-            message: format!("expected the case as run (written by skid run): {e}"),
-        })?;
-        Some(case)
+        Some(read_json(
+            &case_path,
+            "the case as run (written by skid run)",
+        )?)
     } else {
         None
     };

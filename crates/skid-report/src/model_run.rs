@@ -16,7 +16,7 @@ use serde::Deserialize;
 use skid_cases::csv_out::CsvTable;
 use skid_cases::spin_down::{SpinDown, SpinPoint};
 
-use super::{History, ReportError, Run, RunSummary, dynamic_rows, read};
+use super::{History, ReportError, Run, RunSummary, dynamic_rows, read, read_json};
 
 /// The fields of a model run's `summary.json` the benchmark reads.
 #[derive(Deserialize)]
@@ -53,12 +53,8 @@ struct Spin {
 /// [`ReportError`] naming the file that is missing or malformed, or the history in which no
 /// body turns.
 pub(crate) fn load(dir: &Path) -> Result<Run, ReportError> {
-    let summary_path = dir.join("summary.json");
     let summary: ModelRunSummary =
-        serde_json::from_str(&read(&summary_path)?).map_err(|e| ReportError::Parse {
-            path: summary_path.clone(),
-            message: format!("expected a skid model run summary: {e}"),
-        })?;
+        read_json(&dir.join("summary.json"), "a skid model run summary")?;
     let history_path = dir.join("history.csv");
     let spin = turning_body(&read(&history_path)?, &history_path)?;
     let omega0 = spin.points.first().map_or(0.0, |p| p.omega);

@@ -14,7 +14,7 @@ use serde::Deserialize;
 
 use super::format::{Checks, Counts, Sig, plain};
 use super::plot::{STRESS_SVG, plot_scatter_log_log};
-use super::{ReportError, read};
+use super::{ReportError, read_json};
 
 /// How a run of the sweep ended, as `scripts/stress.py` classified it.
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, PartialOrd, Ord)]
@@ -137,10 +137,7 @@ pub struct StressMeasures {
 /// # Errors
 /// [`ReportError::Read`] or [`ReportError::Parse`] naming the file.
 pub fn load(path: &Path) -> Result<StressSweep, ReportError> {
-    serde_json::from_str(&read(path)?).map_err(|e| ReportError::Parse {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })
+    read_json(path, "the stress sweep written by scripts/stress.py")
 }
 
 /// Plotted energy errors below this are drawn at it (a log axis has no zero).
