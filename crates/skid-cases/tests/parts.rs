@@ -1,6 +1,6 @@
 //! Several deformable parts: the two pads of `2d-two-pads-on-drum.json`, one part there, given
-//! as two parts (the lower pad numbered from 0 with its own set names) merge into the same mesh
-//! and run to the same history, bit for bit; parts that cannot be merged are refused with the
+//! as two parts in `2d-two-pads-on-drum-parts.json` (the lower pad numbered from 0 with its own
+//! set names) merge into the same mesh and run to the same history, bit for bit; parts that cannot be merged are refused with the
 //! field at fault.
 
 use std::path::{Path, PathBuf};
@@ -15,72 +15,18 @@ fn repo(path: &str) -> PathBuf {
         .join(path)
 }
 
-/// The scene with its lower pad (nodes 22-43, elements 10-19, the `lower-*` sets) moved into
-/// a second part `lower`, whose sets are referred to as `lower.<set>`.
+/// The scene in one part, and in the two parts of `2d-two-pads-on-drum-parts.json` (its lower
+/// pad numbered from 0, with its own set names, referred to as `lower.<set>`).
 fn two_parts() -> (Value, Value) {
-    let text = std::fs::read_to_string(repo("cases/verification/2d-two-pads-on-drum.json"))
-        .expect("scene");
-    let one: Value = serde_json::from_str(&text).expect("json");
-    let mut two = one.clone();
-    let part = &mut two["part"];
-    let nodes = part["nodes"].as_array().expect("nodes").clone();
-    let connectivity = part["elements"][0]["connectivity"]
-        .as_array()
-        .expect("connectivity")
-        .clone();
-    let shifted = |list: &Value, by: u64| -> Value {
-        list.as_array()
-            .expect("list")
-            .iter()
-            .map(|v| json!(v.as_u64().expect("index") - by))
-            .collect()
+    let read = |file: &str| -> Value {
+        let text =
+            std::fs::read_to_string(repo(&format!("cases/verification/{file}"))).expect("scene");
+        serde_json::from_str(&text).expect("json")
     };
-    let mut lower_sets = serde_json::Map::new();
-    let mut lower_surfaces = serde_json::Map::new();
-    for (name, members) in part["node_sets"].as_object().expect("sets").clone() {
-        if let Some(own) = name.strip_prefix("lower-") {
-            lower_sets.insert(own.to_string(), shifted(&members, 22));
-            part["node_sets"]
-                .as_object_mut()
-                .expect("sets")
-                .remove(&name);
-        }
-    }
-    for (name, faces) in part["surfaces"].as_object().expect("surfaces").clone() {
-        if let Some(own) = name.strip_prefix("lower-") {
-            let faces: Value = faces
-                .as_array()
-                .expect("faces")
-                .iter()
-                .map(|f| shifted(f, 22))
-                .collect();
-            lower_surfaces.insert(own.to_string(), faces);
-            part["surfaces"]
-                .as_object_mut()
-                .expect("surfaces")
-                .remove(&name);
-        }
-    }
-    let lower = json!({
-        "name": "lower",
-        "nodes": nodes[22..].to_vec(),
-        "elements": [{
-            "type": "CPE4R",
-            "connectivity": connectivity[10..].iter().map(|c| shifted(c, 22)).collect::<Vec<_>>(),
-        }],
-        "node_sets": lower_sets,
-        "surfaces": lower_surfaces,
-        "section": part["section"].clone(),
-    });
-    part["nodes"] = json!(nodes[..22].to_vec());
-    part["elements"][0]["connectivity"] = json!(connectivity[..10].to_vec());
-    two["parts"] = json!([lower]);
-    // every reference to a lower-* set becomes lower.<set>
-    let text = serde_json::to_string(&two)
-        .expect("text")
-        .replace("\"lower-front\"", "\"lower.front\"")
-        .replace("\"lower-back\"", "\"lower.back\"");
-    (one, serde_json::from_str(&text).expect("json"))
+    (
+        read("2d-two-pads-on-drum.json"),
+        read("2d-two-pads-on-drum-parts.json"),
+    )
 }
 
 fn history(spec: &Value) -> String {
