@@ -293,6 +293,26 @@ pub(crate) fn read(path: &Path) -> Result<String, ReportError> {
     })
 }
 
+/// Where the runs in `runs` came from: the one directory of the input files its `batch.json`
+/// lists (`cases/inp` for the drum decks), else `cases/drum`, the benchmark's own.
+pub(crate) fn batch_inputs(runs: &Path) -> String {
+    let listed: Option<Vec<serde_json::Value>> = std::fs::read_to_string(runs.join("batch.json"))
+        .ok()
+        .and_then(|text| serde_json::from_str(&text).ok());
+    let mut dirs: Vec<String> = listed
+        .unwrap_or_default()
+        .iter()
+        .filter_map(|entry| entry.get("case_file")?.as_str().map(Path::new))
+        .filter_map(|file| file.parent().map(|d| d.display().to_string()))
+        .collect();
+    dirs.sort();
+    dirs.dedup();
+    match dirs.as_slice() {
+        [dir] if !dir.is_empty() => dir.clone(),
+        _ => "cases/drum".into(),
+    }
+}
+
 /// The JSON file `path` read as a `T`; `expected` says what it should be in the message of a
 /// file that is not.
 ///
@@ -425,7 +445,11 @@ fn regenerate(sources: &ReportSources<'_>, out: &Path) -> String {
     let mut commands = Vec::new();
     let mut report = String::from("skid report");
     if let Some(runs) = sources.runs {
-        commands.push(format!("skid batch cases/drum --out {}", runs.display()));
+        commands.push(format!(
+            "skid batch {} --out {}",
+            batch_inputs(runs),
+            runs.display()
+        ));
         let _ = write!(report, " --runs {}", runs.display());
         if let Some(reference) = sources.reference {
             let _ = write!(report, " --reference {reference}");
@@ -596,6 +620,21 @@ pub(crate) mod test_runs {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The regenerating command names the directory the batch's inputs came from.
+    #[test]
+    fn the_batch_inputs_are_named_by_their_directory() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        assert_eq!(batch_inputs(dir.path()), "cases/drum");
+        let listed = r#"[{"case_file": "cases/inp/2d-analytic.inp"},
+                         {"case_file": "cases/inp/3d-r3d4.inp"}]"#;
+        std::fs::write(dir.path().join("batch.json"), listed).expect("write");
+        assert_eq!(batch_inputs(dir.path()), "cases/inp");
+        let mixed = r#"[{"case_file": "cases/inp/2d-analytic.inp"},
+                        {"case_file": "cases/drum/3d-r3d4.json"}]"#;
+        std::fs::write(dir.path().join("batch.json"), mixed).expect("write");
+        assert_eq!(batch_inputs(dir.path()), "cases/drum");
+    }
 
     fn linear(omega0: f64, decel: f64, dt: f64, n: usize) -> History {
         let time: Vec<f64> = (0..=n).map(|k| k as f64 * dt).collect();

@@ -194,7 +194,7 @@ pub fn render(runs_dir: &Path, runs: &[Run], reference: usize) -> (String, Count
     let _ = write!(
         out,
         "## Benchmark: the drum idealizations\n\n\
-         Runs in `{dir}` (`skid batch cases/drum`). \
+         Runs in `{dir}` (`skid batch {inputs}`). \
          Reference: **{reference}**. omega_ref(t) is its drum angular velocity, linearly \
          interpolated at each run's times; times count from the start of the dynamic step. \
          e_slide = max |omega - omega_ref| / omega0 over t <= 0.9 t_stop of the run \
@@ -204,6 +204,7 @@ pub fn render(runs_dir: &Path, runs: &[Run], reference: usize) -> (String, Count
          ![omega(t) - omega_ref(t)]({DIFFERENCE_SVG})\n\n\
          ### Runs\n\n",
         dir = runs_dir.display(),
+        inputs = super::batch_inputs(runs_dir),
         reference = reference_run.name,
     );
     table(runs, &measures, &mut out);
