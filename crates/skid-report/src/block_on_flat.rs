@@ -173,8 +173,8 @@ pub(crate) fn flat_pair(spec: &ModelSpec) -> Option<(&ContactPairSpec, &RigidBod
 }
 
 /// The unit outward normal of a flat surface: a plane's; a polyline's whose segments all run
-/// one way (their direction turned clockwise); a triangle mesh's whose triangles all face one
-/// way (within 1e-9). `None` for any other surface.
+/// one way (their direction turned clockwise), and the extrusion of one; a triangle mesh's whose
+/// triangles all face one way (within 1e-9). `None` for any other surface.
 fn flat_normal(surface: &RigidSurfaceSpec) -> Option<[f64; 3]> {
     let same = |normals: Vec<[f64; 3]>| {
         let first = *normals.first()?;
@@ -191,6 +191,28 @@ fn flat_normal(surface: &RigidSurfaceSpec) -> Option<[f64; 3]> {
                 .map(|w| unit([w[1][1] - w[0][1], w[0][0] - w[1][0], 0.0]))
                 .collect(),
         ),
+        RigidSurfaceSpec::Extrusion {
+            axis,
+            reference,
+            profile,
+            ..
+        } => {
+            // the profile's plane: u along the reference (made perpendicular to the axis), v
+            // along axis x u
+            let e = unit(*axis);
+            let along: f64 = reference.iter().zip(&e).map(|(a, b)| a * b).sum();
+            let u = unit([0, 1, 2].map(|k| reference[k] - along * e[k]));
+            let v = [
+                e[1] * u[2] - e[2] * u[1],
+                e[2] * u[0] - e[0] * u[2],
+                e[0] * u[1] - e[1] * u[0],
+            ];
+            let normal = flat_normal(&RigidSurfaceSpec::Polyline {
+                points: profile.clone(),
+                closed: false,
+            })?;
+            Some([0, 1, 2].map(|k| normal[0] * u[k] + normal[1] * v[k]))
+        }
         RigidSurfaceSpec::Triangles {
             vertices,
             triangles,
@@ -304,6 +326,14 @@ mod tests {
             },
         };
         assert_eq!(flat_normal(&mesh(0.0)), Some([0.0, 1.0, 0.0]));
+        // a straight profile in the x-y plane swept along z, walked towards -x: outside up
+        let extruded = RigidSurfaceSpec::Extrusion {
+            axis: [0.0, 0.0, 2.0],
+            reference: [1.0, 0.0, 0.0],
+            profile: vec![[1.0, 0.0], [0.0, 0.0], [-1.0, 0.0]],
+            closed: false,
+        };
+        assert_eq!(flat_normal(&extruded), Some([0.0, 1.0, 0.0]));
         assert_eq!(flat_normal(&mesh(0.1)), None);
     }
 
