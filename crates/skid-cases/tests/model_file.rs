@@ -379,7 +379,7 @@ fn every_model_error_names_its_field() {
     )
     .expect("json");
     type Edit = fn(&mut Value);
-    let cases: [(&Value, Edit, &str, &str); 11] = [
+    let cases: [(&Value, Edit, &str, &str); 17] = [
         (
             &base,
             |v| v["skid_model"] = json!(2),
@@ -451,6 +451,55 @@ fn every_model_error_names_its_field() {
             |v| v["boundary"][1]["dofs"] = json!(["x", "z", "rz"]),
             "rigid_bodies[1]",
             "at most one axis",
+        ),
+        (
+            &base,
+            |v| {
+                v["rigid_bodies"][0]["surface"] = json!({"type": "extrusion", "axis": [0, 0, 1],
+                    "reference": [1, 0, 0], "profile": [[1, 0], [-1, 0]]})
+            },
+            "rigid_bodies[0].surface",
+            "a 3D surface",
+        ),
+        (
+            &base,
+            |v| v["rigid_bodies"][0]["surface"] = json!({"type": "polyline", "points": [[1, 0]]}),
+            "rigid_bodies[0].surface",
+            "at least 2 vertices",
+        ),
+        (
+            &base3,
+            |v| {
+                v["rigid_bodies"][0]["surface"] =
+                    json!({"type": "polyline", "points": [[1, 0], [-1, 0]]})
+            },
+            "rigid_bodies[0].surface",
+            "a 2D surface",
+        ),
+        (
+            &base3,
+            |v| {
+                v["rigid_bodies"][0]["surface"] = json!({"type": "revolution", "axis": [1, 0, 0],
+                    "profile": [[-0.1, -1], [0.2, 1]]})
+            },
+            "rigid_bodies[0].surface",
+            "r >= 0",
+        ),
+        (
+            &base3,
+            |v| {
+                v["rigid_bodies"][0]["surface"] = json!({"type": "triangles",
+                    "vertices": [[0, 0, 0], [0, 0, 1], [1, 0, 0]], "triangles": [[0, 1, 2]],
+                    "chart": {"type": "plane", "normal": [0, 1, 0], "tangent": [0, 2, 0]}})
+            },
+            "rigid_bodies[0].surface",
+            "not parallel",
+        ),
+        (
+            &base3,
+            |v| v["steps"][0]["automatic"] = json!({"initial": 0.5, "min": 0.1, "max": 1.0}),
+            "steps[0].increments",
+            "exactly one of increments (fixed) and automatic",
         ),
     ];
     for (base, edit, field, fragment) in cases {
