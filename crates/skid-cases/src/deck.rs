@@ -2,6 +2,7 @@
 //!
 //! - [`keywords`]: the keyword layer: keyword blocks with parameters and data lines, comments,
 //!   continuation lines and `*INCLUDE`, each with its file and line.
+//! - [`instances`]: parts and their instances flattened into the blocks of one mesh.
 //! - [`read`]: the keyword subset read into definitions with the deck's labels and names
 //!   ([`fields`] reads typed parameters and fields, [`mesh`] nodes, elements and sets,
 //!   [`rigid`] analytical and faceted rigid surfaces, [`loads`] amplitudes and loads).
@@ -19,7 +20,9 @@
 //! `*AMPLITUDE` (TABULAR, step or total time), `*STEP` (NLGEOM, AMPLITUDE=RAMP|STEP), `*STATIC` (DIRECT, or automatic
 //! increments without it) and `*DYNAMIC` (DIRECT, ALPHA), `*CLOAD`, `*DSLOAD` / `*DLOAD` pressures and `*DLOAD` gravity (`GRAV`), each with
 //! `AMPLITUDE=`, `*OUTPUT`, `*NODE OUTPUT`, `*CONTACT OUTPUT`,
-//! `*END STEP`, `*INCLUDE`. Anything else is an error at its line.
+//! `*END STEP`, `*INCLUDE`, and `*PART` / `*END PART`, `*ASSEMBLY` / `*END ASSEMBLY`,
+//! `*INSTANCE` / `*END INSTANCE` (translated, not rotated). Anything else is an error at its
+//! line.
 //!
 //! How skid reads what the keywords leave open, or what it models differently:
 //! - model-data boundary conditions hold throughout; in a step, zero-valued conditions on a
@@ -59,6 +62,7 @@
 
 pub mod assemble;
 pub mod fields;
+pub mod instances;
 pub mod keywords;
 pub mod loads;
 pub mod mesh;
@@ -92,7 +96,7 @@ pub fn is_deck(path: &Path) -> bool {
 /// # Errors
 /// [`DeckError`] naming the file and line of the first problem.
 pub fn read_model(path: &Path) -> Result<DeckModel, DeckError> {
-    let blocks = read_deck(path)?;
+    let blocks = instances::flatten(read_deck(path)?)?;
     let defs = read::read_definitions(&blocks)?;
     let name = path
         .file_stem()

@@ -1,0 +1,318 @@
+//! Parts and instances (`*PART` ... `*END PART`, `*ASSEMBLY` with `*INSTANCE` ... `*END
+//! INSTANCE`, as Abaqus/CAE writes decks) flattened into the keyword blocks of one mesh, which
+//! the rest of the reader takes as a deck without parts.
+//!
+//! Each instance copies its part's nodes, elements, sets, surfaces and sections: node and
+//! element labels are raised by the instance's offset (`k` times a stride above every label
+//! of the deck, for the `k`-th instance from 1), set and surface names take the prefix
+//! `<instance>.`, and nodes move by the instance's translation. Assembly-level sets with
+//! `INSTANCE=` name the instance's labels, and a field `<instance>.<label>` anywhere outside
+//! the parts names that instance's node or element. A deck without `*PART` is left as it is.
+//! Instances are not rotated, and a translated instance carries no analytical surface.
+
+use std::collections::HashMap;
+
+use super::fields::{allow_parameters, key};
+use super::keywords::{Block, DataLine, DeckError};
+
+/// What a part holds: its blocks in order.
+struct Part {
+    blocks: Vec<Block>,
+}
+
+/// An instance: its part, label offset and translation.
+struct Instance {
+    part: String,
+    offset: u64,
+    translation: [f64; 3],
+}
+
+/// Flattens the parts and instances of `blocks` (see the module documentation).
+///
+/// # Errors
+/// [`DeckError`] at a keyword inside a part or an assembly that is not read there, an unknown
+/// part, a rotated instance, or an unterminated part, instance or assembly.
+pub fn flatten(blocks: Vec<Block>) -> Result<Vec<Block>, DeckError> {
+    if !blocks.iter().any(|b| b.name == "PART") {
+        return Ok(blocks);
+    }
+    let stride = blocks
+        .iter()
+        .filter(|b| b.name == "NODE" || b.name == "ELEMENT")
+        .flat_map(|b| &b.data)
+        .filter_map(|line| line.fields.first()?.parse::<u64>().ok())
+        .max()
+        .unwrap_or(0)
+        + 1;
+    let mut parts: HashMap<String, Part> = HashMap::new();
+    let mut instances: HashMap<String, Instance> = HashMap::new();
+    let mut out = Vec::with_capacity(blocks.len());
+    let mut iter = blocks.into_iter();
+    while let Some(block) = iter.next() {
+        match block.name.as_str() {
+            "PART" => {
+                allow_parameters(&block, &["NAME"])?;
+                let name = named(&block, "NAME")?;
+                let mut held = Vec::new();
+                loop {
+                    let inner = iter
+                        .next()
+                        .ok_or_else(|| block.error("no *END PART closes it"))?;
+                    match inner.name.as_str() {
+                        "END PART" => break,
+                        "PART" | "ASSEMBLY" | "END ASSEMBLY" | "STEP" => {
+                            return Err(inner.error(format!(
+                                "*PART {name} is not closed: expected *END PART before this \
+                                 keyword"
+                            )));
+                        }
+                        _ => in_part(&inner)?,
+                    }
+                    held.push(inner);
+                }
+                parts.insert(key(&name), Part { blocks: held });
+            }
+            "ASSEMBLY" => {
+                allow_parameters(&block, &["NAME"])?;
+                loop {
+                    let inner = iter
+                        .next()
+                        .ok_or_else(|| block.error("no *END ASSEMBLY closes it"))?;
+                    match inner.name.as_str() {
+                        "END ASSEMBLY" => break,
+                        "INSTANCE" => {
+                            let end = iter
+                                .next()
+                                .ok_or_else(|| inner.error("no *END INSTANCE closes it"))?;
+                            if end.name != "END INSTANCE" {
+                                return Err(end.error(
+                                    "expected *END INSTANCE: an instance holds no keywords of \
+                                     its own (define them in its *PART)",
+                                ));
+                            }
+                            let k = instances.len() as u64 + 1;
+                            let (name, instance) = instance(&inner, k * stride)?;
+                            let part = parts.get(&key(&instance.part)).ok_or_else(|| {
+                                inner.error(format!("no *PART named {}", instance.part))
+                            })?;
+                            for b in &part.blocks {
+                                out.push(copy(b, &name, &instance)?);
+                            }
+                            instances.insert(key(&name), instance);
+                        }
+                        "NSET" | "ELSET" if inner.parameter("INSTANCE").is_some() => {
+                            out.push(assembly_set(inner, &instances)?);
+                        }
+                        "NODE" | "ELEMENT" | "NSET" | "ELSET" | "SURFACE" | "RIGID BODY"
+                        | "MASS" | "ROTARY INERTIA" => out.push(labelled(inner, &instances)),
+                        _ => {
+                            return Err(inner.error(
+                                "is not read inside an *ASSEMBLY (skid reads instances, nodes, \
+                                 elements, sets, surfaces, rigid bodies and point inertias \
+                                 there)",
+                            ));
+                        }
+                    }
+                }
+            }
+            "END PART" | "END ASSEMBLY" | "INSTANCE" | "END INSTANCE" => {
+                return Err(block.error("outside the *PART or *ASSEMBLY it belongs to"));
+            }
+            _ => out.push(labelled(block, &instances)),
+        }
+    }
+    Ok(out)
+}
+
+/// The value of the required parameter `name`.
+fn named(block: &Block, name: &str) -> Result<String, DeckError> {
+    block
+        .parameter(name)
+        .flatten()
+        .map(str::to_string)
+        .ok_or_else(|| block.error(format!("expected {name}=")))
+}
+
+/// Refuses a keyword a part does not hold.
+fn in_part(block: &Block) -> Result<(), DeckError> {
+    match block.name.as_str() {
+        "NODE" | "ELEMENT" | "NSET" | "ELSET" | "SURFACE" | "SOLID SECTION"
+        | "MEMBRANE SECTION" | "SHELL SECTION" => Ok(()),
+        _ => Err(block.error(
+            "is not read inside a *PART (skid reads nodes, elements, sets, surfaces and \
+             sections there; give the rest in the assembly or the model data)",
+        )),
+    }
+}
+
+/// `*INSTANCE, NAME, PART` with its optional translation line; a rotation line is refused.
+fn instance(block: &Block, offset: u64) -> Result<(String, Instance), DeckError> {
+    allow_parameters(block, &["NAME", "PART"])?;
+    let name = named(block, "NAME")?;
+    let part = named(block, "PART")?;
+    let mut translation = [0.0; 3];
+    match block.data.as_slice() {
+        [] => {}
+        [line] => {
+            for (k, t) in translation.iter_mut().enumerate() {
+                if let Some(text) = line.fields.get(k).filter(|f| !f.is_empty()) {
+                    *t = text.parse().map_err(|_| {
+                        super::fields::line_error(
+                            block,
+                            line,
+                            format!(
+                                "field {} (translation): expected a number, got '{text}'",
+                                k + 1
+                            ),
+                        )
+                    })?;
+                }
+            }
+        }
+        _ => {
+            return Err(
+                block.error("a rotated instance is not read: give its part's nodes where they are")
+            );
+        }
+    }
+    Ok((
+        name,
+        Instance {
+            part,
+            offset,
+            translation,
+        },
+    ))
+}
+
+/// The block `b` of a part copied into instance `name`.
+fn copy(b: &Block, name: &str, instance: &Instance) -> Result<Block, DeckError> {
+    let mut out = b.clone();
+    let prefix = |v: &str| format!("{name}.{v}");
+    for (parameter, value) in &mut out.parameters {
+        let renamed = matches!(parameter.as_str(), "NSET" | "ELSET")
+            || (parameter == "NAME" && b.name == "SURFACE");
+        if renamed && let Some(v) = value.as_mut() {
+            *v = prefix(v);
+        }
+    }
+    let raise = |field: &mut String| {
+        if let Ok(label) = field.parse::<u64>() {
+            *field = (label + instance.offset).to_string();
+        }
+    };
+    let moved = instance.translation != [0.0; 3];
+    match b.name.as_str() {
+        "NODE" => {
+            for line in &mut out.data {
+                if let Some(label) = line.fields.first_mut() {
+                    raise(label);
+                }
+                if moved {
+                    translate(b, line, &instance.translation)?;
+                }
+            }
+        }
+        "ELEMENT" => {
+            for line in &mut out.data {
+                line.fields.iter_mut().for_each(raise);
+            }
+        }
+        "NSET" | "ELSET" => {
+            let generate = b.parameter("GENERATE").is_some();
+            for line in &mut out.data {
+                for (k, field) in line.fields.iter_mut().enumerate() {
+                    if generate {
+                        // first, last, increment
+                        if k < 2 {
+                            raise(field);
+                        }
+                    } else if field.parse::<u64>().is_ok() {
+                        raise(field);
+                    } else if !field.is_empty() {
+                        *field = prefix(field);
+                    }
+                }
+            }
+        }
+        "SURFACE" => {
+            let on_elements = b.parameter("TYPE").flatten().is_none_or(|t| {
+                t.eq_ignore_ascii_case("ELEMENT") || t.eq_ignore_ascii_case("NODE")
+            });
+            if !on_elements && moved {
+                return Err(b.error(
+                    "an analytical surface in a translated instance is not read: give it in \
+                     the assembly",
+                ));
+            }
+            if on_elements {
+                for line in &mut out.data {
+                    if let Some(first) = line.fields.first_mut() {
+                        if first.parse::<u64>().is_ok() {
+                            raise(first);
+                        } else if !first.is_empty() {
+                            *first = prefix(first);
+                        }
+                    }
+                }
+            }
+        }
+        _ => {}
+    }
+    Ok(out)
+}
+
+/// Moves the coordinates of a `*NODE` line by `t`.
+fn translate(b: &Block, line: &mut DataLine, t: &[f64; 3]) -> Result<(), DeckError> {
+    let location = line.location.clone();
+    for (k, field) in line.fields.iter_mut().skip(1).take(3).enumerate() {
+        let x: f64 = field.parse().map_err(|_| DeckError {
+            location: location.clone(),
+            message: format!(
+                "*{}: field {} (coordinate): expected a number",
+                b.name,
+                k + 2
+            ),
+        })?;
+        *field = format!("{:?}", x + t[k]);
+    }
+    Ok(())
+}
+
+/// An assembly-level `*NSET`/`*ELSET` with `INSTANCE=`: its labels are the instance's.
+fn assembly_set(mut b: Block, instances: &HashMap<String, Instance>) -> Result<Block, DeckError> {
+    let name = named(&b, "INSTANCE")?;
+    let instance = instances
+        .get(&key(&name))
+        .ok_or_else(|| b.error(format!("no *INSTANCE named {name} before it")))?;
+    let generate = b.parameter("GENERATE").is_some();
+    for line in &mut b.data {
+        for (k, field) in line.fields.iter_mut().enumerate() {
+            if (!generate || k < 2)
+                && let Ok(label) = field.parse::<u64>()
+            {
+                *field = (label + instance.offset).to_string();
+            }
+        }
+    }
+    b.parameters.retain(|(p, _)| p != "INSTANCE");
+    Ok(b)
+}
+
+/// `b` with every field `<instance>.<label>` replaced by the instance's label.
+fn labelled(mut b: Block, instances: &HashMap<String, Instance>) -> Block {
+    if instances.is_empty() {
+        return b;
+    }
+    for line in &mut b.data {
+        for field in &mut line.fields {
+            if let Some((name, label)) = field.rsplit_once('.')
+                && let (Some(instance), Ok(label)) =
+                    (instances.get(&key(name)), label.parse::<u64>())
+            {
+                *field = (label + instance.offset).to_string();
+            }
+        }
+    }
+    b
+}

@@ -1,0 +1,163 @@
+//! Decks with parts and instances, as Abaqus/CAE writes them: a block defined in a `*PART`,
+//! placed by a translated `*INSTANCE` and referred to as `Block-1.<set>` and `Block-1.<label>`,
+//! reads to the mesh of the same deck written without parts and runs to the same history; what
+//! a part or an instance cannot hold is refused at its line.
+
+use std::path::Path;
+
+#[path = "support/deck_text.rs"]
+mod deck_text;
+use deck_text::{assert_refused_at, read_deck_text};
+
+use skid_cases::model_spec::ModelSpec;
+use skid_cases::runner::run_model;
+
+/// The model data after the mesh and the rigid ground, and the step, with `block` the name of
+/// the block's element set, `bottom` its contact surface and `corner` its corner node.
+fn rest(block: &str, bottom: &str, corner: &str) -> String {
+    format!(
+        "\
+*Material, name=soft
+*Elastic
+1.0e6, 0.3
+*Density
+1000.
+*Surface Interaction, name=rough
+*Friction
+0.3
+*Contact Pair, interaction=rough
+{bottom}, ground
+*Boundary
+ground, ENCASTRE
+{corner}, 1, 1
+*Step, name=press, nlgeom
+*Static, direct
+0.25, 1.
+*Dload
+{block}, P3, 1.e4
+*End Step
+"
+    )
+}
+
+const GROUND: &str = "\
+*Node, nset=ground
+10, 0., 0.
+*Surface, name=ground, type=segments
+START, -1., 0.
+LINE, 1., 0.
+*Rigid Body, ref node=ground, analytical surface=ground
+*Element, type=MASS, elset=ground_mass
+20, 10
+*Mass, elset=ground_mass
+0.05
+";
+
+fn flat() -> String {
+    format!(
+        "\
+*Heading
+a block on a rigid line
+*Node
+1, -0.25, 0.
+2, 0.25, 0.
+3, 0.25, 0.5
+4, -0.25, 0.5
+*Element, type=CPE4R, elset=block
+1, 1, 2, 3, 4
+*Nset, nset=bottom
+1, 2
+*Surface, name=bottom, type=node
+bottom
+*Solid Section, elset=block, material=soft
+0.01
+{GROUND}{}",
+        rest("block", "bottom", "1")
+    )
+}
+
+fn with_parts() -> String {
+    format!(
+        "\
+*Heading
+a block on a rigid line, as a part and its instance
+*Part, name=Block
+*Node
+1, -0.25, -1.
+2, 0.25, -1.
+3, 0.25, -0.5
+4, -0.25, -0.5
+*Element, type=CPE4R, elset=block
+1, 1, 2, 3, 4
+*Nset, nset=bottom, generate
+1, 2, 1
+*Surface, name=bottom, type=node
+bottom
+*Solid Section, elset=block, material=soft
+0.01
+*End Part
+*Assembly, name=Assembly
+*Instance, name=Block-1, part=Block
+0., 1., 0.
+*End Instance
+{GROUND}*End Assembly
+{}",
+        rest("Block-1.block", "Block-1.bottom", "Block-1.1")
+    )
+}
+
+fn history(model: &ModelSpec) -> String {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let summary = run_model(model, Path::new("block.inp"), dir.path()).expect("runs");
+    assert!(summary.error.is_none(), "{:?}", summary.error);
+    std::fs::read_to_string(dir.path().join("history.csv")).expect("history")
+}
+
+#[test]
+fn a_translated_instance_of_a_part_reads_to_the_flat_deck() {
+    let (flat, parts) = (
+        read_deck_text(&flat()).expect("flat deck"),
+        read_deck_text(&with_parts()).expect("deck with parts"),
+    );
+    assert_eq!(parts.part.nodes, flat.part.nodes);
+    assert_eq!(parts.part.elements, flat.part.elements);
+    assert_eq!(
+        parts.part.node_sets["Block-1.bottom"],
+        flat.part.node_sets["bottom"]
+    );
+    assert_eq!(history(&parts), history(&flat));
+}
+
+#[test]
+fn what_parts_and_instances_cannot_hold_is_refused() {
+    let deck = with_parts();
+    let inside = deck.replace(
+        "*Solid Section, elset=block, material=soft\n0.01\n*End Part",
+        "*Solid Section, elset=block, material=soft\n0.01\n*Boundary\n1, 1, 1\n*End Part",
+    );
+    assert_refused_at(&inside, "*Boundary", "not read inside a *PART");
+    let rotated = deck.replace("0., 1., 0.\n", "0., 1., 0.\n0., 0., 0., 0., 0., 1., 30.\n");
+    assert_refused_at(
+        &rotated,
+        "*Instance, name=Block-1, part=Block",
+        "rotated instance",
+    );
+    let unknown = deck.replace("part=Block\n", "part=Brick\n");
+    assert_refused_at(
+        &unknown,
+        "*Instance, name=Block-1, part=Brick",
+        "no *PART named Brick",
+    );
+    let open = deck.replace("*End Part\n", "");
+    assert_refused_at(
+        &open,
+        "*Assembly, name=Assembly",
+        "*PART Block is not closed",
+    );
+    let outside = deck.replace("*Assembly, name=Assembly\n", "");
+    assert_refused_at(
+        &outside,
+        "*Instance, name=Block-1, part=Block",
+        "outside the *PART or *ASSEMBLY",
+    );
+}
