@@ -161,3 +161,37 @@ fn what_parts_and_instances_cannot_hold_is_refused() {
         "outside the *PART or *ASSEMBLY",
     );
 }
+
+/// Two instances of one part: each its own nodes (translated apart), elements and sets, and
+/// both blocks pressed onto the ground run.
+#[test]
+fn two_instances_of_one_part_are_two_bodies() {
+    let deck = with_parts()
+        .replace(
+            "*End Instance\n",
+            "*End Instance\n*Instance, name=Block-2, part=Block\n0.75, 1., 0.\n*End Instance\n",
+        )
+        .replace(
+            "Block-1.bottom, ground\n",
+            "Block-1.bottom, ground\nBlock-2.bottom, ground\n",
+        )
+        .replace("Block-1.1, 1, 1\n", "Block-1.1, 1, 1\nBlock-2.1, 1, 1\n")
+        .replace(
+            "Block-1.block, P3, 1.e4\n",
+            "Block-1.block, P3, 1.e4\nBlock-2.block, P3, 1.e4\n",
+        );
+    let model = read_deck_text(&deck).expect("two instances");
+    assert_eq!(model.part.nodes.len(), 8);
+    let (one, two) = (
+        &model.part.node_sets["Block-1.bottom"],
+        &model.part.node_sets["Block-2.bottom"],
+    );
+    assert_eq!(one.len(), 2);
+    assert!(one.iter().all(|n| !two.contains(n)));
+    for (a, b) in one.iter().zip(two) {
+        let (p, q) = (&model.part.nodes[*a], &model.part.nodes[*b]);
+        assert_eq!((q[0] - p[0], q[1] - p[1]), (0.75, 0.0));
+    }
+    assert_eq!(model.contact.len(), 2);
+    history(&model);
+}
