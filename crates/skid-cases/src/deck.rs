@@ -21,7 +21,7 @@
 //! increments without it) and `*DYNAMIC` (DIRECT, ALPHA), `*CLOAD`, `*DSLOAD` / `*DLOAD` pressures and `*DLOAD` gravity (`GRAV`), each with
 //! `AMPLITUDE=`, `*OUTPUT`, `*NODE OUTPUT`, `*CONTACT OUTPUT`,
 //! `*END STEP`, `*INCLUDE`, and `*PART` / `*END PART`, `*ASSEMBLY` / `*END ASSEMBLY`,
-//! `*INSTANCE` / `*END INSTANCE` (translated, not rotated). Anything else is an error at its
+//! `*INSTANCE` / `*END INSTANCE` (translated and rotated). Anything else is an error at its
 //! line.
 //!
 //! How skid reads what the keywords leave open, or what it models differently:

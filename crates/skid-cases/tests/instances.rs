@@ -136,12 +136,9 @@ fn what_parts_and_instances_cannot_hold_is_refused() {
         "*Solid Section, elset=block, material=soft\n0.01\n*Boundary\n1, 1, 1\n*End Part",
     );
     assert_refused_at(&inside, "*Boundary", "not read inside a *PART");
-    let rotated = deck.replace("0., 1., 0.\n", "0., 1., 0.\n0., 0., 0., 0., 0., 1., 30.\n");
-    assert_refused_at(
-        &rotated,
-        "*Instance, name=Block-1, part=Block",
-        "rotated instance",
-    );
+    let tilted = deck.replace("0., 1., 0.\n", "0., 1., 0.\n0., 0., 0., 1., 0., 0., 90.\n");
+    // (the first two nodes land on the x axis, which the turn leaves in place)
+    assert_refused_at(&tilted, "3, 0.25, -0.5", "out of its plane");
     let unknown = deck.replace("part=Block\n", "part=Brick\n");
     assert_refused_at(
         &unknown,
@@ -194,4 +191,21 @@ fn two_instances_of_one_part_are_two_bodies() {
     }
     assert_eq!(model.contact.len(), 2);
     history(&model);
+}
+
+/// A rotated instance: translated, then turned by 180 degrees about the z axis through the
+/// origin, its nodes are the flat deck's turned about the origin.
+#[test]
+fn a_rotated_instance_turns_its_nodes_after_the_translation() {
+    let turned = with_parts().replace("0., 1., 0.\n", "0., 1., 0.\n0., 0., 0., 0., 0., 1., 180.\n");
+    let (flat, turned) = (
+        read_deck_text(&flat()).expect("flat deck"),
+        read_deck_text(&turned).expect("rotated instance"),
+    );
+    for (a, b) in flat.part.nodes.iter().zip(&turned.part.nodes) {
+        assert!(
+            (a[0] + b[0]).abs() < 1e-15 && (a[1] + b[1]).abs() < 1e-15,
+            "{a:?} {b:?}"
+        );
+    }
 }

@@ -5,14 +5,16 @@
 //! Each instance copies its part's nodes, elements, sets, surfaces and sections: node and
 //! element labels are raised by the instance's offset (`k` times a stride above every label
 //! of the deck, for the `k`-th instance from 1), set and surface names take the prefix
-//! `<instance>.`, and nodes move by the instance's translation. Assembly-level sets with
-//! `INSTANCE=` name the instance's labels, and a field `<instance>.<label>` anywhere outside
-//! the parts names that instance's node or element. A deck without `*PART` is left as it is.
-//! Instances are not rotated, and a translated instance carries no analytical surface.
+//! `<instance>.`, and nodes move by the instance's translation, then rotation. Assembly-level
+//! sets with `INSTANCE=` name the instance's labels, and a field `<instance>.<label>` anywhere
+//! outside the parts names that instance's node or element. A deck without `*PART` is left as it is.
+//! An instance that moves its part carries no analytical surface (give it in the assembly).
 
 use std::collections::HashMap;
 
-use super::fields::{allow_parameters, key};
+use nalgebra::{Rotation3, Unit, Vector3};
+
+use super::fields::{allow_parameters, at_most, key, line_error, real};
 use super::keywords::{Block, DataLine, DeckError};
 
 /// What a part holds: its blocks in order.
@@ -20,11 +22,28 @@ struct Part {
     blocks: Vec<Block>,
 }
 
-/// An instance: its part, label offset and translation.
+/// An instance: its part, label offset and placement.
 struct Instance {
     part: String,
     offset: u64,
     translation: [f64; 3],
+    /// A point `a` of the rotation axis, and the rotation (after the translation).
+    rotation: Option<(Vector3<f64>, Rotation3<f64>)>,
+}
+
+impl Instance {
+    /// Where the part's point `x` lies in the assembly: `a + Q (x + t - a)`.
+    fn place(&self, x: Vector3<f64>) -> Vector3<f64> {
+        let moved = x + Vector3::from(self.translation);
+        match &self.rotation {
+            Some((a, q)) => a + q * (moved - a),
+            None => moved,
+        }
+    }
+
+    fn moves(&self) -> bool {
+        self.translation != [0.0; 3] || self.rotation.is_some()
+    }
 }
 
 /// Flattens the parts and instances of `blocks` (see the module documentation).
@@ -145,35 +164,42 @@ fn in_part(block: &Block) -> Result<(), DeckError> {
     }
 }
 
-/// `*INSTANCE, NAME, PART` with its optional translation line; a rotation line is refused.
+/// `*INSTANCE, NAME, PART` with its optional placement: a translation line `x, y, z`, then a
+/// rotation line `a (3), b (3), angle` (about the axis from `a` to `b`, in degrees, after the
+/// translation).
 fn instance(block: &Block, offset: u64) -> Result<(String, Instance), DeckError> {
     allow_parameters(block, &["NAME", "PART"])?;
     let name = named(block, "NAME")?;
     let part = named(block, "PART")?;
+    let numbers = |line: &DataLine, count: usize, what: &str| -> Result<Vec<f64>, DeckError> {
+        at_most(block, line, count)?;
+        (0..count)
+            .map(|k| match line.fields.get(k).filter(|f| !f.is_empty()) {
+                Some(_) => real(block, line, k, what),
+                None => Ok(0.0),
+            })
+            .collect()
+    };
     let mut translation = [0.0; 3];
-    match block.data.as_slice() {
-        [] => {}
-        [line] => {
-            for (k, t) in translation.iter_mut().enumerate() {
-                if let Some(text) = line.fields.get(k).filter(|f| !f.is_empty()) {
-                    *t = text.parse().map_err(|_| {
-                        super::fields::line_error(
-                            block,
-                            line,
-                            format!(
-                                "field {} (translation): expected a number, got '{text}'",
-                                k + 1
-                            ),
-                        )
-                    })?;
-                }
-            }
-        }
-        _ => {
-            return Err(
-                block.error("a rotated instance is not read: give its part's nodes where they are")
-            );
-        }
+    let mut rotation = None;
+    let lines = block.data.as_slice();
+    if let Some(line) = lines.first() {
+        let t = numbers(line, 3, "translation")?;
+        translation.copy_from_slice(&t);
+    }
+    if let Some(line) = lines.get(1) {
+        let r = numbers(line, 7, "rotation")?;
+        let a = Vector3::new(r[0], r[1], r[2]);
+        let axis = Unit::try_new(Vector3::new(r[3], r[4], r[5]) - a, 0.0)
+            .ok_or_else(|| line_error(block, line, "the rotation axis' two points coincide"))?;
+        rotation = Some((a, Rotation3::from_axis_angle(&axis, r[6].to_radians())));
+    }
+    if let Some(line) = lines.get(2) {
+        return Err(line_error(
+            block,
+            line,
+            "expected at most a translation line and a rotation line",
+        ));
     }
     Ok((
         name,
@@ -181,6 +207,7 @@ fn instance(block: &Block, offset: u64) -> Result<(String, Instance), DeckError>
             part,
             offset,
             translation,
+            rotation,
         },
     ))
 }
@@ -201,7 +228,7 @@ fn copy(b: &Block, name: &str, instance: &Instance) -> Result<Block, DeckError> 
             *field = (label + instance.offset).to_string();
         }
     };
-    let moved = instance.translation != [0.0; 3];
+    let moved = instance.moves();
     match b.name.as_str() {
         "NODE" => {
             for line in &mut out.data {
@@ -209,7 +236,7 @@ fn copy(b: &Block, name: &str, instance: &Instance) -> Result<Block, DeckError> 
                     raise(label);
                 }
                 if moved {
-                    translate(b, line, &instance.translation)?;
+                    place(b, line, instance)?;
                 }
             }
         }
@@ -241,8 +268,8 @@ fn copy(b: &Block, name: &str, instance: &Instance) -> Result<Block, DeckError> 
             });
             if !on_elements && moved {
                 return Err(b.error(
-                    "an analytical surface in a translated instance is not read: give it in \
-                     the assembly",
+                    "an analytical surface in a moved instance is not read: give it in the \
+                     assembly",
                 ));
             }
             if on_elements {
@@ -262,19 +289,24 @@ fn copy(b: &Block, name: &str, instance: &Instance) -> Result<Block, DeckError> 
     Ok(out)
 }
 
-/// Moves the coordinates of a `*NODE` line by `t`.
-fn translate(b: &Block, line: &mut DataLine, t: &[f64; 3]) -> Result<(), DeckError> {
-    let location = line.location.clone();
-    for (k, field) in line.fields.iter_mut().skip(1).take(3).enumerate() {
-        let x: f64 = field.parse().map_err(|_| DeckError {
-            location: location.clone(),
-            message: format!(
-                "*{}: field {} (coordinate): expected a number",
-                b.name,
-                k + 2
-            ),
-        })?;
-        *field = format!("{:?}", x + t[k]);
+/// Places the coordinates of a `*NODE` line (2 or 3 of them) as the instance does; a 2D node
+/// that the placement takes out of its plane is refused.
+fn place(b: &Block, line: &mut DataLine, instance: &Instance) -> Result<(), DeckError> {
+    let count = line.fields.len().saturating_sub(1).min(3);
+    let mut x = Vector3::zeros();
+    for k in 0..count {
+        x[k] = real(b, line, k + 1, "coordinate")?;
+    }
+    let placed = instance.place(x);
+    if count < 3 && placed.z.abs() > 1e-12 * (1.0 + placed.norm()) {
+        return Err(line_error(
+            b,
+            line,
+            "the instance's placement takes this 2D node out of its plane",
+        ));
+    }
+    for k in 0..count {
+        line.fields[k + 1] = format!("{:?}", placed[k]);
     }
     Ok(())
 }
