@@ -47,7 +47,7 @@ use serde::Deserialize;
 use format::Counts;
 
 use skid_cases::atomic::write_atomic;
-use skid_cases::csv_out::{CsvError, CsvTable};
+use skid_cases::csv_out::{CsvError, CsvTable, Row};
 use skid_cases::runner::{CASE_JSON, MODEL_JSON};
 use skid_cases::schema::Case;
 
@@ -224,11 +224,7 @@ pub fn parse_history(text: &str, path: &Path) -> Result<History, ReportError> {
     let mut non_finite = 0;
     for row in table {
         let row = row?;
-        non_finite += row
-            .fields()
-            .filter_map(|f| f.trim().parse::<f64>().ok())
-            .filter(|v| !v.is_finite())
-            .count();
+        non_finite += non_finite_fields(&row);
         time.push(row.number(it)?);
         omega.push(row.number(iw)?);
     }
@@ -236,6 +232,14 @@ pub fn parse_history(text: &str, path: &Path) -> Result<History, ReportError> {
         non_finite,
         ..dynamic_part(&time, &omega)
     })
+}
+
+/// The fields of a history row that read as NaN or an infinity.
+pub(crate) fn non_finite_fields(row: &Row<'_>) -> usize {
+    row.fields()
+        .filter_map(|f| f.trim().parse::<f64>().ok())
+        .filter(|v| !v.is_finite())
+        .count()
 }
 
 /// Linear interpolation of `values(times)` at `t`; `None` outside `[times[0], times[last]]`

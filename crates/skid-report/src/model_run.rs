@@ -16,7 +16,9 @@ use serde::Deserialize;
 use skid_cases::csv_out::CsvTable;
 use skid_cases::spin_down::{SpinDown, SpinPoint};
 
-use super::{History, ReportError, Run, RunSummary, dynamic_rows, read, read_json};
+use super::{
+    History, ReportError, Run, RunSummary, dynamic_rows, non_finite_fields, read, read_json,
+};
 
 /// The fields of a model run's `summary.json` the benchmark reads.
 #[derive(Deserialize)]
@@ -120,11 +122,7 @@ fn turning_body(text: &str, path: &Path) -> Result<Spin, ReportError> {
     let mut non_finite = 0;
     for row in table {
         let row = row?;
-        non_finite += row
-            .fields()
-            .filter_map(|f| f.trim().parse::<f64>().ok())
-            .filter(|v| !v.is_finite())
-            .count();
+        non_finite += non_finite_fields(&row);
         time.push(row.number::<f64>(time_column)?);
         for ((angle, omega), body) in columns.iter().zip(&mut states) {
             body.push((row.number::<f64>(*angle)?, row.number::<f64>(*omega)?));
