@@ -17,11 +17,6 @@ use nalgebra::{Rotation3, Unit, Vector3};
 use super::fields::{allow_parameters, at_most, key, line_error, real};
 use super::keywords::{Block, DataLine, DeckError};
 
-/// What a part holds: its blocks in order.
-struct Part {
-    blocks: Vec<Block>,
-}
-
 /// An instance: its part, label offset and placement.
 struct Instance {
     part: String,
@@ -63,7 +58,8 @@ pub fn flatten(blocks: Vec<Block>) -> Result<Vec<Block>, DeckError> {
         .max()
         .unwrap_or(0)
         + 1;
-    let mut parts: HashMap<String, Part> = HashMap::new();
+    // each part's blocks in order, by key
+    let mut parts: HashMap<String, Vec<Block>> = HashMap::new();
     let mut instances: HashMap<String, Instance> = HashMap::new();
     let mut out = Vec::with_capacity(blocks.len());
     let mut iter = blocks.into_iter();
@@ -89,7 +85,7 @@ pub fn flatten(blocks: Vec<Block>) -> Result<Vec<Block>, DeckError> {
                     }
                     held.push(inner);
                 }
-                parts.insert(key(&name), Part { blocks: held });
+                parts.insert(key(&name), held);
             }
             "ASSEMBLY" => {
                 allow_parameters(&block, &["NAME"])?;
@@ -114,7 +110,7 @@ pub fn flatten(blocks: Vec<Block>) -> Result<Vec<Block>, DeckError> {
                             let part = parts.get(&key(&instance.part)).ok_or_else(|| {
                                 inner.error(format!("no *PART named {}", instance.part))
                             })?;
-                            for b in &part.blocks {
+                            for b in part {
                                 out.push(copy(b, &name, &instance)?);
                             }
                             instances.insert(key(&name), instance);
