@@ -413,10 +413,11 @@ impl AnalyticalSurface {
 
 /// The rigid surface of facets given outward in skid's convention, in the body frame (2D:
 /// segments whose direction turned clockwise points out; 3D: quadrilaterals counter-clockwise
-/// seen from outside). They must form a regular prism about an axis through the origin: `n`
+/// seen from outside), if they form a regular prism about an axis through the origin: `n`
 /// facets inscribed in one circle, each spanning the same axial range (2D: a regular polygon),
 /// which is the model file's [`RigidSurfaceSpec::FacetedCylinder`]. Returns it with the axial
-/// range (3D) of the facets.
+/// range (3D) of the facets, or why they form none (the caller then reads them as a
+/// [`chain`] of lines or a mesh of [`triangles`]).
 pub fn prism(
     facets: &[Vec<Vector3<f64>>],
     dimension: usize,
