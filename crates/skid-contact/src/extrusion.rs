@@ -4,7 +4,7 @@
 use nalgebra::{Matrix2x3, Matrix3, Vector2, Vector3};
 
 use crate::error::ContactError;
-use crate::polyline::RigidPolyline;
+use crate::polyline::{RigidPolyline, lift_from_plane};
 use crate::surface::{Projection, RigidSurface, SurfaceShape};
 
 /// The [`RigidPolyline`] `profile` of the plane spanned by the unit `reference` direction `a`
@@ -82,13 +82,7 @@ impl RigidSurface for RigidExtrusion {
         let frame = self.frame();
         let q = frame * y;
         let section = self.profile.project(&Vector3::new(q.x, q.y, 0.0))?;
-        let lift = |gradient: &Vector3<f64>, hessian: &Matrix3<f64>| {
-            let h2 = hessian.fixed_view::<2, 2>(0, 0).into_owned();
-            (
-                frame.transpose() * gradient.xy(),
-                frame.transpose() * h2 * frame,
-            )
-        };
+        let lift = |gradient, hessian| lift_from_plane(&frame, gradient, hessian);
         let (gap_gradient, gap_hessian) = lift(&section.gap_gradient, &section.gap_hessian);
         let (arc_gradient, arc_hessian) =
             lift(&section.coords_gradient[0], &section.coords_hessian[0]);

@@ -1,7 +1,7 @@
 //! Rigid polyline in the plane (2D): a chain of straight segments, open or closed, such as a
 //! floor, a ramp or a punch profile meshed with rigid line elements.
 
-use nalgebra::{Matrix3, Vector2, Vector3};
+use nalgebra::{Matrix2x3, Matrix3, Vector2, Vector3};
 use rstar::{AABB, PointDistance, RTree, RTreeObject};
 
 use crate::error::ContactError;
@@ -238,6 +238,21 @@ impl RigidPolyline {
         matches!(closest.feature, Feature::Interior(_))
             .then(|| (closest.segment, self.segments[closest.segment].normal))
     }
+}
+
+/// The body-frame gradient and Hessian `(F^T g, F^T H F)` of a profile function `f(q)` whose
+/// plane gradient `g` and Hessian `H` a [`RigidPolyline`] projection gives (in the `x-y`
+/// block), for `q = F y` with the rows of `frame` `F` the plane's two directions.
+pub(crate) fn lift_from_plane(
+    frame: &Matrix2x3<f64>,
+    gradient: &Vector3<f64>,
+    hessian: &Matrix3<f64>,
+) -> (Vector3<f64>, Matrix3<f64>) {
+    let h2 = hessian.fixed_view::<2, 2>(0, 0).into_owned();
+    (
+        frame.transpose() * gradient.xy(),
+        frame.transpose() * h2 * frame,
+    )
 }
 
 /// `(v_x, v_y, 0)`.

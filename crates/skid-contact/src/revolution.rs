@@ -2,10 +2,10 @@
 //! revolved about an axis through the body origin, such as a stepped drum, a cone or a roller
 //! with flanges.
 
-use nalgebra::{Matrix2x3, Matrix3, Vector2, Vector3};
+use nalgebra::{Matrix2x3, Vector2, Vector3};
 
 use crate::error::ContactError;
-use crate::polyline::RigidPolyline;
+use crate::polyline::{RigidPolyline, lift_from_plane};
 use crate::surface::{AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, SurfaceShape};
 
 /// The surface swept by the [`RigidPolyline`] `profile` of the `r-z` half-plane (`r >= 0` the
@@ -77,13 +77,10 @@ impl RigidSurface for RigidRevolution {
         let meridian = self.profile.project(&Vector3::new(r, z, 0.0))?;
         // [u e]^T: rows u and e map (r, z) derivatives to y
         let frame = Matrix2x3::from_rows(&[u.transpose(), e.transpose()]);
-        let lift = |gradient: &Vector3<f64>, hessian: &Matrix3<f64>| {
-            let g2 = gradient.xy();
-            let h2 = hessian.fixed_view::<2, 2>(0, 0).into_owned();
-            (
-                frame.transpose() * g2,
-                frame.transpose() * h2 * frame + w * w.transpose() * (g2.x / r),
-            )
+        // plus the curvature of r: f_r w w^T / r
+        let lift = |gradient: &Vector3<f64>, hessian| {
+            let (g, h) = lift_from_plane(&frame, gradient, hessian);
+            (g, h + w * w.transpose() * (gradient.x / r))
         };
         let (gap_gradient, gap_hessian) = lift(&meridian.gap_gradient, &meridian.gap_hessian);
         let (arc_gradient, arc_hessian) =

@@ -312,23 +312,10 @@ impl AnalyticalSurface {
         reference: &Vector3<f64>,
         ends: &[Vector2<f64>],
     ) -> Result<RigidSurfaceSpec, String> {
-        let tol = 1e-9 * self.size().max(reference.norm());
-        let mut points: Vec<Vector2<f64>> = std::iter::once(self.start)
-            .chain(ends.iter().copied())
-            .collect();
-        let closed = (points[points.len() - 1] - points[0]).norm() <= tol;
-        if closed {
-            points.pop();
-        }
-        let points: Vec<[f64; 2]> = points
-            .iter()
-            .rev()
-            .map(|p| {
-                let y = self.global(p) - reference;
-                [self.ex.dot(&y), self.ey.dot(&y)]
-            })
-            .collect();
-        check_outward(&points, closed)?;
+        let (points, closed) = self.profile_points(reference, ends, |p| {
+            let y = self.global(p) - reference;
+            [self.ex.dot(&y), self.ey.dot(&y)]
+        })?;
         Ok(match self.kind {
             AnalyticalKind::Cylinder => RigidSurfaceSpec::Extrusion {
                 axis: self.ez.into(),
@@ -338,6 +325,29 @@ impl AnalyticalSurface {
             },
             _ => RigidSurfaceSpec::Polyline { points, closed },
         })
+    }
+
+    /// The points of a profile of lines (its start, then the ends of `ends`), closed if it ends
+    /// where it starts (the last point dropped), each placed by `place` and taken in reverse:
+    /// the deck's outward normal is the travel turned counter-clockwise, a polyline's turned
+    /// clockwise. A closed profile traversed inwards is refused ([`check_outward`]).
+    fn profile_points(
+        &self,
+        reference: &Vector3<f64>,
+        ends: &[Vector2<f64>],
+        place: impl Fn(&Vector2<f64>) -> [f64; 2],
+    ) -> Result<(Vec<[f64; 2]>, bool), String> {
+        let tol = 1e-9 * self.size().max(reference.norm());
+        let mut points: Vec<Vector2<f64>> = std::iter::once(self.start)
+            .chain(ends.iter().copied())
+            .collect();
+        let closed = (points[points.len() - 1] - points[0]).norm() <= tol;
+        if closed {
+            points.pop();
+        }
+        let points: Vec<[f64; 2]> = points.iter().rev().map(place).collect();
+        check_outward(&points, closed)?;
+        Ok((points, closed))
     }
 
     /// A revolved profile of lines: at one radius `r = R`, running from high to low `z`, the
@@ -379,20 +389,14 @@ impl AnalyticalSurface {
                 axis: self.ez.into(),
             });
         }
-        let mut points: Vec<Vector2<f64>> = std::iter::once(self.start).chain(ends).collect();
-        let closed = (points[points.len() - 1] - points[0]).norm() <= tol;
-        if closed {
-            points.pop();
-        }
         let shift = self.ez.dot(&d);
-        let profile: Vec<[f64; 2]> = points.iter().rev().map(|p| [p.x, p.y + shift]).collect();
+        let (profile, closed) = self.profile_points(reference, &ends, |p| [p.x, p.y + shift])?;
         if let Some(p) = profile.iter().find(|p| p[0] < 0.0) {
             return Err(format!(
                 "a revolved profile lies at r >= 0, got the point r = {}, z = {}",
                 p[0], p[1]
             ));
         }
-        check_outward(&profile, closed)?;
         Ok(RigidSurfaceSpec::Revolution {
             axis: self.ez.into(),
             profile,
