@@ -18,7 +18,7 @@
 //! `*BOUNDARY` (OP=MOD/NEW and, on rigid bodies and part nodes, magnitudes with AMPLITUDE= in
 //! steps: see `assemble::motions`), `*INITIAL CONDITIONS` (VELOCITY, ROTATING VELOCITY),
 //! `*AMPLITUDE` (TABULAR, step or total time), `*STEP` (NLGEOM, AMPLITUDE=RAMP|STEP), `*STATIC` (DIRECT, or automatic
-//! increments without it) and `*DYNAMIC` (DIRECT, ALPHA), `*CLOAD`, `*DSLOAD` / `*DLOAD` pressures and `*DLOAD` gravity (`GRAV`), each with
+//! increments without it) and `*DYNAMIC` (DIRECT, ALPHA, or automatic increments without DIRECT), `*CLOAD`, `*DSLOAD` / `*DLOAD` pressures and `*DLOAD` gravity (`GRAV`), each with
 //! `AMPLITUDE=`, `*OUTPUT`, `*NODE OUTPUT`, `*CONTACT OUTPUT`,
 //! `*END STEP`, `*INCLUDE`, and `*PART` / `*END PART`, `*ASSEMBLY` / `*END ASSEMBLY`,
 //! `*INSTANCE` / `*END INSTANCE` (translated and rotated). Anything else is an error at its
@@ -40,6 +40,10 @@
 //!   carry their factor in each step (see [`assemble`] and [`loads`] for gravity's direction
 //!   and `OP=NEW`);
 //! - `*DYNAMIC` without `ALPHA` takes the keyword's default `-0.05`;
+//! - `*DYNAMIC` without `DIRECT` sizes its increments by their estimated local error, the
+//!   model's `adaptive` steps with the tolerance [`read::AUTOMATIC_DYNAMIC_TOLERANCE`] and the
+//!   data line `initial, period, min, max` with the keyword's defaults, not by the
+//!   half-increment residual (`HAFTOL` is refused);
 //! - `*ELASTIC` is the compressible neo-Hookean solid with the same small-strain moduli;
 //! - rigid membranes and shells are contacted on their mid-surface (zero thickness), rigid
 //!   elements carry no mass (give it with `*MASS` and `*ROTARY INERTIA`);

@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use skid_cases::csv_out::CsvTable;
+use skid_cases::deck::read::AUTOMATIC_DYNAMIC_TOLERANCE;
 use skid_cases::deck::read_model;
 use skid_cases::drum::{deck, model_spec};
 use skid_cases::model_spec::{ModelStepSpec, RigidSurfaceSpec, SlaveSpec};
@@ -242,8 +243,8 @@ fn keywords_parameters_and_values_outside_the_subset_are_errors_at_their_line() 
         ),
         (
             "*Dynamic, direct",
-            "*Dynamic",
-            &["*DYNAMIC", "half-increment residual", "add DIRECT"],
+            "*Dynamic, haftol=10.",
+            &["*DYNAMIC", "HAFTOL is not read", "half-increment residual"],
         ),
         (
             "*Static, direct\n 0.2, 1.",
@@ -702,6 +703,65 @@ fn concentrated_loads_of_two_amplitudes_on_one_body_are_written_apart() {
     let message = skid_cases::deck::write::write_deck(&model, &Default::default())
         .expect_err("two loads on y");
     assert!(message.contains("loads[0] and loads[2]"), "{message}");
+}
+
+/// `*DYNAMIC` without `DIRECT` is an adaptive step with the deck's tolerance: the data line
+/// `initial, period, min, max` with the keyword's defaults where absent (min the smaller of
+/// initial and 1e-5 of the period, max the period); the writer writes it back the same way,
+/// and refuses an adaptive step of another tolerance, which no keyword holds.
+#[test]
+fn automatic_dynamic_incrementation_is_an_adaptive_step() {
+    let dynamic = |data: &str| {
+        let deck = variant(
+            "*Dynamic, direct, alpha=-0.3\n 1.e-4, 0.15\n",
+            &format!("*Dynamic, alpha=-0.3\n{data}"),
+        )
+        .expect("automatic dynamic");
+        assert!(
+            deck.notes
+                .iter()
+                .any(|n| n.contains("*DYNAMIC without DIRECT")),
+            "{:?}",
+            deck.notes
+        );
+        let model = deck.model;
+        match &model.steps[1] {
+            ModelStepSpec::Dynamic {
+                dt,
+                duration,
+                alpha,
+                adaptive,
+                ..
+            } => {
+                assert_eq!((*duration, *alpha), (0.15, -0.3));
+                let a = adaptive.clone().expect("adaptive");
+                assert_eq!(a.tolerance, AUTOMATIC_DYNAMIC_TOLERANCE);
+                ((*dt, a.min_dt, a.max_dt), model)
+            }
+            other => panic!("{other:?}"),
+        }
+    };
+    let (sizes, _) = dynamic(" 1.e-4, 0.15\n");
+    assert_eq!(sizes, (1e-4, 1e-4f64.min(1e-5 * 0.15), 0.15));
+    let (sizes, model) = dynamic(" 1.e-4, 0.15, 1.e-6, 1.e-3\n");
+    assert_eq!(sizes, (1e-4, 1e-6, 1e-3));
+    let written = skid_cases::deck::write::write_deck(&model, &Default::default()).expect("deck");
+    assert!(
+        written.contains("*DYNAMIC, ALPHA=-0.3\n0.0001, 0.15, 1e-6, 0.001\n"),
+        "{written}"
+    );
+    let read = read_text(&written).expect("reads back").model;
+    assert_eq!(read.steps, model.steps);
+    let mut other = model.clone();
+    if let ModelStepSpec::Dynamic {
+        adaptive: Some(a), ..
+    } = &mut other.steps[1]
+    {
+        a.tolerance = 1e-6;
+    }
+    let message = skid_cases::deck::write::write_deck(&other, &Default::default())
+        .expect_err("another tolerance");
+    assert!(message.contains("steps[1].adaptive.tolerance"), "{message}");
 }
 
 /// `*STATIC` without `DIRECT` is automatic incrementation: the data line `initial, period,

@@ -6,7 +6,8 @@
 //! are written so that they read back to the same bits.
 //!
 //! Two settings have no keyword and are refused: a static step's regularisation time other
-//! than the default, and adaptive increments; loads that change between steps are refused too
+//! than the default, and an adaptive dynamic step's tolerance other than that of `*DYNAMIC`
+//! without `DIRECT`; loads that change between steps are refused too
 //! (prescribed motions of rigid bodies and node sets are written in every step, at their value
 //! times the step's factor). General contact is written as `*CONTACT` with
 //! all exterior faces, so its search distance is not kept (every exterior node becomes a
@@ -20,6 +21,7 @@ use skid_contact::surface::AnalyticCylinder;
 use skid_fem::tetra::TetMesh;
 
 use super::mesh::ElementKind;
+use super::read::AUTOMATIC_DYNAMIC_TOLERANCE;
 use crate::model_spec::{
     AmplitudeTime, BoundarySpec, DefaultAmplitude, Dof, LoadSpec, ModelSpec, ModelStepSpec,
     RigidBodySpec, RigidSurfaceSpec, SlaveSpec,
@@ -386,18 +388,35 @@ pub fn write_deck(
                 alpha,
                 adaptive,
                 ..
-            } => {
-                if adaptive.is_some() {
-                    return Err(format!("steps[{i}].adaptive has no keyword in the subset"));
+            } => match adaptive {
+                None => {
+                    let _ = writeln!(
+                        out,
+                        "*DYNAMIC, DIRECT, ALPHA={}\n{}, {}",
+                        num(*alpha),
+                        num(*dt),
+                        num(*duration)
+                    );
                 }
-                let _ = writeln!(
-                    out,
-                    "*DYNAMIC, DIRECT, ALPHA={}\n{}, {}",
-                    num(*alpha),
-                    num(*dt),
-                    num(*duration)
-                );
-            }
+                Some(a) if a.tolerance == AUTOMATIC_DYNAMIC_TOLERANCE => {
+                    let _ = writeln!(
+                        out,
+                        "*DYNAMIC, ALPHA={}\n{}, {}, {}, {}",
+                        num(*alpha),
+                        num(*dt),
+                        num(*duration),
+                        num(a.min_dt),
+                        num(a.max_dt)
+                    );
+                }
+                Some(a) => {
+                    return Err(format!(
+                        "steps[{i}].adaptive.tolerance: a deck's *DYNAMIC without DIRECT \
+                             takes the tolerance {AUTOMATIC_DYNAMIC_TOLERANCE:e}, not {:e}",
+                        a.tolerance
+                    ));
+                }
+            },
         }
         let _ = writeln!(
             out,

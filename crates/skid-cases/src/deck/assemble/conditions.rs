@@ -5,7 +5,9 @@ use super::carried::Frozen;
 use super::loads::{Given, InForce, amplitude_name, amplitude_spec, apply_loads, model_loads};
 use super::motions::{Held, HeldInStep, Holder, prescribed_motions};
 use super::*;
+use crate::deck::read::AUTOMATIC_DYNAMIC_TOLERANCE;
 use crate::model_spec::{AmplitudeSpec, DefaultAmplitude};
+use crate::schema::AdaptiveSpec;
 
 pub(super) fn apply_model_boundary(
     defs: &Definitions,
@@ -377,13 +379,22 @@ pub(super) fn step_spec(
                 boundary,
             }
         }
-        Procedure::Dynamic { dt, period, alpha } => ModelStepSpec::Dynamic {
+        Procedure::Dynamic {
+            dt,
+            period,
+            alpha,
+            automatic,
+        } => ModelStepSpec::Dynamic {
             name: step.name.clone(),
             duration: *period,
             dt: *dt,
             alpha: *alpha,
             boundary,
-            adaptive: None,
+            adaptive: automatic.map(|[min_dt, max_dt]| AdaptiveSpec {
+                tolerance: AUTOMATIC_DYNAMIC_TOLERANCE,
+                min_dt,
+                max_dt,
+            }),
             default_amplitude: step
                 .default_amplitude
                 .filter(|&a| a == DefaultAmplitude::Ramp),
