@@ -209,3 +209,106 @@ fn a_rotated_instance_turns_its_nodes_after_the_translation() {
         );
     }
 }
+
+/// An analytical surface defined in a part moves with its instance: a ground line defined one
+/// unit low and placed by a translation gives the flat deck's ground and runs to its history;
+/// a profile defined elsewhere and turned by 180 degrees about the z axis lands on the same
+/// line (to round-off); a 3D cylinder's axis points are placed alike.
+#[test]
+fn an_analytical_surface_in_a_part_moves_with_its_instance() {
+    let in_part = |surface: &str, placement: &str| {
+        flat()
+            .replace(
+                GROUND,
+                &format!(
+                    "\
+*Part, name=Ground
+*Surface, name=ground, type=segments
+{surface}*End Part
+*Assembly, name=Assembly
+*Instance, name=Ground-1, part=Ground
+{placement}*End Instance
+*Node, nset=ground
+10, 0., 0.
+*Rigid Body, ref node=ground, analytical surface=Ground-1.ground
+*Element, type=MASS, elset=ground_mass
+20, 10
+*Mass, elset=ground_mass
+0.05
+*End Assembly
+"
+                ),
+            )
+            .replace("bottom, ground\n", "bottom, Ground-1.ground\n")
+    };
+    let flat = read_deck_text(&flat()).expect("flat deck");
+    let translated = read_deck_text(&in_part("START, -1., -1.\nLINE, 1., -1.\n", "0., 1., 0.\n"))
+        .expect("translated ground");
+    assert_eq!(translated.rigid_bodies, flat.rigid_bodies);
+    assert_eq!(history(&translated), history(&flat));
+    let turned = read_deck_text(&in_part(
+        "START, 1., 1.\nLINE, -1., 1.\n",
+        "0., -1., 0.\n0., 0., 0., 0., 0., 1., 180.\n",
+    ))
+    .expect("turned ground");
+    let json = |model: &ModelSpec| serde_json::to_value(&model.rigid_bodies).expect("json");
+    assert_close(&json(&turned), &json(&flat));
+    let out_of_plane = in_part(
+        "START, -1., -1.\nLINE, 1., -1.\n",
+        "0., 1., 0.\n0., 0., 0., 0., 1., 0., 90.\n",
+    );
+    assert_refused_at(&out_of_plane, "START, -1., -1.", "out of its plane");
+
+    let drum = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../cases/inp/3d-analytic.inp"),
+    )
+    .expect("3D deck");
+    let axis = "*SURFACE, NAME=drum, TYPE=REVOLUTION\n0.0, 0.0, 0.0, 0.0, 0.0, 1.0\n";
+    let profile = "START, 0.2, 0.5196152422706632\nLINE, 0.2, -0.5196152422706632\n";
+    assert!(drum.contains(&format!("{axis}{profile}")));
+    let placed = |points: &str, placement: &str| {
+        drum.replace(
+            &format!("{axis}{profile}"),
+            &format!(
+                "*Part, name=Drum\n*Surface, name=drum, type=revolution\n{points}\n{profile}\
+                 *End Part\n*Assembly, name=A\n*Instance, name=Drum-1, part=Drum\n\
+                 {placement}*End Instance\n*End Assembly\n"
+            ),
+        )
+        .replace("ANALYTICAL SURFACE=drum", "ANALYTICAL SURFACE=Drum-1.drum")
+        .replace("pad-drum-slave, drum\n", "pad-drum-slave, Drum-1.drum\n")
+    };
+    let original = read_deck_text(&drum).expect("3D drum");
+    for (points, placement) in [
+        ("0., -1., 0., 0., -1., 1.", "0., 1., 0.\n"),
+        (
+            "0., 0., 0., 0., 0., -1.",
+            "0., 0., 0.\n0., 0., 0., 1., 0., 0., 180.\n",
+        ),
+    ] {
+        let moved = read_deck_text(&placed(points, placement)).expect("placed drum");
+        assert_close(&json(&moved), &json(&original));
+    }
+}
+
+/// Every number of `a` within 1e-12 of `b`'s, the rest equal.
+fn assert_close(a: &serde_json::Value, b: &serde_json::Value) {
+    use serde_json::Value;
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => {
+            let (x, y) = (x.as_f64().expect("f64"), y.as_f64().expect("f64"));
+            assert!((x - y).abs() <= 1e-12, "{x} vs {y}");
+        }
+        (Value::Array(x), Value::Array(y)) => {
+            assert_eq!(x.len(), y.len(), "{a} vs {b}");
+            x.iter().zip(y).for_each(|(x, y)| assert_close(x, y));
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            assert_eq!(x.keys().collect::<Vec<_>>(), y.keys().collect::<Vec<_>>());
+            x.values()
+                .zip(y.values())
+                .for_each(|(x, y)| assert_close(x, y));
+        }
+        _ => assert_eq!(a, b),
+    }
+}

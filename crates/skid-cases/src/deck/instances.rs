@@ -8,7 +8,8 @@
 //! `<instance>.`, and nodes move by the instance's translation, then rotation. Assembly-level
 //! sets with `INSTANCE=` name the instance's labels, and a field `<instance>.<label>` anywhere
 //! outside the parts names that instance's node or element. A deck without `*PART` is left as it is.
-//! An instance that moves its part carries no analytical surface (give it in the assembly).
+//! An analytical surface in a part moves with its instance: the points that place its profile
+//! are placed as the nodes are.
 
 use std::collections::HashMap;
 
@@ -45,7 +46,8 @@ impl Instance {
 ///
 /// # Errors
 /// [`DeckError`] at a keyword inside a part or an assembly that is not read there, an unknown
-/// part, a rotated instance, or an unterminated part, instance or assembly.
+/// part, a 2D node or profile point that an instance turns out of its plane, or an unterminated
+/// part, instance or assembly.
 pub fn flatten(blocks: Vec<Block>) -> Result<Vec<Block>, DeckError> {
     if !blocks.iter().any(|b| b.name == "PART") {
         return Ok(blocks);
@@ -263,10 +265,7 @@ fn copy(b: &Block, name: &str, instance: &Instance) -> Result<Block, DeckError> 
                 t.eq_ignore_ascii_case("ELEMENT") || t.eq_ignore_ascii_case("NODE")
             });
             if !on_elements && moved {
-                return Err(b.error(
-                    "an analytical surface in a moved instance is not read: give it in the \
-                     assembly",
-                ));
+                place_analytical(b, &mut out, instance)?;
             }
             if on_elements {
                 for line in &mut out.data {
@@ -289,20 +288,69 @@ fn copy(b: &Block, name: &str, instance: &Instance) -> Result<Block, DeckError> 
 /// that the placement takes out of its plane is refused.
 fn place(b: &Block, line: &mut DataLine, instance: &Instance) -> Result<(), DeckError> {
     let count = line.fields.len().saturating_sub(1).min(3);
+    place_point(b, line, 1, count, instance)
+}
+
+/// Places the points of an analytical surface (`out`, a copy of `b`) as the instance does:
+/// the points `a`, `b` (and `c`) of `TYPE=CYLINDER` and `TYPE=REVOLUTION`, which carry the
+/// local profile with them, and every point of a `TYPE=SEGMENTS` profile, which is given in
+/// the part's `x-y` plane (the end point of `START` and `LINE`, the end point and the centre
+/// of `CIRCL`).
+fn place_analytical(b: &Block, out: &mut Block, instance: &Instance) -> Result<(), DeckError> {
+    let kind = b
+        .parameter("TYPE")
+        .flatten()
+        .unwrap_or_default()
+        .to_ascii_uppercase();
+    for (k, line) in out.data.iter_mut().enumerate() {
+        match kind.as_str() {
+            "CYLINDER" | "REVOLUTION" => {
+                let axis_lines = if kind == "CYLINDER" { 2 } else { 1 };
+                if k < axis_lines {
+                    for first in (0..line.fields.len().min(6)).step_by(3) {
+                        place_point(b, line, first, 3, instance)?;
+                    }
+                }
+            }
+            _ => {
+                let word = line.fields.first().map(|w| w.to_ascii_uppercase());
+                let points: &[usize] = match word.as_deref() {
+                    Some("START" | "LINE") => &[1],
+                    Some("CIRCL") => &[1, 3],
+                    _ => &[],
+                };
+                for &first in points {
+                    place_point(b, line, first, 2, instance)?;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Places the point of `count` coordinates (2 or 3) from field `first` of `line` as the
+/// instance does; a 2D point that the placement takes out of its plane is refused.
+fn place_point(
+    b: &Block,
+    line: &mut DataLine,
+    first: usize,
+    count: usize,
+    instance: &Instance,
+) -> Result<(), DeckError> {
     let mut x = Vector3::zeros();
     for k in 0..count {
-        x[k] = real(b, line, k + 1, "coordinate")?;
+        x[k] = real(b, line, first + k, "coordinate")?;
     }
     let placed = instance.place(x);
     if count < 3 && placed.z.abs() > 1e-12 * (1.0 + placed.norm()) {
         return Err(line_error(
             b,
             line,
-            "the instance's placement takes this 2D node out of its plane",
+            "the instance's placement takes this 2D point out of its plane",
         ));
     }
     for k in 0..count {
-        line.fields[k + 1] = format!("{:?}", placed[k]);
+        line.fields[first + k] = format!("{:?}", placed[k]);
     }
     Ok(())
 }
