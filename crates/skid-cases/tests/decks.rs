@@ -734,7 +734,7 @@ fn automatic_dynamic_incrementation_is_an_adaptive_step() {
                 ..
             } => {
                 assert_eq!((*duration, *alpha), (0.15, -0.3));
-                let a = adaptive.clone().expect("adaptive");
+                let a = adaptive.expect("adaptive");
                 assert_eq!(a.tolerance, AUTOMATIC_DYNAMIC_TOLERANCE);
                 ((*dt, a.min_dt, a.max_dt), model)
             }
