@@ -312,3 +312,52 @@ fn assert_close(a: &serde_json::Value, b: &serde_json::Value) {
         _ => assert_eq!(a, b),
     }
 }
+
+/// An analytical rigid part as Abaqus/CAE writes it: an empty `*PART` whose instance defines
+/// its own reference node, surface and rigid body (in the part's coordinates, placed by the
+/// instance); it reads to the flat deck's ground and runs to its history (the body named by
+/// its reference node set, `Ground-1.ref`). What an instance cannot hold is refused.
+#[test]
+fn an_instance_may_define_its_own_rigid_body() {
+    let cae = flat()
+        .replace(
+            GROUND,
+            "\
+*Part, name=Ground
+*End Part
+*Assembly, name=Assembly
+*Instance, name=Ground-1, part=Ground
+0., 1., 0.
+*Node
+1, 0., -1.
+*Nset, nset=ref
+1
+*Surface, type=SEGMENTS, name=ground
+START, -1., -1.
+LINE, 1., -1.
+*Rigid Body, ref node=ref, analytical surface=ground
+*End Instance
+*Element, type=MASS, elset=ground_mass
+20, Ground-1.1
+*Mass, elset=ground_mass
+0.05
+*End Assembly
+",
+        )
+        .replace("bottom, ground\n", "bottom, Ground-1.ground\n")
+        .replace("ground, ENCASTRE\n", "Ground-1.ref, ENCASTRE\n");
+    let (flat, mut cae_model) = (
+        read_deck_text(&flat()).expect("flat deck"),
+        read_deck_text(&cae).expect("CAE-style rigid part"),
+    );
+    assert_eq!(cae_model.rigid_bodies[0].name, "Ground-1.ref");
+    let history_cae = history(&cae_model).replace("Ground-1.ref", "ground");
+    cae_model.rigid_bodies[0].name = "ground".into();
+    assert_eq!(cae_model.rigid_bodies, flat.rigid_bodies);
+    assert_eq!(history_cae, history(&flat));
+    let held = cae.replace(
+        "*Rigid Body, ref node=ref, analytical surface=ground\n",
+        "*Rigid Body, ref node=ref, analytical surface=ground\n*Boundary\nref, ENCASTRE\n",
+    );
+    assert_refused_at(&held, "*Boundary", "not read inside an *INSTANCE");
+}

@@ -2,10 +2,14 @@
 //! INSTANCE`, as Abaqus/CAE writes decks) flattened into the keyword blocks of one mesh, which
 //! the rest of the reader takes as a deck without parts.
 //!
-//! Each instance copies its part's nodes, elements, sets, surfaces and sections: node and
+//! Each instance copies its part's nodes, elements, sets, surfaces, sections, rigid bodies and
+//! point inertias, and then those it defines itself between `*INSTANCE` and `*END INSTANCE`
+//! (as Abaqus/CAE writes an analytical rigid part: an empty part whose instance holds the
+//! reference node, the surface and the `*RIGID BODY`), all in the part's coordinates: node and
 //! element labels are raised by the instance's offset (`k` times a stride above every label
 //! of the deck, for the `k`-th instance from 1), set and surface names take the prefix
-//! `<instance>.`, and nodes move by the instance's translation, then rotation. Assembly-level
+//! `<instance>.` (as do the sets and surfaces a `*RIGID BODY` names, and its `REF NODE`), and
+//! nodes move by the instance's translation, then rotation. Assembly-level
 //! sets with `INSTANCE=` name the instance's labels, and a field `<instance>.<label>` anywhere
 //! outside the parts names that instance's node or element. A deck without `*PART` is left as it is.
 //! An analytical surface in a part moves with its instance: the points that place its profile
@@ -83,7 +87,7 @@ pub fn flatten(blocks: Vec<Block>) -> Result<Vec<Block>, DeckError> {
                                  keyword"
                             )));
                         }
-                        _ => in_part(&inner)?,
+                        _ => in_part(&inner, "a *PART")?,
                     }
                     held.push(inner);
                 }
@@ -98,21 +102,25 @@ pub fn flatten(blocks: Vec<Block>) -> Result<Vec<Block>, DeckError> {
                     match inner.name.as_str() {
                         "END ASSEMBLY" => break,
                         "INSTANCE" => {
-                            let end = iter
-                                .next()
-                                .ok_or_else(|| inner.error("no *END INSTANCE closes it"))?;
-                            if end.name != "END INSTANCE" {
-                                return Err(end.error(
-                                    "expected *END INSTANCE: an instance holds no keywords of \
-                                     its own (define them in its *PART)",
-                                ));
+                            // what the instance defines itself, as Abaqus/CAE writes an
+                            // analytical rigid part: its reference node, surface and rigid body
+                            let mut own = Vec::new();
+                            loop {
+                                let next = iter
+                                    .next()
+                                    .ok_or_else(|| inner.error("no *END INSTANCE closes it"))?;
+                                if next.name == "END INSTANCE" {
+                                    break;
+                                }
+                                in_part(&next, "an *INSTANCE")?;
+                                own.push(next);
                             }
                             let k = instances.len() as u64 + 1;
                             let (name, instance) = instance(&inner, k * stride)?;
                             let part = parts.get(&key(&instance.part)).ok_or_else(|| {
                                 inner.error(format!("no *PART named {}", instance.part))
                             })?;
-                            for b in part {
+                            for b in part.iter().chain(&own) {
                                 out.push(copy(b, &name, &instance)?);
                             }
                             instances.insert(key(&name), instance);
@@ -150,15 +158,16 @@ fn named(block: &Block, name: &str) -> Result<String, DeckError> {
         .ok_or_else(|| block.error(format!("expected {name}=")))
 }
 
-/// Refuses a keyword a part does not hold.
-fn in_part(block: &Block) -> Result<(), DeckError> {
+/// Refuses a keyword that a part, or an instance's own definitions (`holder`), do not hold.
+fn in_part(block: &Block, holder: &str) -> Result<(), DeckError> {
     match block.name.as_str() {
         "NODE" | "ELEMENT" | "NSET" | "ELSET" | "SURFACE" | "SOLID SECTION"
-        | "MEMBRANE SECTION" | "SHELL SECTION" => Ok(()),
-        _ => Err(block.error(
-            "is not read inside a *PART (skid reads nodes, elements, sets, surfaces and \
-             sections there; give the rest in the assembly or the model data)",
-        )),
+        | "MEMBRANE SECTION" | "SHELL SECTION" | "RIGID BODY" | "MASS" | "ROTARY INERTIA" => Ok(()),
+        _ => Err(block.error(format!(
+            "is not read inside {holder} (skid reads nodes, elements, sets, surfaces, sections, \
+             rigid bodies and point inertias there; give the rest in the assembly or the model \
+             data)"
+        ))),
     }
 }
 
@@ -214,18 +223,28 @@ fn instance(block: &Block, offset: u64) -> Result<(String, Instance), DeckError>
 fn copy(b: &Block, name: &str, instance: &Instance) -> Result<Block, DeckError> {
     let mut out = b.clone();
     let prefix = |v: &str| format!("{name}.{v}");
-    for (parameter, value) in &mut out.parameters {
-        let renamed = matches!(parameter.as_str(), "NSET" | "ELSET")
-            || (parameter == "NAME" && b.name == "SURFACE");
-        if renamed && let Some(v) = value.as_mut() {
-            *v = prefix(v);
-        }
-    }
     let raise = |field: &mut String| {
         if let Ok(label) = field.parse::<u64>() {
             *field = (label + instance.offset).to_string();
         }
     };
+    for (parameter, value) in &mut out.parameters {
+        let renamed = matches!(
+            parameter.as_str(),
+            "NSET" | "ELSET" | "ANALYTICAL SURFACE" | "TIE NSET"
+        ) || (parameter == "NAME" && b.name == "SURFACE");
+        if let Some(v) = value.as_mut() {
+            if renamed {
+                *v = prefix(v);
+            } else if parameter == "REF NODE" {
+                if v.parse::<u64>().is_ok() {
+                    raise(v);
+                } else {
+                    *v = prefix(v);
+                }
+            }
+        }
+    }
     let moved = instance.moves();
     match b.name.as_str() {
         "NODE" => {
