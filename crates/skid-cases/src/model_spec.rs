@@ -250,15 +250,19 @@ pub enum RigidSurfaceSpec {
         /// Angle of the first vertex, rad.
         phase: f64,
     },
-    /// A chain of straight segments (2D: rigid line elements) through `points`, back to the
-    /// first point if `closed`. Its outward normal is each segment's direction turned clockwise
-    /// (a closed chain counter-clockwise is contacted from outside, clockwise from inside); the
-    /// surface coordinate is the
-    /// arc length from the first point. Beyond an open chain's ends the gap is the signed
-    /// distance to the end point.
+    /// A chain of straight segments (2D: rigid line elements) and circular arcs through
+    /// `points`, back to the first point if `closed`. Its outward normal is each piece's
+    /// direction turned clockwise (a closed chain counter-clockwise is contacted from outside,
+    /// clockwise from inside; a counter-clockwise arc from outside its circle); the surface
+    /// coordinate is the arc length from the first point. Beyond an open chain's ends the gap
+    /// is the signed distance to the end point.
     Polyline {
         /// Points `[x, y]`, m.
         points: Vec<[f64; 2]>,
+        /// The centre `[x, y]` of each piece that is a circular arc (under 180 degrees) from
+        /// its point to the next, `null` for a straight piece (absent or empty: all straight).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        centres: Vec<Option<[f64; 2]>>,
         /// Whether the last point joins the first.
         #[serde(default)]
         closed: bool,
@@ -276,6 +280,10 @@ pub enum RigidSurfaceSpec {
         reference: [f64; 3],
         /// Profile points `[u, v]`, m.
         profile: Vec<[f64; 2]>,
+        /// The centre `[u, v]` of each piece that is a circular arc (under 180 degrees) from
+        /// its point to the next, `null` for a straight piece (absent or empty: all straight).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        centres: Vec<Option<[f64; 2]>>,
         /// Whether the last point joins the first.
         #[serde(default)]
         closed: bool,
@@ -291,6 +299,10 @@ pub enum RigidSurfaceSpec {
         axis: [f64; 3],
         /// Profile points `[r, z]`, m.
         profile: Vec<[f64; 2]>,
+        /// The centre `[r, z]` of each piece that is a circular arc (under 180 degrees) from
+        /// its point to the next, `null` for a straight piece (absent or empty: all straight).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        centres: Vec<Option<[f64; 2]>>,
         /// Whether the last point joins the first.
         #[serde(default)]
         closed: bool,

@@ -88,6 +88,7 @@ ground-lines, SPOS
 *Rigid Body, ref node=ground, elset=ground-lines";
     let expected = RigidSurfaceSpec::Polyline {
         points: vec![[1.0, 0.1], [0.5, 0.0], [-1.0, 0.0]],
+        centres: Vec::new(),
         closed: false,
     };
     let from_profile = read_deck_text(&block_2d(profile)).expect("profile");
@@ -112,6 +113,7 @@ ground-lines, SPOS
         ground(&clockwise),
         &RigidSurfaceSpec::Polyline {
             points: vec![[1.0, -2.0], [1.0, -0.5], [-1.0, -0.5], [-1.0, -2.0]],
+            centres: Vec::new(),
             closed: true,
         }
     );

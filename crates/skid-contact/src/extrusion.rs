@@ -1,5 +1,6 @@
-//! Rigid extruded profile (3D): a profile of straight segments in a plane through the body
-//! origin, swept without end along the plane's normal, such as a step, a ramp or a die profile.
+//! Rigid extruded profile (3D): a profile of straight segments and arcs in a plane through the
+//! body origin, swept without end along the plane's normal, such as a step, a ramp or a die
+//! profile with rounded edges.
 
 use nalgebra::{Matrix2x3, Matrix3, Vector2, Vector3};
 
@@ -17,24 +18,21 @@ use crate::surface::{Projection, RigidSurface, SurfaceShape};
 #[derive(Clone, Debug)]
 pub struct RigidExtrusion {
     profile: RigidPolyline,
-    points: Vec<Vector2<f64>>,
-    closed: bool,
     axis: Vector3<f64>,
     reference: Vector3<f64>,
 }
 
 impl RigidExtrusion {
-    /// The extrusion along `axis` of the profile `points` (closed if `closed`), given in the
-    /// plane of `reference` (made perpendicular to `axis`) and `axis x reference`.
+    /// The extrusion along `axis` of `profile`, given in the plane of `reference` (made
+    /// perpendicular to `axis`) and `axis x reference`.
     ///
     /// # Errors
-    /// [`ContactError::InvalidSurface`] for an invalid profile (see [`RigidPolyline::new`]), or
-    /// an axis or reference direction that is not finite, zero or parallel to the other.
+    /// [`ContactError::InvalidSurface`] for an axis or reference direction that is not finite,
+    /// zero or parallel to the other.
     pub fn new(
         axis: Vector3<f64>,
         reference: Vector3<f64>,
-        points: Vec<Vector2<f64>>,
-        closed: bool,
+        profile: RigidPolyline,
     ) -> Result<Self, ContactError> {
         let bad = || {
             ContactError::InvalidSurface(format!(
@@ -51,9 +49,7 @@ impl RigidExtrusion {
             .filter(|r| r.iter().all(|c| c.is_finite()))
             .ok_or_else(bad)?;
         Ok(Self {
-            profile: RigidPolyline::new(points.clone(), closed)?,
-            points,
-            closed,
+            profile,
             axis,
             reference,
         })
@@ -73,8 +69,8 @@ impl RigidSurface for RigidExtrusion {
         SurfaceShape::Extrusion {
             axis: self.axis,
             reference: self.reference,
-            profile: self.points.clone(),
-            closed: self.closed,
+            profile: self.profile.drawn_points(),
+            closed: self.profile.is_closed(),
         }
     }
 
@@ -119,8 +115,7 @@ mod tests {
         let extrusion = RigidExtrusion::new(
             Vector3::z(),
             Vector3::x(),
-            vec![Vector2::new(1.0, 0.0), Vector2::new(-1.0, 0.0)],
-            false,
+            RigidPolyline::new(vec![Vector2::new(1.0, 0.0), Vector2::new(-1.0, 0.0)], false)?,
         )?;
         let plane = RigidPlane::new(Vector3::y(), Vector3::x())?;
         for y in [
@@ -136,25 +131,32 @@ mod tests {
         Ok(())
     }
 
-    /// Gap and coordinates against finite differences on a step profile in a tilted plane.
+    /// Gap and coordinates against finite differences on a step profile with a fillet in a
+    /// tilted plane.
     #[test]
     fn gradients_match_finite_differences() -> Result<(), ContactError> {
         let extrusion = RigidExtrusion::new(
             Vector3::new(0.2, 0.1, 1.0),
             Vector3::new(1.0, 0.3, 0.0),
-            vec![
-                Vector2::new(1.0, 0.1),
-                Vector2::new(0.3, 0.1),
-                Vector2::new(0.0, 0.0),
-                Vector2::new(-1.0, 0.0),
-            ],
-            false,
+            RigidPolyline::with_arcs(
+                vec![
+                    Vector2::new(1.0, 0.1),
+                    Vector2::new(0.3, 0.1),
+                    Vector2::new(0.0, 0.0),
+                    Vector2::new(-1.0, 0.0),
+                    Vector2::new(-1.2, 0.2),
+                ],
+                vec![None, None, None, Some(Vector2::new(-1.0, 0.2))],
+                false,
+            )?,
         )?;
         for y in [
             Vector3::new(0.5, 0.2, 0.3),
             Vector3::new(0.1, 0.05, -0.2),
             Vector3::new(-0.4, 0.02, 0.1),
             Vector3::new(0.35, 0.25, 0.0),
+            // over the concave fillet about (-1, 0.2)
+            Vector3::new(-1.05, 0.1, 0.4),
         ] {
             check_gradients(&extrusion, &y, 1e-6);
         }
@@ -162,8 +164,7 @@ mod tests {
             RigidExtrusion::new(
                 Vector3::z(),
                 Vector3::z(),
-                vec![Vector2::zeros(), Vector2::x()],
-                false
+                RigidPolyline::new(vec![Vector2::zeros(), Vector2::x()], false)?
             )
             .is_err()
         );

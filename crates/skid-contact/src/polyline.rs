@@ -1,36 +1,142 @@
-//! Rigid polyline in the plane (2D): a chain of straight segments, open or closed, such as a
-//! floor, a ramp or a punch profile meshed with rigid line elements.
+//! Rigid polyline in the plane (2D): a chain of straight segments and circular arcs, open or
+//! closed, such as a floor, a ramp, a punch profile meshed with rigid line elements or the
+//! `LINE` and `CIRCL` profile of an analytical surface.
 
-use nalgebra::{Matrix2x3, Matrix3, Vector2, Vector3};
+use std::f64::consts::PI;
+
+use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
 use rstar::{AABB, PointDistance, RTree, RTreeObject};
 
 use crate::error::ContactError;
 use crate::surface::{Projection, RigidSurface, SurfaceShape};
 
-/// One segment `P_k -> P_{k+1}` in the plane.
+/// The circle an arc piece follows.
+#[derive(Clone, Copy, Debug)]
+struct Bend {
+    centre: Vector2<f64>,
+    radius: f64,
+    /// Signed angle from the start to the end about the centre (counter-clockwise positive),
+    /// `0 < |sweep| < pi`.
+    sweep: f64,
+    /// Unit direction from the centre to the start.
+    from: Vector2<f64>,
+}
+
+impl Bend {
+    /// `+1` for a counter-clockwise arc (contacted from outside its circle), `-1` otherwise.
+    fn turn(&self) -> f64 {
+        self.sweep.signum()
+    }
+}
+
+/// One piece `P_k -> P_{k+1}` in the plane: a straight segment, or an arc if `bend`.
 #[derive(Clone, Debug)]
 struct Segment {
     start: Vector2<f64>,
-    /// Unit tangent `t_k = (P_{k+1} - P_k) / L_k`.
+    end: Vector2<f64>,
+    /// Unit tangent `t_k = (P_{k+1} - P_k) / L_k` of a straight segment.
     tangent: Vector2<f64>,
-    /// Outward unit normal `n_k`: the tangent turned clockwise, `(t_y, -t_x)`.
+    /// Outward unit normal `n_k` of a straight segment: the tangent turned clockwise,
+    /// `(t_y, -t_x)`.
     normal: Vector2<f64>,
-    /// Length `L_k`.
+    /// Length `L_k` (`R |sweep|` for an arc).
     length: f64,
     /// Arc length `s_k` of `P_k` from the first vertex.
     arc: f64,
+    bend: Option<Bend>,
 }
 
-/// Where on a segment a point's closest point lies.
+impl Segment {
+    /// The outward unit normal at the start (`at_end`: at the end).
+    fn normal_at(&self, at_end: bool) -> Vector2<f64> {
+        match &self.bend {
+            None => self.normal,
+            Some(b) => {
+                let point = if at_end { self.end } else { self.start };
+                (point - b.centre) / b.radius * b.turn()
+            }
+        }
+    }
+
+    /// Where the piece's closest point to `q` lies, the point and its distance: within `tiny`
+    /// (a length along the piece) of an end, that end, unless the end is `smooth` (the next
+    /// piece goes on with the same normal there): then only beyond `tiny` past it, so that a
+    /// point on the common normal of two smoothly joined pieces takes their curvature, not a
+    /// vertex's.
+    fn closest(
+        &self,
+        q: &Vector2<f64>,
+        tiny: f64,
+        smooth: [bool; 2],
+    ) -> (Place, Vector2<f64>, f64) {
+        let end = |place: Place, point: Vector2<f64>| (place, point, (q - point).norm());
+        let low = if smooth[0] { -tiny } else { tiny };
+        let high = self.length - if smooth[1] { -tiny } else { tiny };
+        let Some(bend) = &self.bend else {
+            let u = (q - self.start).dot(&self.tangent);
+            return if u <= low {
+                end(Place::Start, self.start)
+            } else if u >= high {
+                end(Place::End, self.end)
+            } else {
+                end(Place::Interior(u), self.start + self.tangent * u)
+            };
+        };
+        let d = q - bend.centre;
+        let rho = d.norm();
+        // the angle from the start about the centre, in the direction of travel
+        let angle = bend.from.perp(&d).atan2(bend.from.dot(&d)) * bend.turn();
+        let u = angle * bend.radius;
+        if rho > tiny && u > low && u < high {
+            return (
+                Place::Interior(u),
+                bend.centre + d * (bend.radius / rho),
+                (rho - bend.radius).abs(),
+            );
+        }
+        let (first, last) = (end(Place::Start, self.start), end(Place::End, self.end));
+        if first.2 <= last.2 { first } else { last }
+    }
+
+    /// The axis-aligned box holding the piece.
+    fn bounds(&self) -> (Vector2<f64>, Vector2<f64>) {
+        let (mut low, mut high) = (self.start.inf(&self.end), self.start.sup(&self.end));
+        if let Some(bend) = &self.bend {
+            // the circle's extreme points the arc passes
+            for k in 0..4 {
+                let direction = Vector2::new([1.0, 0.0, -1.0, 0.0][k], [0.0, 1.0, 0.0, -1.0][k]);
+                let angle =
+                    bend.from.perp(&direction).atan2(bend.from.dot(&direction)) * bend.turn();
+                if angle > 0.0 && angle < bend.sweep.abs() {
+                    let point = bend.centre + direction * bend.radius;
+                    low = low.inf(&point);
+                    high = high.sup(&point);
+                }
+            }
+        }
+        (low, high)
+    }
+}
+
+/// Where on one piece, taken by itself, a point's closest point lies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Place {
+    Start,
+    End,
+    /// The interior, at arc length `u` from the piece's start.
+    Interior(f64),
+}
+
+/// Where on a piece a point's closest point lies.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Feature {
-    /// The interior, at arc length `u` from the segment's start.
+    /// The interior, at arc length `u` from the piece's start.
     Interior(f64),
     /// Vertex `j` of the polyline.
     Vertex(usize),
 }
 
-/// A segment's closest point to a point, with its distance.
+/// A piece's closest point to a point, with its distance.
 #[derive(Clone, Copy, Debug)]
 struct Closest {
     segment: usize,
@@ -39,54 +145,61 @@ struct Closest {
     distance: f64,
 }
 
-/// A segment in the search tree.
+/// A piece in the search tree.
 #[derive(Clone, Debug)]
 struct Located {
     index: usize,
-    start: Vector2<f64>,
-    end: Vector2<f64>,
+    segment: Segment,
 }
 
 impl RTreeObject for Located {
     type Envelope = AABB<[f64; 2]>;
 
     fn envelope(&self) -> Self::Envelope {
-        let (low, high) = (self.start.inf(&self.end), self.start.sup(&self.end));
+        let (low, high) = self.segment.bounds();
         AABB::from_corners([low.x, low.y], [high.x, high.y])
     }
 }
 
 impl PointDistance for Located {
-    /// Square of the exact distance to the segment (a NaN counts as infinitely far).
+    /// Square of the exact distance to the piece (a NaN counts as infinitely far).
     fn distance_2(&self, point: &[f64; 2]) -> f64 {
-        let q = Vector2::new(point[0], point[1]);
-        let edge = self.end - self.start;
-        let t = ((q - self.start).dot(&edge) / edge.norm_squared()).clamp(0.0, 1.0);
-        let d = (q - self.start - edge * t).norm_squared();
+        let (_, _, d) = self
+            .segment
+            .closest(&Vector2::new(point[0], point[1]), 0.0, [false; 2]);
+        let d = d * d;
         if d.is_nan() { f64::INFINITY } else { d }
     }
 }
 
 /// A polyline of vertices `P_0 .. P_m` in the body frame's plane `z = 0` (a closed one also has
-/// the segment `P_m -> P_0`), contacted on the side of its outward normals: each segment's
-/// direction turned clockwise (the right-hand side walking along it; for a closed polyline
-/// counter-clockwise about its inside, the outside).
+/// the piece `P_m -> P_0`), each piece a straight segment or a circular arc under 180 degrees
+/// about a given centre, contacted on the side of its outward normals: each piece's direction
+/// turned clockwise (the right-hand side walking along it; for a closed polyline
+/// counter-clockwise about its inside, the outside; a counter-clockwise arc is contacted from
+/// outside its circle, a clockwise one from inside).
 ///
 /// With `q` the in-plane point and `p` its closest point on the polyline (exact, over all
-/// segments):
+/// pieces):
 /// * on the interior of segment `k` (`p = P_k + u t_k`, `0 < u < L_k`): `g = n_k.(q - P_k)`,
 ///   `dg/dy = n_k`, `xi_0 = s_k + u` (arc length), `d xi_0/dy = t_k`; second derivatives vanish;
-/// * at vertex `P_j`: with `N_j` the sum of the normals of the segments meeting there (the
-///   pseudo-normal) and `s = sign((q - P_j).N_j)` (`+` on ties), `g = s |q - P_j|`,
+/// * on the interior of arc `k` (centre `c`, radius `R`, `d = q - c`, `rho = |d|`,
+///   `e_r = d/rho`, `e_phi = e_z x e_r`, `sigma = +1` counter-clockwise, `-1` clockwise):
+///   `g = sigma (rho - R)`, `dg/dy = sigma e_r`, `d^2g/dy^2 = sigma (I - e_z e_z^T - e_r e_r^T)/rho`;
+///   `xi_0 = s_k + sigma R (phi - phi_k)` with `phi` the angle of `d`,
+///   `d xi_0/dy = sigma R e_phi/rho` and `d^2 xi_0/dy^2 = sigma R d^2 phi/dy^2`,
+///   `d^2 phi/dy^2 = [[2 d_x d_y, d_y^2 - d_x^2], [d_y^2 - d_x^2, -2 d_x d_y]]/rho^4`;
+/// * at vertex `P_j`: with `N_j` the sum of the outward normals of the pieces meeting there
+///   (the pseudo-normal) and `s = sign((q - P_j).N_j)` (`+` on ties), `g = s |q - P_j|`,
 ///   `dg/dy = s (q - P_j)/|q - P_j|` (`N_j/|N_j|` when `|q - P_j| ~ 0`),
 ///   `d^2g/dy^2 = s (I - e_z e_z^T - dg/dy dg/dy^T)/|q - P_j|` (zero when `|q - P_j| ~ 0`),
 ///   `xi_0 = s_j`, `d xi_0/dy = 0`.
 ///
 /// Always `xi_1 = y_z`, `d xi_1/dy = e_z`; a closed polyline's `xi_0` has the period of its
-/// length. The gap is the signed distance, C1 across the segments' ends on the outside. Equally
-/// distant features (to round-off) resolve to a segment's interior before a vertex, then to the
-/// lowest segment. Segments are found through an R*-tree of their bounding boxes, so that a
-/// projection visits the few segments near the point rather than all.
+/// length. The gap is the signed distance, C1 across the pieces' ends on the outside. Equally
+/// distant features (to round-off) resolve to a piece's interior before a vertex, then to the
+/// lowest piece. Pieces are found through an R*-tree of their bounding boxes, so that a
+/// projection visits the few pieces near the point rather than all.
 #[derive(Clone, Debug)]
 pub struct RigidPolyline {
     vertices: Vec<Vector2<f64>>,
@@ -94,6 +207,8 @@ pub struct RigidPolyline {
     segments: Vec<Segment>,
     /// Pseudo-normal `N_j` of each vertex.
     vertex_normals: Vec<Vector2<f64>>,
+    /// Whether the two pieces at each vertex meet with one normal (to 1e-9).
+    smooth: Vec<bool>,
     tree: RTree<Located>,
     /// Total length (the period of a closed polyline's arc length).
     length: f64,
@@ -102,12 +217,29 @@ pub struct RigidPolyline {
 }
 
 impl RigidPolyline {
-    /// The polyline through `vertices` (at least 2; at least 3 if `closed`).
+    /// The polyline of straight segments through `vertices` (at least 2; at least 3 if
+    /// `closed`).
     ///
     /// # Errors
-    /// [`ContactError::InvalidSurface`] for too few or non-finite vertices, or a segment
-    /// shorter than `1e-12` of the largest vertex distance from the origin.
+    /// As [`RigidPolyline::with_arcs`].
     pub fn new(vertices: Vec<Vector2<f64>>, closed: bool) -> Result<Self, ContactError> {
+        Self::with_arcs(vertices, Vec::new(), closed)
+    }
+
+    /// The polyline through `vertices` whose piece `k` (from vertex `k` to the next) is the
+    /// arc about `centres[k]` where that is given, and straight otherwise (`centres` empty:
+    /// all straight).
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidSurface`] for too few or non-finite vertices, centres given for
+    /// another number of pieces, a piece shorter than `1e-12` of the largest vertex distance
+    /// from the origin, an arc whose ends lie at different distances from its centre (by more
+    /// than `1e-9` of the radius), or an arc of 180 degrees or more.
+    pub fn with_arcs(
+        vertices: Vec<Vector2<f64>>,
+        centres: Vec<Option<Vector2<f64>>>,
+        closed: bool,
+    ) -> Result<Self, ContactError> {
         let invalid = |message: String| Err(ContactError::InvalidSurface(message));
         let least = if closed { 3 } else { 2 };
         if vertices.len() < least {
@@ -117,8 +249,12 @@ impl RigidPolyline {
                 vertices.len()
             ));
         }
-        if let Some(v) = vertices.iter().find(|v| !v.iter().all(|c| c.is_finite())) {
-            return invalid(format!("non-finite polyline vertex {v:?}"));
+        if let Some(v) = vertices
+            .iter()
+            .chain(centres.iter().flatten())
+            .find(|v| !v.iter().all(|c| c.is_finite()))
+        {
+            return invalid(format!("non-finite polyline vertex or centre {v:?}"));
         }
         let scale = vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
         let count = if closed {
@@ -126,39 +262,85 @@ impl RigidPolyline {
         } else {
             vertices.len() - 1
         };
+        if !centres.is_empty() && centres.len() != count {
+            return invalid(format!(
+                "{} arc centres given for {count} pieces",
+                centres.len()
+            ));
+        }
         let mut segments = Vec::with_capacity(count);
         let mut arc = 0.0;
         for k in 0..count {
             let (a, b) = (vertices[k], vertices[(k + 1) % vertices.len()]);
-            let length = (b - a).norm();
-            if length <= 1e-12 * scale.max(f64::MIN_POSITIVE) {
+            let chord = (b - a).norm();
+            if chord <= 1e-12 * scale.max(f64::MIN_POSITIVE) {
                 return invalid(format!(
-                    "polyline segment {k} from {a:?} to {b:?} has no length"
+                    "polyline piece {k} from {a:?} to {b:?} has no length"
                 ));
             }
-            let tangent = (b - a) / length;
+            let tangent = (b - a) / chord;
+            let bend = match centres.get(k).copied().flatten() {
+                None => None,
+                Some(centre) => {
+                    let (r0, r1) = ((a - centre).norm(), (b - centre).norm());
+                    if (r0 - r1).abs() > 1e-9 * r0.max(r1) {
+                        return invalid(format!(
+                            "arc {k} from {a:?} to {b:?} about {centre:?}: its ends lie at \
+                             {r0} and {r1} from the centre"
+                        ));
+                    }
+                    let (from, to) = ((a - centre) / r0, (b - centre) / r1);
+                    let sweep = from.perp(&to).atan2(from.dot(&to));
+                    if sweep.abs() >= PI * (1.0 - 1e-12) {
+                        return invalid(format!(
+                            "arc {k} from {a:?} to {b:?} about {centre:?} turns 180 degrees or \
+                             more: its direction is ambiguous, split it"
+                        ));
+                    }
+                    Some(Bend {
+                        centre,
+                        radius: r0,
+                        sweep,
+                        from,
+                    })
+                }
+            };
+            let length = bend.map_or(chord, |b| b.radius * b.sweep.abs());
             segments.push(Segment {
                 start: a,
+                end: b,
                 tangent,
                 normal: Vector2::new(tangent.y, -tangent.x),
                 length,
                 arc,
+                bend,
             });
             arc += length;
         }
         let mut vertex_normals = vec![Vector2::zeros(); vertices.len()];
         for (k, segment) in segments.iter().enumerate() {
-            vertex_normals[k] += segment.normal;
-            vertex_normals[(k + 1) % vertices.len()] += segment.normal;
+            vertex_normals[k] += segment.normal_at(false);
+            vertex_normals[(k + 1) % vertices.len()] += segment.normal_at(true);
         }
+        let smooth = (0..vertices.len())
+            .map(|j| {
+                let before = if j > 0 { j - 1 } else { count.wrapping_sub(1) };
+                match (
+                    segments.get(before).filter(|_| j > 0 || closed),
+                    segments.get(j),
+                ) {
+                    (Some(a), Some(b)) => (a.normal_at(true) - b.normal_at(false)).norm() <= 1e-9,
+                    _ => false,
+                }
+            })
+            .collect();
         let tree = RTree::bulk_load(
             segments
                 .iter()
                 .enumerate()
-                .map(|(index, s)| Located {
+                .map(|(index, segment)| Located {
                     index,
-                    start: s.start,
-                    end: s.start + s.tangent * s.length,
+                    segment: segment.clone(),
                 })
                 .collect(),
         );
@@ -167,10 +349,52 @@ impl RigidPolyline {
             closed,
             segments,
             vertex_normals,
+            smooth,
             tree,
             length: arc,
             scale,
         })
+    }
+
+    /// The axis-aligned box `(low, high)` holding every piece.
+    pub fn bounds(&self) -> (Vector2<f64>, Vector2<f64>) {
+        self.segments.iter().map(Segment::bounds).fold(
+            (
+                Vector2::repeat(f64::INFINITY),
+                Vector2::repeat(f64::NEG_INFINITY),
+            ),
+            |(low, high), (l, h)| (low.inf(&l), high.sup(&h)),
+        )
+    }
+
+    /// Whether the last vertex joins the first.
+    pub fn is_closed(&self) -> bool {
+        self.closed
+    }
+
+    /// Points along the polyline for drawing it: the vertices, with arcs drawn through points
+    /// at most 5 degrees apart (a closed polyline's first point not repeated).
+    pub fn drawn_points(&self) -> Vec<Vector2<f64>> {
+        let mut points = Vec::new();
+        for segment in &self.segments {
+            points.push(segment.start);
+            if let Some(bend) = &segment.bend {
+                let steps = (bend.sweep.abs() / 5f64.to_radians()).ceil() as usize;
+                for i in 1..steps {
+                    let angle = bend.sweep * i as f64 / steps as f64;
+                    let (sin, cos) = angle.sin_cos();
+                    let direction = Vector2::new(
+                        bend.from.x * cos - bend.from.y * sin,
+                        bend.from.x * sin + bend.from.y * cos,
+                    );
+                    points.push(bend.centre + direction * bend.radius);
+                }
+            }
+        }
+        if !self.closed {
+            points.push(self.vertices[self.vertices.len() - 1]);
+        }
+        points
     }
 
     /// Index of the vertex at the end of segment `k`.
@@ -178,25 +402,20 @@ impl RigidPolyline {
         (k + 1) % self.vertices.len()
     }
 
-    /// The closest point of segment `k` to `q`; within `tiny` of an end, that end's vertex.
+    /// The closest point of piece `k` to `q`; within `tiny` of an end, that end's vertex.
     fn closest_on(&self, k: usize, q: &Vector2<f64>, tiny: f64) -> Closest {
-        let segment = &self.segments[k];
-        let u = (q - segment.start).dot(&segment.tangent);
-        let (feature, point) = if u <= tiny {
-            (Feature::Vertex(k), segment.start)
-        } else if u >= segment.length - tiny {
-            (
-                Feature::Vertex(self.end_vertex(k)),
-                self.vertices[self.end_vertex(k)],
-            )
-        } else {
-            (Feature::Interior(u), segment.start + segment.tangent * u)
+        let smooth = [self.smooth[k], self.smooth[self.end_vertex(k)]];
+        let (place, point, distance) = self.segments[k].closest(q, tiny, smooth);
+        let feature = match place {
+            Place::Start => Feature::Vertex(k),
+            Place::End => Feature::Vertex(self.end_vertex(k)),
+            Place::Interior(u) => Feature::Interior(u),
         };
         Closest {
             segment: k,
             feature,
             point,
-            distance: (q - point).norm(),
+            distance,
         }
     }
 
@@ -227,16 +446,17 @@ impl RigidPolyline {
 }
 
 impl RigidPolyline {
-    /// The segment whose interior holds the closest point to `q`, with its outward normal;
-    /// `None` where the closest point is a vertex (or `q` is not finite).
+    /// The straight segment whose interior holds the closest point to `q`, with its outward
+    /// normal; `None` where the closest point is a vertex or on an arc (or `q` is not finite).
     pub(crate) fn interior_segment(&self, q: &Vector2<f64>) -> Option<(usize, Vector2<f64>)> {
         if !q.iter().all(|c| c.is_finite()) {
             return None;
         }
         let tiny = 64.0 * f64::EPSILON * (self.scale + q.norm());
         let closest = self.nearest(q, tiny)?;
-        matches!(closest.feature, Feature::Interior(_))
-            .then(|| (closest.segment, self.segments[closest.segment].normal))
+        let segment = &self.segments[closest.segment];
+        (matches!(closest.feature, Feature::Interior(_)) && segment.bend.is_none())
+            .then_some((closest.segment, segment.normal))
     }
 }
 
@@ -263,7 +483,7 @@ fn lift(v: &Vector2<f64>) -> Vector3<f64> {
 impl RigidSurface for RigidPolyline {
     fn shape(&self) -> SurfaceShape {
         SurfaceShape::Polyline {
-            vertices: self.vertices.iter().map(lift).collect(),
+            vertices: self.drawn_points().iter().map(lift).collect(),
             closed: self.closed,
         }
     }
@@ -276,14 +496,44 @@ impl RigidSurface for RigidPolyline {
         let tiny = 64.0 * f64::EPSILON * (self.scale + q.norm());
         let closest = self.nearest(&q, tiny)?;
         let segment = &self.segments[closest.segment];
-        let (gap, gap_gradient, gap_hessian, arc, arc_gradient) = match closest.feature {
-            Feature::Interior(u) => (
-                segment.normal.dot(&(q - segment.start)),
-                lift(&segment.normal),
-                Matrix3::zeros(),
-                segment.arc + u,
-                lift(&segment.tangent),
-            ),
+        let (gap, gap_gradient, gap_hessian, arc, arc_gradient, arc_hessian) = match closest.feature
+        {
+            Feature::Interior(u) => match &segment.bend {
+                None => (
+                    segment.normal.dot(&(q - segment.start)),
+                    lift(&segment.normal),
+                    Matrix3::zeros(),
+                    segment.arc + u,
+                    lift(&segment.tangent),
+                    Matrix3::zeros(),
+                ),
+                Some(bend) => {
+                    let sigma = bend.turn();
+                    let d = q - bend.centre;
+                    let rho = d.norm();
+                    let radial = d / rho;
+                    let across = Vector2::new(-radial.y, radial.x);
+                    let phi_hessian = Matrix2::new(
+                        2.0 * d.x * d.y,
+                        d.y * d.y - d.x * d.x,
+                        d.y * d.y - d.x * d.x,
+                        -2.0 * d.x * d.y,
+                    ) / rho.powi(4);
+                    let plane = |m: Matrix2<f64>| {
+                        let mut out = Matrix3::zeros();
+                        out.fixed_view_mut::<2, 2>(0, 0).copy_from(&m);
+                        out
+                    };
+                    (
+                        sigma * (rho - bend.radius),
+                        lift(&(radial * sigma)),
+                        plane((Matrix2::identity() - radial * radial.transpose()) * (sigma / rho)),
+                        segment.arc + u,
+                        lift(&(across * (sigma * bend.radius / rho))),
+                        plane(phi_hessian * (sigma * bend.radius)),
+                    )
+                }
+            },
             Feature::Vertex(j) => {
                 let offset = q - closest.point;
                 let pseudo = self.vertex_normals[j];
@@ -298,7 +548,9 @@ impl RigidSurface for RigidPolyline {
                         - direction * direction.transpose();
                     (direction * sign, across * (sign / closest.distance))
                 } else {
-                    let normal = pseudo.try_normalize(0.0).unwrap_or(segment.normal);
+                    let normal = pseudo
+                        .try_normalize(0.0)
+                        .unwrap_or_else(|| segment.normal_at(false));
                     (lift(&normal), Matrix3::zeros())
                 };
                 // the arc length of vertex j: the start of the segment leaving it, or the
@@ -310,6 +562,7 @@ impl RigidSurface for RigidPolyline {
                     curvature,
                     arc,
                     Vector3::zeros(),
+                    Matrix3::zeros(),
                 )
             }
         };
@@ -319,7 +572,7 @@ impl RigidSurface for RigidPolyline {
             coords: Vector2::new(arc, y.z),
             coords_gradient: [arc_gradient, Vector3::z()],
             gap_hessian,
-            coords_hessian: [Matrix3::zeros(); 2],
+            coords_hessian: [arc_hessian, Matrix3::zeros()],
         })
     }
 
@@ -463,6 +716,138 @@ mod tests {
         assert!((slip[0] - 0.02).abs() < 1e-12);
         check_gradients(&square, &Vector3::new(0.2, 1.3, 0.0), 1e-6);
         Ok(())
+    }
+
+    /// A step walked in -x, outside up: a floor at y = 1 from x = 2 to 1, a counter-clockwise
+    /// quarter circle about (1, 0) down to (0, 0) (a rounded convex edge), a floor at y = 0 to
+    /// x = -1, and a clockwise quarter circle about (-1, 1) up to (-2, 1) (a concave fillet).
+    fn rounded() -> RigidPolyline {
+        RigidPolyline::with_arcs(
+            vec![
+                Vector2::new(2.0, 1.0),
+                Vector2::new(1.0, 1.0),
+                Vector2::new(0.0, 0.0),
+                Vector2::new(-1.0, 0.0),
+                Vector2::new(-2.0, 1.0),
+            ],
+            vec![
+                None,
+                Some(Vector2::new(1.0, 0.0)),
+                None,
+                Some(Vector2::new(-1.0, 1.0)),
+            ],
+            false,
+        )
+        .expect("rounded profile")
+    }
+
+    /// On an arc the gap is the distance to its circle, signed by the side it is contacted
+    /// on, and the arc length runs on along it; gradients and Hessians of both match finite
+    /// differences on either arc, above and below the surface.
+    #[test]
+    fn arcs_project_on_their_circle() {
+        let profile = rounded();
+        // the rounded edge: outside its circle the gap is positive, inside negative
+        let angle = 3.0 * PI / 4.0;
+        let on = Vector2::new(1.0 + angle.cos(), angle.sin());
+        let y = Vector3::new(on.x + 0.1 * angle.cos(), on.y + 0.1 * angle.sin(), 0.2);
+        let p = project(&profile, &y);
+        assert!((p.gap - 0.1).abs() < 1e-14, "{}", p.gap);
+        let under = Vector3::new(on.x - 0.1 * angle.cos(), on.y - 0.1 * angle.sin(), 0.0);
+        assert!((project(&profile, &under).gap + 0.1).abs() < 1e-14);
+        assert!(
+            (p.coords[0] - (1.0 + PI / 4.0)).abs() < 1e-14,
+            "{:?}",
+            p.coords
+        );
+        // the fillet: inside its circle, 0.6 from the centre, the point is 0.4 above it
+        let q = Vector3::new(-1.0 - 0.6 * 0.5f64.sqrt(), 1.0 - 0.6 * 0.5f64.sqrt(), 0.0);
+        let b = project(&profile, &q);
+        assert!((b.gap - 0.4).abs() < 1e-14, "{}", b.gap);
+        assert!((b.coords[0] - (2.0 + PI / 2.0 + PI / 4.0)).abs() < 1e-14);
+        assert!((profile.coords_period()[0].is_none()));
+        for y in [
+            y,
+            q,
+            Vector3::new(0.4, 0.3, 0.0),
+            Vector3::new(0.7, 0.9, 0.1),
+            Vector3::new(-1.5, 0.1, 0.0),
+            Vector3::new(-1.2, 0.6, 0.0),
+        ] {
+            check_gradients(&profile, &y, 1e-6);
+        }
+    }
+
+    /// The closest point over the pieces is the nearest of a dense sampling of the profile,
+    /// and the arc length is continuous across the joints of lines and arcs.
+    #[test]
+    fn arcs_are_searched_exactly() {
+        let profile = rounded();
+        let samples = profile.drawn_points();
+        let dense: Vec<Vector2<f64>> = samples
+            .windows(2)
+            .flat_map(|w| (0..200).map(move |i| w[0] + (w[1] - w[0]) * (i as f64 / 200.0)))
+            .collect();
+        for k in 0..60 {
+            let q = Vector2::new(
+                -2.4 + 0.077 * k as f64,
+                1.3 * ((k * 29 % 13) as f64 / 12.0) - 0.2,
+            );
+            let p = project(&profile, &lift(&q));
+            let sampled = dense
+                .iter()
+                .map(|d| (q - d).norm())
+                .fold(f64::INFINITY, f64::min);
+            // the drawn chords sag by R (1 - cos 2.5 deg) below the arcs
+            assert!(
+                (p.gap.abs() - sampled).abs() < 1e-3,
+                "{q:?}: {} vs {sampled}",
+                p.gap
+            );
+        }
+        for joint in [
+            Vector2::new(1.0, 1.0),
+            Vector2::new(0.0, 0.0),
+            Vector2::new(-1.0, 0.0),
+        ] {
+            let (a, b) = (
+                project(&profile, &lift(&(joint + Vector2::new(1e-7, 0.0)))),
+                project(&profile, &lift(&(joint - Vector2::new(1e-7, 0.0)))),
+            );
+            assert!((a.coords[0] - b.coords[0]).abs() < 1e-6, "{joint:?}");
+        }
+    }
+
+    #[test]
+    fn invalid_arcs_are_refused() {
+        let invalid = |r: Result<RigidPolyline, ContactError>| {
+            matches!(r, Err(ContactError::InvalidSurface(_)))
+        };
+        let (a, b) = (Vector2::new(1.0, 0.0), Vector2::new(-1.0, 0.0));
+        // a half circle is ambiguous, ends off the circle are wrong, centres must match pieces
+        assert!(invalid(RigidPolyline::with_arcs(
+            vec![a, b],
+            vec![Some(Vector2::zeros())],
+            false
+        )));
+        assert!(invalid(RigidPolyline::with_arcs(
+            vec![a, Vector2::new(0.0, 1.1)],
+            vec![Some(Vector2::zeros())],
+            false
+        )));
+        assert!(invalid(RigidPolyline::with_arcs(
+            vec![a, b],
+            vec![None, None],
+            false
+        )));
+        assert!(
+            RigidPolyline::with_arcs(
+                vec![a, Vector2::new(0.0, 1.0)],
+                vec![Some(Vector2::zeros())],
+                false
+            )
+            .is_ok()
+        );
     }
 
     /// The tree finds the same closest segment as a scan of all segments.

@@ -1,6 +1,6 @@
-//! Rigid surface of revolution (3D): a profile of straight segments in the `r-z` half-plane
-//! revolved about an axis through the body origin, such as a stepped drum, a cone or a roller
-//! with flanges.
+//! Rigid surface of revolution (3D): a profile of straight segments and arcs in the `r-z`
+//! half-plane revolved about an axis through the body origin, such as a stepped drum, a cone,
+//! a roller with flanges or a spherical indenter.
 
 use nalgebra::{Matrix2x3, Vector2, Vector3};
 
@@ -24,33 +24,30 @@ use crate::surface::{AnalyticCylinder, DiscreteGradient, Projection, RigidSurfac
 #[derive(Clone, Debug)]
 pub struct RigidRevolution {
     profile: RigidPolyline,
-    points: Vec<Vector2<f64>>,
-    closed: bool,
     chart: AnalyticCylinder,
 }
 
 impl RigidRevolution {
-    /// The revolution of the profile `points` (`(r, z)`, `r >= 0`; closed if `closed`) about
-    /// `axis`, with the chart radius `radius` of the circumferential coordinate.
+    /// The revolution of `profile` (in `(r, z)`, `r >= 0`) about `axis`, with the chart radius
+    /// `radius` of the circumferential coordinate.
     ///
     /// # Errors
-    /// [`ContactError::InvalidSurface`] for an invalid profile (see [`RigidPolyline::new`]), a
-    /// negative or non-finite `r`, or an invalid axis or radius.
+    /// [`ContactError::InvalidSurface`] for a profile that reaches `r < 0`, or an invalid axis
+    /// or radius.
     pub fn new(
         axis: Vector3<f64>,
-        points: Vec<Vector2<f64>>,
-        closed: bool,
+        profile: RigidPolyline,
         radius: f64,
     ) -> Result<Self, ContactError> {
-        if let Some(p) = points.iter().find(|p| p.x < 0.0 || p.x.is_nan()) {
+        let (low, _) = profile.bounds();
+        if low.x < 0.0 || low.x.is_nan() {
             return Err(ContactError::InvalidSurface(format!(
-                "a profile of revolution lies at r >= 0, got the point {p:?}"
+                "a profile of revolution lies at r >= 0, this one reaches r = {}",
+                low.x
             )));
         }
         Ok(Self {
-            profile: RigidPolyline::new(points.clone(), closed)?,
-            points,
-            closed,
+            profile,
             chart: AnalyticCylinder::new(radius, axis)?,
         })
     }
@@ -61,8 +58,8 @@ impl RigidSurface for RigidRevolution {
         SurfaceShape::Revolution {
             axis: self.chart.axis(),
             reference: self.chart.reference_direction(),
-            profile: self.points.clone(),
-            closed: self.closed,
+            profile: self.profile.drawn_points(),
+            closed: self.profile.is_closed(),
         }
     }
 
@@ -149,8 +146,7 @@ mod tests {
     /// A drum with a step and a cone: r = 0.2 for z in [-0.1, 0], a cone out to r = 0.25 at
     /// z = 0.05, then r = 0.25 to z = 0.1; walked towards +z so that the outside is at larger r.
     fn stepped() -> RigidRevolution {
-        RigidRevolution::new(
-            Vector3::new(0.0, 0.0, 2.0),
+        let profile = RigidPolyline::new(
             vec![
                 Vector2::new(0.2, -0.1),
                 Vector2::new(0.2, 0.0),
@@ -158,9 +154,9 @@ mod tests {
                 Vector2::new(0.25, 0.1),
             ],
             false,
-            0.2,
         )
-        .expect("profile")
+        .expect("profile");
+        RigidRevolution::new(Vector3::new(0.0, 0.0, 2.0), profile, 0.2).expect("revolution")
     }
 
     /// The straight profile r = R is the analytical cylinder: the same gap, coordinates (the
@@ -171,8 +167,7 @@ mod tests {
         let cylinder = AnalyticCylinder::new(0.2, axis)?;
         let revolution = RigidRevolution::new(
             axis,
-            vec![Vector2::new(0.2, -1.0), Vector2::new(0.2, 1.0)],
-            false,
+            RigidPolyline::new(vec![Vector2::new(0.2, -1.0), Vector2::new(0.2, 1.0)], false)?,
             0.2,
         )?;
         for y in [
@@ -224,8 +219,7 @@ mod tests {
         let cylinder = AnalyticCylinder::new(0.2, axis)?;
         let straight = RigidRevolution::new(
             axis,
-            vec![Vector2::new(0.2, -1.0), Vector2::new(0.2, 1.0)],
-            false,
+            RigidPolyline::new(vec![Vector2::new(0.2, -1.0), Vector2::new(0.2, 1.0)], false)?,
             0.2,
         )?;
         let (a, b) = (
@@ -260,6 +254,35 @@ mod tests {
         }
     }
 
+    /// Two quarter circles about the origin, from the south pole up to the north pole,
+    /// revolved: a sphere, whose gap is `|y| - R` and whose derivatives match finite
+    /// differences.
+    #[test]
+    fn a_revolved_half_circle_is_a_sphere() -> Result<(), ContactError> {
+        let r = 0.3;
+        let profile = RigidPolyline::with_arcs(
+            vec![
+                Vector2::new(0.0, -r),
+                Vector2::new(r, 0.0),
+                Vector2::new(0.0, r),
+            ],
+            vec![Some(Vector2::zeros()), Some(Vector2::zeros())],
+            false,
+        )?;
+        let sphere = RigidRevolution::new(Vector3::new(0.1, 0.0, 1.0), profile, r)?;
+        for y in [
+            Vector3::new(0.31, 0.02, -0.05),
+            Vector3::new(-0.1, 0.2, 0.25),
+            Vector3::new(0.05, -0.12, -0.2),
+        ] {
+            let p = project(&sphere, &y);
+            assert!((p.gap - (y.norm() - r)).abs() < 1e-15, "{y:?}");
+            assert!((p.gap_gradient - y.normalize()).norm() < 1e-14);
+            check_gradients(&sphere, &y, 1e-6);
+        }
+        Ok(())
+    }
+
     /// On the cone the gap is the distance to it in the meridian half-plane, its normal the
     /// profile's normal turned about the axis; the axis itself has no projection.
     #[test]
@@ -278,8 +301,8 @@ mod tests {
         assert!(
             RigidRevolution::new(
                 Vector3::z(),
-                vec![Vector2::new(-0.1, 0.0), Vector2::new(0.2, 0.0)],
-                false,
+                RigidPolyline::new(vec![Vector2::new(-0.1, 0.0), Vector2::new(0.2, 0.0)], false)
+                    .expect("profile"),
                 0.2
             )
             .is_err()

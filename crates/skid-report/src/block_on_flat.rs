@@ -185,6 +185,8 @@ fn flat_normal(surface: &RigidSurfaceSpec) -> Option<[f64; 3]> {
     };
     match surface {
         RigidSurfaceSpec::Plane { normal, .. } => Some(unit(*normal)),
+        // an arc is never flat
+        RigidSurfaceSpec::Polyline { centres, .. } if centres.iter().any(Option::is_some) => None,
         RigidSurfaceSpec::Polyline { points, .. } => same(
             points
                 .windows(2)
@@ -195,6 +197,7 @@ fn flat_normal(surface: &RigidSurfaceSpec) -> Option<[f64; 3]> {
             axis,
             reference,
             profile,
+            centres,
             ..
         } => {
             // the profile's plane: u along the reference (made perpendicular to the axis), v
@@ -209,6 +212,7 @@ fn flat_normal(surface: &RigidSurfaceSpec) -> Option<[f64; 3]> {
             ];
             let normal = flat_normal(&RigidSurfaceSpec::Polyline {
                 points: profile.clone(),
+                centres: centres.clone(),
                 closed: false,
             })?;
             Some([0, 1, 2].map(|k| normal[0] * u[k] + normal[1] * v[k]))
@@ -305,11 +309,19 @@ mod tests {
     fn flat_element_surfaces_have_one_normal() {
         let line = |points: Vec<[f64; 2]>| RigidSurfaceSpec::Polyline {
             points,
+            centres: Vec::new(),
             closed: false,
         };
         // walked towards -x: the outside (right-hand side) is up
         let floor = line(vec![[1.0, 0.0], [0.2, 0.0], [-1.0, 0.0]]);
         assert_eq!(flat_normal(&floor), Some([0.0, 1.0, 0.0]));
+        // the same points with a shallow arc between the last two
+        let bump = RigidSurfaceSpec::Polyline {
+            points: vec![[1.0, 0.0], [0.2, 0.0], [-1.0, 0.0]],
+            centres: vec![None, Some([-0.4, -5.0])],
+            closed: false,
+        };
+        assert_eq!(flat_normal(&bump), None);
         let ramp = line(vec![[1.0, 0.1], [0.2, 0.0], [-1.0, 0.0]]);
         assert_eq!(flat_normal(&ramp), None);
         let mesh = |lift: f64| RigidSurfaceSpec::Triangles {
@@ -331,6 +343,7 @@ mod tests {
             axis: [0.0, 0.0, 2.0],
             reference: [1.0, 0.0, 0.0],
             profile: vec![[1.0, 0.0], [0.0, 0.0], [-1.0, 0.0]],
+            centres: Vec::new(),
             closed: false,
         };
         assert_eq!(flat_normal(&extruded), Some([0.0, 1.0, 0.0]));

@@ -11,6 +11,7 @@
 //! line is `e_z x (x_2 - x_1)`, of a quadrilateral the right-hand normal of `1-2-3-4`.
 
 use nalgebra::{Vector2, Vector3};
+use skid_contact::RigidPolyline;
 use skid_contact::surface::AnalyticCylinder;
 use std::f64::consts::TAU;
 
@@ -174,9 +175,10 @@ fn unit(v: Vector3<f64>) -> Option<Vector3<f64>> {
 
 impl AnalyticalSurface {
     /// The surface in the frame of a body whose reference node is at `reference`: a closed
-    /// clockwise circle is a [`RigidSurfaceSpec::Cylinder`] about an axis through the
-    /// reference node; a straight profile (lines in one direction) is an unbounded
-    /// [`RigidSurfaceSpec::Plane`] through it; a revolved `r = R` line a cylinder.
+    /// clockwise circle about it is a [`RigidSurfaceSpec::Cylinder`] about an axis through the
+    /// reference node; a straight profile (lines in one direction) through it an unbounded
+    /// [`RigidSurfaceSpec::Plane`]; a revolved `r = R` line a cylinder; any other profile of
+    /// lines and arcs a polyline, an extrusion or a surface of revolution of it.
     pub fn spec(&self, reference: &Vector3<f64>) -> Result<RigidSurfaceSpec, String> {
         match self.kind {
             AnalyticalKind::Revolution => self.revolution(reference),
@@ -200,10 +202,6 @@ impl AnalyticalSurface {
                 Piece::Arc { .. } => None,
             })
             .collect();
-        let axis_distance = |point: &Vector3<f64>| {
-            let d = point - reference;
-            (d - self.ez * self.ez.dot(&d)).norm()
-        };
         if lines.len() == self.pieces.len() {
             // straight profile: every piece in the direction of the first
             let mut from = self.start;
@@ -216,7 +214,7 @@ impl AnalyticalSurface {
                     return Err("a LINE of the profile has zero length".into());
                 }
                 if (d.normalize() - direction).norm() > 1e-9 {
-                    return self.polyline(reference, &lines);
+                    return self.polyline(reference);
                 }
                 from = *end;
             }
@@ -225,94 +223,59 @@ impl AnalyticalSurface {
             let distance = normal.dot(&(self.global(&self.start) - reference));
             if distance.abs() > tol {
                 // not a plane through the reference node: the segment itself
-                return self.polyline(reference, &lines);
+                return self.polyline(reference);
             }
             return Ok(RigidSurfaceSpec::Plane {
                 normal: normal.into(),
                 tangent: t.into(),
             });
         }
-        // circle: arcs about one centre, closing after one clockwise turn
+        match self.centred_circle(reference, tol) {
+            Some(radius) => Ok(RigidSurfaceSpec::Cylinder {
+                radius,
+                axis: self.ez.into(),
+            }),
+            None => self.polyline(reference),
+        }
+    }
+
+    /// The radius of the profile if it is one full circle traversed clockwise (contacted
+    /// from outside) about a centre on the axis through the reference node: arcs about one
+    /// centre and radius, turning once and ending where they start.
+    fn centred_circle(&self, reference: &Vector3<f64>, tol: f64) -> Option<f64> {
         let mut from = self.start;
         let mut turned = 0.0;
         let mut circle: Option<(Vector2<f64>, f64)> = None;
         for piece in &self.pieces {
             let Piece::Arc { end, centre } = piece else {
-                return Err(
-                    "a profile mixing LINE and CIRCL is not supported: give a closed \
-                            circle or straight lines"
-                        .into(),
-                );
+                return None;
             };
             let (r0, r1) = ((from - centre).norm(), (end - centre).norm());
             if (r0 - r1).abs() > tol {
-                return Err(format!(
-                    "an arc's start and end lie at {r0} and {r1} m from its centre"
-                ));
+                return None;
             }
             match circle {
                 None => circle = Some((*centre, r0)),
-                Some((c, r)) if (c - centre).norm() > tol || (r - r0).abs() > tol => {
-                    return Err(
-                        "the arcs of a closed profile must share one centre and radius".into(),
-                    );
-                }
+                Some((c, r)) if (c - centre).norm() > tol || (r - r0).abs() > tol => return None,
                 Some(_) => {}
             }
-            let a0 = (from - centre).y.atan2((from - centre).x);
-            let a1 = (end - centre).y.atan2((end - centre).x);
-            let mut sweep = a1 - a0;
-            // an arc is under 180 degrees: take the sweep in (-pi, pi]
-            if sweep > TAU / 2.0 {
-                sweep -= TAU;
-            } else if sweep <= -TAU / 2.0 {
-                sweep += TAU;
-            }
-            turned += sweep;
+            let (a, b) = (from - centre, end - centre);
+            turned += a.perp(&b).atan2(a.dot(&b));
             from = *end;
         }
-        let (centre, radius) = circle.ok_or("empty profile")?;
-        if (from - self.start).norm() > tol || ((turned.abs() - TAU).abs() > 1e-9) {
-            return Err(format!(
-                "the arcs must close into one full circle (they turn {:.6} rad and end {:e} m \
-                 from the start)",
-                turned,
-                (from - self.start).norm()
-            ));
-        }
-        if turned > 0.0 {
-            return Err(
-                "the circle is traversed counter-clockwise, so its outward normal \
-                        (direction of travel turned counter-clockwise) points into it; skid's \
-                        circles are contacted from outside: traverse it clockwise"
-                    .into(),
-            );
-        }
-        let offset = axis_distance(&self.global(&centre));
-        if offset > tol {
-            return Err(format!(
-                "the circle's centre lies {offset:e} m off the reference node; skid's rigid \
-                 circles and cylinders are centred on their reference node"
-            ));
-        }
-        Ok(RigidSurfaceSpec::Cylinder {
-            radius,
-            axis: self.ez.into(),
-        })
+        let (centre, radius) = circle?;
+        let d = self.global(&centre) - reference;
+        let offset = (d - self.ez * self.ez.dot(&d)).norm();
+        let closes = (from - self.start).norm() <= tol && (turned + TAU).abs() <= 1e-9;
+        (closes && offset <= tol).then_some(radius)
     }
 
-    /// A profile of lines other than a straight line through the reference node, in the body
-    /// frame: in 2D (`SEGMENTS`) a [`RigidSurfaceSpec::Polyline`], in 3D (`CYLINDER`) the
-    /// [`RigidSurfaceSpec::Extrusion`] of the profile along the generator, closed if it ends
-    /// where it starts and refused if it is then traversed inwards. Its points are taken in
-    /// reverse: the deck's outward normal is the direction of travel turned counter-clockwise,
-    /// the polyline's turned clockwise.
-    fn polyline(
-        &self,
-        reference: &Vector3<f64>,
-        ends: &[Vector2<f64>],
-    ) -> Result<RigidSurfaceSpec, String> {
-        let (points, closed) = self.profile_points(reference, ends, |p| {
+    /// Any other profile, in the body frame: in 2D (`SEGMENTS`) a
+    /// [`RigidSurfaceSpec::Polyline`], in 3D (`CYLINDER`) the [`RigidSurfaceSpec::Extrusion`]
+    /// of the profile along the generator, closed if it ends where it starts and refused if it
+    /// is then traversed inwards, its `CIRCL` pieces arcs about their centres.
+    fn polyline(&self, reference: &Vector3<f64>) -> Result<RigidSurfaceSpec, String> {
+        let (points, centres, closed) = self.profile_points(reference, |p| {
             let y = self.global(p) - reference;
             [self.ex.dot(&y), self.ey.dot(&y)]
         })?;
@@ -321,33 +284,77 @@ impl AnalyticalSurface {
                 axis: self.ez.into(),
                 reference: self.ex.into(),
                 profile: points,
+                centres,
                 closed,
             },
-            _ => RigidSurfaceSpec::Polyline { points, closed },
+            _ => RigidSurfaceSpec::Polyline {
+                points,
+                centres,
+                closed,
+            },
         })
     }
 
-    /// The points of a profile of lines (its start, then the ends of `ends`), closed if it ends
-    /// where it starts (the last point dropped), each placed by `place` and taken in reverse:
-    /// the deck's outward normal is the travel turned counter-clockwise, a polyline's turned
-    /// clockwise. A closed profile traversed inwards is refused ([`check_outward`]).
+    /// The points of the profile (its start, then the ends of its pieces), closed if it ends
+    /// where it starts (the last point dropped), and the centre of each piece that is an arc
+    /// (none if all are lines), each placed by `place` and taken in reverse: the deck's outward
+    /// normal is the travel turned counter-clockwise, a polyline's turned clockwise. A closed
+    /// profile traversed inwards is refused ([`check_outward`]), as is one whose arcs do not
+    /// fit their centres.
+    #[allow(clippy::type_complexity)] // the spec's three profile fields
     fn profile_points(
         &self,
         reference: &Vector3<f64>,
-        ends: &[Vector2<f64>],
         place: impl Fn(&Vector2<f64>) -> [f64; 2],
-    ) -> Result<(Vec<[f64; 2]>, bool), String> {
+    ) -> Result<(Vec<[f64; 2]>, Vec<Option<[f64; 2]>>, bool), String> {
         let tol = 1e-9 * self.size().max(reference.norm());
         let mut points: Vec<Vector2<f64>> = std::iter::once(self.start)
-            .chain(ends.iter().copied())
+            .chain(self.pieces.iter().map(|p| match p {
+                Piece::Line { end } | Piece::Arc { end, .. } => *end,
+            }))
+            .collect();
+        // the centre of piece k, from point k to k + 1
+        let centres: Vec<Option<Vector2<f64>>> = self
+            .pieces
+            .iter()
+            .map(|p| match p {
+                Piece::Line { .. } => None,
+                Piece::Arc { centre, .. } => Some(*centre),
+            })
             .collect();
         let closed = (points[points.len() - 1] - points[0]).norm() <= tol;
-        if closed {
+        let m = centres.len();
+        // reversed, piece i runs from the reversed point i to i + 1: the original piece
+        // m - 1 - i of an open profile; of a closed one (its last point dropped) the original
+        // m - 2 - i, and the closing piece last
+        let reversed: Vec<Option<Vector2<f64>>> = if closed {
             points.pop();
-        }
-        let points: Vec<[f64; 2]> = points.iter().rev().map(place).collect();
-        check_outward(&points, closed)?;
-        Ok((points, closed))
+            (0..m)
+                .map(|i| {
+                    if i + 1 < m {
+                        centres[m - 2 - i]
+                    } else {
+                        centres[m - 1]
+                    }
+                })
+                .collect()
+        } else {
+            centres.iter().rev().copied().collect()
+        };
+        let points: Vec<[f64; 2]> = points.iter().rev().map(&place).collect();
+        let centres: Vec<Option<[f64; 2]>> = if reversed.iter().all(Option::is_none) {
+            Vec::new()
+        } else {
+            reversed.iter().map(|c| c.as_ref().map(&place)).collect()
+        };
+        RigidPolyline::with_arcs(
+            points.iter().map(|p| Vector2::from(*p)).collect(),
+            centres.iter().map(|c| c.map(Vector2::from)).collect(),
+            closed,
+        )
+        .map_err(|e| e.to_string())?;
+        check_outward(&points, &centres, closed)?;
+        Ok((points, centres, closed))
     }
 
     /// A revolved profile of lines: at one radius `r = R`, running from high to low `z`, the
@@ -364,18 +371,12 @@ impl AnalyticalSurface {
                  surfaces of revolution turn about their reference node"
             ));
         }
-        let mut ends = Vec::with_capacity(self.pieces.len());
-        for piece in &self.pieces {
-            let Piece::Line { end } = piece else {
-                return Err(
-                    "a revolved profile must be lines (CIRCL arcs are not supported)".into(),
-                );
-            };
-            ends.push(*end);
-        }
         let radius = self.start.x;
         let mut from = self.start;
-        let cylinder = ends.iter().all(|end| {
+        let cylinder = self.pieces.iter().all(|piece| {
+            let Piece::Line { end } = piece else {
+                return false;
+            };
             let down = (end.x - radius).abs() <= tol && end.y < from.y - tol;
             from = *end;
             down
@@ -390,16 +391,24 @@ impl AnalyticalSurface {
             });
         }
         let shift = self.ez.dot(&d);
-        let (profile, closed) = self.profile_points(reference, &ends, |p| [p.x, p.y + shift])?;
-        if let Some(p) = profile.iter().find(|p| p[0] < 0.0) {
+        let (profile, centres, closed) = self.profile_points(reference, |p| [p.x, p.y + shift])?;
+        let meridian = RigidPolyline::with_arcs(
+            profile.iter().map(|p| Vector2::from(*p)).collect(),
+            centres.iter().map(|c| c.map(Vector2::from)).collect(),
+            closed,
+        )
+        .map_err(|e| e.to_string())?;
+        let (low, _) = meridian.bounds();
+        if low.x < 0.0 {
             return Err(format!(
-                "a revolved profile lies at r >= 0, got the point r = {}, z = {}",
-                p[0], p[1]
+                "a revolved profile lies at r >= 0, this one reaches r = {}",
+                low.x
             ));
         }
         Ok(RigidSurfaceSpec::Revolution {
             axis: self.ez.into(),
             profile,
+            centres,
             closed,
             radius: None,
         })
@@ -697,18 +706,37 @@ pub fn chain(segments: &[[Vector3<f64>; 2]]) -> Result<RigidSurfaceSpec, String>
 /// The polyline through `points` (body frame), refused if it is closed and faces inwards
 /// (see [`check_outward`]).
 fn outward_polyline(points: Vec<[f64; 2]>, closed: bool) -> Result<RigidSurfaceSpec, String> {
-    check_outward(&points, closed)?;
-    Ok(RigidSurfaceSpec::Polyline { points, closed })
+    check_outward(&points, &[], closed)?;
+    Ok(RigidSurfaceSpec::Polyline {
+        points,
+        centres: Vec::new(),
+        closed,
+    })
 }
 
-/// Refuses a closed chain of `points` that faces inwards (clockwise, negative area, with the
-/// outside on the right of the travel): a deck's closed rigid surfaces are contacted from
-/// outside.
-fn check_outward(points: &[[f64; 2]], closed: bool) -> Result<(), String> {
+/// Refuses a closed chain of `points` (piece `k` an arc about `centres[k]` where given) that
+/// faces inwards (clockwise, negative area, with the outside on the right of the travel): a
+/// deck's closed rigid surfaces are contacted from outside. The area is the polygon's
+/// `sum (a_x b_y - b_x a_y) / 2` plus, for each arc of radius `R` turning by the signed angle
+/// `theta`, the circular segment `R^2 (theta - sin theta) / 2` between it and its chord.
+fn check_outward(
+    points: &[[f64; 2]],
+    centres: &[Option<[f64; 2]>],
+    closed: bool,
+) -> Result<(), String> {
     let area: f64 = (0..points.len())
         .map(|k| {
             let (a, b) = (points[k], points[(k + 1) % points.len()]);
-            a[0] * b[1] - b[0] * a[1]
+            let chord = (a[0] * b[1] - b[0] * a[1]) / 2.0;
+            let segment = centres.get(k).copied().flatten().map_or(0.0, |c| {
+                let (u, v) = (
+                    Vector2::new(a[0] - c[0], a[1] - c[1]),
+                    Vector2::new(b[0] - c[0], b[1] - c[1]),
+                );
+                let theta = u.perp(&v).atan2(u.dot(&v));
+                u.norm_squared() * (theta - theta.sin()) / 2.0
+            });
+            chord + segment
         })
         .sum();
     if closed && area < 0.0 {

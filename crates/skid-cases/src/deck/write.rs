@@ -16,7 +16,8 @@
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 
-use nalgebra::Vector3;
+use nalgebra::{Vector2, Vector3};
+use skid_contact::RigidPolyline;
 use skid_contact::surface::AnalyticCylinder;
 use skid_fem::tetra::TetMesh;
 
@@ -805,6 +806,7 @@ fn surface_deck(
             axis,
             reference,
             profile,
+            centres,
             closed,
         } => {
             let e = Vector3::from(*axis).normalize();
@@ -817,16 +819,25 @@ fn surface_deck(
                 list((c + a).iter().map(|x| num(*x))),
                 list((c + e).iter().map(|x| num(*x)))
             );
-            profile_lines(out, profile, *closed);
+            profile_lines(out, profile, centres, *closed, |q| q);
             Ok(format!(", ANALYTICAL SURFACE={name}"))
         }
         RigidSurfaceSpec::Revolution {
             axis,
             profile,
+            centres,
             closed,
             radius,
         } => {
-            let largest = profile.iter().map(|p| p[0]).fold(0.0, f64::max);
+            let largest = RigidPolyline::with_arcs(
+                profile.iter().map(|p| Vector2::from(*p)).collect(),
+                centres.iter().map(|c| c.map(Vector2::from)).collect(),
+                *closed,
+            )
+            .map_err(|e| format!("rigid body {name}: {e}"))?
+            .bounds()
+            .1
+            .x;
             if radius.is_some_and(|r| r != largest) {
                 return Err(format!(
                     "rigid body {name}: the radius of a surface of revolution's circumferential \
@@ -840,10 +851,20 @@ fn surface_deck(
                 list(c.iter().map(|x| num(*x))),
                 list((c + e).iter().map(|x| num(*x)))
             );
-            profile_lines(out, profile, *closed);
+            profile_lines(out, profile, centres, *closed, |q| q);
             Ok(format!(", ANALYTICAL SURFACE={name}"))
         }
-        RigidSurfaceSpec::Polyline { points, closed } => {
+        RigidSurfaceSpec::Polyline {
+            points,
+            centres,
+            closed,
+        } if !centres.is_empty() => {
+            // arcs have no rigid element: the analytical profile, in global x-y
+            let _ = writeln!(out, "*SURFACE, NAME={name}, TYPE=SEGMENTS");
+            profile_lines(out, points, centres, *closed, |q| [q[0] + c.x, q[1] + c.y]);
+            Ok(format!(", ANALYTICAL SURFACE={name}"))
+        }
+        RigidSurfaceSpec::Polyline { points, closed, .. } => {
             let first = *next_node;
             let _ = writeln!(out, "*NODE");
             for q in points {
@@ -928,14 +949,45 @@ fn surface_deck(
 /// The `START` and `LINE` lines of an analytical profile given as a polyline: the deck's travel
 /// runs against the polyline's (its outward normal is the travel turned counter-clockwise),
 /// and a closed profile ends on its start.
-fn profile_lines(out: &mut String, profile: &[[f64; 2]], closed: bool) {
-    let mut points: Vec<&[f64; 2]> = profile.iter().rev().collect();
+/// The `START`, `LINE` and `CIRCL` lines of a profile (piece `k` from point `k` to the next an
+/// arc about `centres[k]` where given), each point placed by `place`, walked in reverse: a
+/// deck's outward normal is the travel turned counter-clockwise, a profile's turned clockwise.
+fn profile_lines(
+    out: &mut String,
+    profile: &[[f64; 2]],
+    centres: &[Option<[f64; 2]>],
+    closed: bool,
+    place: impl Fn([f64; 2]) -> [f64; 2],
+) {
+    let n = profile.len();
+    let mut points: Vec<[f64; 2]> = profile.iter().rev().copied().collect();
     if closed {
         points.extend(points.first().copied());
     }
     for (k, q) in points.iter().enumerate() {
-        let word = if k == 0 { "START" } else { "LINE" };
-        let _ = writeln!(out, "{word}, {}, {}", num(q[0]), num(q[1]));
+        let q = place(*q);
+        // the piece walked from the last point to this one: reversed, piece n - 1 - k, or
+        // the closing piece n - 1
+        let piece = if k < n { n.wrapping_sub(1 + k) } else { n - 1 };
+        match (k, centres.get(piece).copied().flatten()) {
+            (0, _) => {
+                let _ = writeln!(out, "START, {}, {}", num(q[0]), num(q[1]));
+            }
+            (_, Some(centre)) => {
+                let centre = place(centre);
+                let _ = writeln!(
+                    out,
+                    "CIRCL, {}, {}, {}, {}",
+                    num(q[0]),
+                    num(q[1]),
+                    num(centre[0]),
+                    num(centre[1])
+                );
+            }
+            (_, None) => {
+                let _ = writeln!(out, "LINE, {}, {}", num(q[0]), num(q[1]));
+            }
+        }
     }
 }
 

@@ -691,17 +691,21 @@ fn rigid_surface<const D: usize>(
             let axis = vector3(&format!("{field}.axis"), *axis)?;
             Box::new(FacetedCylinder::new(*radius, axis, *facets, *phase).map_err(invalid)?)
         }
-        RigidSurfaceSpec::Polyline { points, closed } => {
+        RigidSurfaceSpec::Polyline {
+            points,
+            centres,
+            closed,
+        } => {
             if D != 2 {
                 return fail(field, "a polyline is a 2D surface");
             }
-            let points = points.iter().map(|p| Vector2::from(*p)).collect();
-            Box::new(RigidPolyline::new(points, *closed).map_err(invalid)?)
+            Box::new(profile(points, centres, *closed).map_err(invalid)?)
         }
         RigidSurfaceSpec::Extrusion {
             axis,
             reference,
-            profile,
+            profile: points,
+            centres,
             closed,
         } => {
             if D != 3 {
@@ -710,20 +714,19 @@ fn rigid_surface<const D: usize>(
                     "an extrusion is a 3D surface (in 2D give a polyline)",
                 );
             }
-            let points = profile.iter().map(|p| Vector2::from(*p)).collect();
             Box::new(
                 RigidExtrusion::new(
                     vector3(&format!("{field}.axis"), *axis)?,
                     vector3(&format!("{field}.reference"), *reference)?,
-                    points,
-                    *closed,
+                    profile(points, centres, *closed).map_err(invalid)?,
                 )
                 .map_err(invalid)?,
             )
         }
         RigidSurfaceSpec::Revolution {
             axis,
-            profile,
+            profile: points,
+            centres,
             closed,
             radius,
         } => {
@@ -731,12 +734,12 @@ fn rigid_surface<const D: usize>(
                 return fail(field, "a surface of revolution is a 3D surface");
             }
             let axis = vector3(&format!("{field}.axis"), *axis)?;
-            let points: Vec<Vector2<f64>> = profile.iter().map(|p| Vector2::from(*p)).collect();
+            let meridian = profile(points, centres, *closed).map_err(invalid)?;
             let radius = match radius {
                 Some(r) => positive(&format!("{field}.radius"), *r).map(|()| *r)?,
-                None => points.iter().map(|p| p.x).fold(0.0, f64::max),
+                None => meridian.bounds().1.x,
             };
-            Box::new(RigidRevolution::new(axis, points, *closed, radius).map_err(invalid)?)
+            Box::new(RigidRevolution::new(axis, meridian, radius).map_err(invalid)?)
         }
         RigidSurfaceSpec::Triangles {
             vertices,
@@ -768,6 +771,20 @@ fn rigid_surface<const D: usize>(
 /// General contact: the nodes of every surface of the part whose distance to `surface` (carried
 /// by a body whose reference node is at `origin`) is below `search_distance` in the initial
 /// configuration, sorted.
+/// The [`RigidPolyline`] of a spec's profile `points`, piece `k` an arc about `centres[k]`
+/// where that is given.
+fn profile(
+    points: &[[f64; 2]],
+    centres: &[Option<[f64; 2]>],
+    closed: bool,
+) -> Result<RigidPolyline, skid_contact::ContactError> {
+    RigidPolyline::with_arcs(
+        points.iter().map(|p| Vector2::from(*p)).collect(),
+        centres.iter().map(|c| c.map(Vector2::from)).collect(),
+        closed,
+    )
+}
+
 fn nodes_near<const D: usize>(
     mesh: &SolidMesh<D>,
     surface: &dyn RigidSurface,
