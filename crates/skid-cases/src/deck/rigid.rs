@@ -17,6 +17,7 @@ use std::f64::consts::TAU;
 
 use super::fields::{allow_parameters, at_most, field, line_error, real};
 use super::keywords::{Block, DeckError};
+use crate::model_file::build::profile_polyline;
 use crate::model_spec::{ChartSpec, RigidSurfaceSpec};
 
 /// One piece of a profile, from the end of the previous one.
@@ -275,7 +276,7 @@ impl AnalyticalSurface {
     /// of the profile along the generator, closed if it ends where it starts and refused if it
     /// is then traversed inwards, its `CIRCL` pieces arcs about their centres.
     fn polyline(&self, reference: &Vector3<f64>) -> Result<RigidSurfaceSpec, String> {
-        let (points, centres, closed) = self.profile_points(reference, |p| {
+        let (points, centres, closed, _) = self.profile_points(reference, |p| {
             let y = self.global(p) - reference;
             [self.ex.dot(&y), self.ey.dot(&y)]
         })?;
@@ -300,13 +301,13 @@ impl AnalyticalSurface {
     /// (none if all are lines), each placed by `place` and taken in reverse: the deck's outward
     /// normal is the travel turned counter-clockwise, a polyline's turned clockwise. A closed
     /// profile traversed inwards is refused ([`check_outward`]), as is one whose arcs do not
-    /// fit their centres.
-    #[allow(clippy::type_complexity)] // the spec's three profile fields
+    /// fit their centres. Returns them with the profile they make.
+    #[allow(clippy::type_complexity)] // the spec's three profile fields and their profile
     fn profile_points(
         &self,
         reference: &Vector3<f64>,
         place: impl Fn(&Vector2<f64>) -> [f64; 2],
-    ) -> Result<(Vec<[f64; 2]>, Vec<Option<[f64; 2]>>, bool), String> {
+    ) -> Result<(Vec<[f64; 2]>, Vec<Option<[f64; 2]>>, bool, RigidPolyline), String> {
         let tol = 1e-9 * self.size().max(reference.norm());
         let mut points: Vec<Vector2<f64>> = std::iter::once(self.start)
             .chain(self.pieces.iter().map(|p| match p {
@@ -347,14 +348,9 @@ impl AnalyticalSurface {
         } else {
             reversed.iter().map(|c| c.as_ref().map(&place)).collect()
         };
-        RigidPolyline::with_arcs(
-            points.iter().map(|p| Vector2::from(*p)).collect(),
-            centres.iter().map(|c| c.map(Vector2::from)).collect(),
-            closed,
-        )
-        .map_err(|e| e.to_string())?;
+        let profile = profile_polyline(&points, &centres, closed).map_err(|e| e.to_string())?;
         check_outward(&points, &centres, closed)?;
-        Ok((points, centres, closed))
+        Ok((points, centres, closed, profile))
     }
 
     /// A revolved profile of lines: at one radius `r = R`, running from high to low `z`, the
@@ -391,13 +387,8 @@ impl AnalyticalSurface {
             });
         }
         let shift = self.ez.dot(&d);
-        let (profile, centres, closed) = self.profile_points(reference, |p| [p.x, p.y + shift])?;
-        let meridian = RigidPolyline::with_arcs(
-            profile.iter().map(|p| Vector2::from(*p)).collect(),
-            centres.iter().map(|c| c.map(Vector2::from)).collect(),
-            closed,
-        )
-        .map_err(|e| e.to_string())?;
+        let (profile, centres, closed, meridian) =
+            self.profile_points(reference, |p| [p.x, p.y + shift])?;
         let (low, _) = meridian.bounds();
         if low.x < 0.0 {
             return Err(format!(

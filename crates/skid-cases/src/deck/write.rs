@@ -16,13 +16,13 @@
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 
-use nalgebra::{Vector2, Vector3};
-use skid_contact::RigidPolyline;
+use nalgebra::Vector3;
 use skid_contact::surface::AnalyticCylinder;
 use skid_fem::tetra::TetMesh;
 
 use super::mesh::ElementKind;
 use super::read::AUTOMATIC_DYNAMIC_TOLERANCE;
+use crate::model_file::build::profile_polyline;
 use crate::model_spec::{
     AmplitudeTime, BoundarySpec, DefaultAmplitude, Dof, LoadSpec, ModelSpec, ModelStepSpec,
     RigidBodySpec, RigidSurfaceSpec, SlaveSpec,
@@ -829,15 +829,11 @@ fn surface_deck(
             closed,
             radius,
         } => {
-            let largest = RigidPolyline::with_arcs(
-                profile.iter().map(|p| Vector2::from(*p)).collect(),
-                centres.iter().map(|c| c.map(Vector2::from)).collect(),
-                *closed,
-            )
-            .map_err(|e| format!("rigid body {name}: {e}"))?
-            .bounds()
-            .1
-            .x;
+            let largest = profile_polyline(profile, centres, *closed)
+                .map_err(|e| format!("rigid body {name}: {e}"))?
+                .bounds()
+                .1
+                .x;
             if radius.is_some_and(|r| r != largest) {
                 return Err(format!(
                     "rigid body {name}: the radius of a surface of revolution's circumferential \

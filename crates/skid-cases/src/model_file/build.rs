@@ -699,7 +699,7 @@ fn rigid_surface<const D: usize>(
             if D != 2 {
                 return fail(field, "a polyline is a 2D surface");
             }
-            Box::new(profile(points, centres, *closed).map_err(invalid)?)
+            Box::new(profile_polyline(points, centres, *closed).map_err(invalid)?)
         }
         RigidSurfaceSpec::Extrusion {
             axis,
@@ -718,7 +718,7 @@ fn rigid_surface<const D: usize>(
                 RigidExtrusion::new(
                     vector3(&format!("{field}.axis"), *axis)?,
                     vector3(&format!("{field}.reference"), *reference)?,
-                    profile(points, centres, *closed).map_err(invalid)?,
+                    profile_polyline(points, centres, *closed).map_err(invalid)?,
                 )
                 .map_err(invalid)?,
             )
@@ -734,7 +734,7 @@ fn rigid_surface<const D: usize>(
                 return fail(field, "a surface of revolution is a 3D surface");
             }
             let axis = vector3(&format!("{field}.axis"), *axis)?;
-            let meridian = profile(points, centres, *closed).map_err(invalid)?;
+            let meridian = profile_polyline(points, centres, *closed).map_err(invalid)?;
             let radius = match radius {
                 Some(r) => positive(&format!("{field}.radius"), *r).map(|()| *r)?,
                 None => meridian.bounds().1.x,
@@ -768,12 +768,12 @@ fn rigid_surface<const D: usize>(
     })
 }
 
-/// General contact: the nodes of every surface of the part whose distance to `surface` (carried
-/// by a body whose reference node is at `origin`) is below `search_distance` in the initial
-/// configuration, sorted.
-/// The [`RigidPolyline`] of a spec's profile `points`, piece `k` an arc about `centres[k]`
-/// where that is given.
-fn profile(
+/// The [`RigidPolyline`] of a spec's profile `points` (of a polyline, an extrusion or a
+/// surface of revolution), piece `k` an arc about `centres[k]` where that is given.
+///
+/// # Errors
+/// As [`RigidPolyline::with_arcs`].
+pub fn profile_polyline(
     points: &[[f64; 2]],
     centres: &[Option<[f64; 2]>],
     closed: bool,
@@ -785,6 +785,9 @@ fn profile(
     )
 }
 
+/// General contact: the nodes of every surface of the part whose distance to `surface` (carried
+/// by a body whose reference node is at `origin`) is below `search_distance` in the initial
+/// configuration, sorted.
 fn nodes_near<const D: usize>(
     mesh: &SolidMesh<D>,
     surface: &dyn RigidSurface,
