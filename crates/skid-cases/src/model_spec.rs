@@ -724,3 +724,23 @@ pub struct StepBoundarySpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dofs: Option<Vec<Dof>>,
 }
+
+/// The [`skid_contact::RigidPolyline`] of a spec's profile `points` (of a polyline, an extrusion or a
+/// surface of revolution), piece `k` an arc about `centres[k]` where that is given.
+///
+/// # Errors
+/// As [`skid_contact::RigidPolyline::with_arcs`].
+pub fn profile_polyline(
+    points: &[[f64; 2]],
+    centres: &[Option<[f64; 2]>],
+    closed: bool,
+) -> Result<skid_contact::RigidPolyline, skid_contact::ContactError> {
+    skid_contact::RigidPolyline::with_arcs(
+        points.iter().map(|p| nalgebra::Vector2::from(*p)).collect(),
+        centres
+            .iter()
+            .map(|c| c.map(nalgebra::Vector2::from))
+            .collect(),
+        closed,
+    )
+}

@@ -17,8 +17,7 @@ use std::f64::consts::TAU;
 
 use super::fields::{allow_parameters, at_most, field, line_error, real};
 use super::keywords::{Block, DeckError};
-use crate::model_file::build::profile_polyline;
-use crate::model_spec::{ChartSpec, RigidSurfaceSpec};
+use crate::model_spec::{ChartSpec, RigidSurfaceSpec, profile_polyline};
 
 /// One piece of a profile, from the end of the previous one.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -22,7 +22,7 @@ use skid_fem::tetra::TetMesh;
 
 use super::mesh::ElementKind;
 use super::read::AUTOMATIC_DYNAMIC_TOLERANCE;
-use crate::model_file::build::profile_polyline;
+use crate::model_spec::profile_polyline;
 use crate::model_spec::{
     AmplitudeTime, BoundarySpec, DefaultAmplitude, Dof, LoadSpec, ModelSpec, ModelStepSpec,
     RigidBodySpec, RigidSurfaceSpec, SlaveSpec,

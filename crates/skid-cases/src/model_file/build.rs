@@ -3,11 +3,10 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use nalgebra::{SVector, Vector2, Vector3};
+use nalgebra::{SVector, Vector3};
 use skid_contact::extrusion::RigidExtrusion;
 use skid_contact::facets::FacetedCylinder;
 use skid_contact::plane::RigidPlane;
-use skid_contact::polyline::RigidPolyline;
 use skid_contact::revolution::RigidRevolution;
 use skid_contact::surface::{AnalyticCylinder, RigidSurface};
 use skid_contact::triangles::{CylinderChart, SurfaceChart, TriangulatedSurface};
@@ -26,7 +25,7 @@ mod motions;
 
 use crate::model_spec::{
     BoundarySpec, ChartSpec, Dof, MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, RigidSurfaceSpec,
-    SlaveSpec, StepBoundarySpec,
+    SlaveSpec, StepBoundarySpec, profile_polyline,
 };
 use crate::schema::{AdaptiveSpec, MaterialSpec, SolverSpec};
 use crate::validate::check_file_name;
@@ -766,23 +765,6 @@ fn rigid_surface<const D: usize>(
             Box::new(TriangulatedSurface::new(vertices, triangles.clone(), chart).map_err(invalid)?)
         }
     })
-}
-
-/// The [`RigidPolyline`] of a spec's profile `points` (of a polyline, an extrusion or a
-/// surface of revolution), piece `k` an arc about `centres[k]` where that is given.
-///
-/// # Errors
-/// As [`RigidPolyline::with_arcs`].
-pub fn profile_polyline(
-    points: &[[f64; 2]],
-    centres: &[Option<[f64; 2]>],
-    closed: bool,
-) -> Result<RigidPolyline, skid_contact::ContactError> {
-    RigidPolyline::with_arcs(
-        points.iter().map(|p| Vector2::from(*p)).collect(),
-        centres.iter().map(|c| c.map(Vector2::from)).collect(),
-        closed,
-    )
 }
 
 /// General contact: the nodes of every surface of the part whose distance to `surface` (carried
