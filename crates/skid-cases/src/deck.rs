@@ -10,7 +10,7 @@
 //!
 //! The subset: `*HEADING`, `*NODE`, `*ELEMENT` (CPE4R, C3D8R; R2D2, R3D3, R3D4, M3D4R, S4R,
 //! C3D4 made rigid; MASS, ROTARYI), `*NSET` / `*ELSET` (GENERATE), `*SURFACE` (ELEMENT, NODE,
-//! SEGMENTS, CYLINDER, REVOLUTION), `*RIGID BODY` (REF NODE, ELSET, ANALYTICAL SURFACE,
+//! SEGMENTS, CYLINDER, REVOLUTION with FILLET RADIUS), `*RIGID BODY` (REF NODE, ELSET, ANALYTICAL SURFACE,
 //! TIE NSET), `*MATERIAL` with `*HYPERELASTIC` (POLYNOMIAL N=1, MOONEY-RIVLIN, NEO HOOKE),
 //! `*ELASTIC` and `*DENSITY`, `*SOLID SECTION`, `*MEMBRANE SECTION`, `*SHELL SECTION`,
 //! `*MASS`, `*ROTARY INERTIA`, `*SURFACE INTERACTION` with `*FRICTION`, `*CONTACT PAIR`,
@@ -56,7 +56,9 @@
 //!   runs straight through the reference node is the unbounded line or plane through it, any
 //!   other a polyline (`SEGMENTS`) or its extrusion along the generator (`CYLINDER`); a
 //!   revolved profile of lines at one radius is a cylinder, any other a surface of revolution
-//!   (its axis through the reference node);
+//!   (its axis through the reference node); `FILLET RADIUS` rounds every corner of the profile
+//!   with a tangent arc of that radius before this reading (a square's corners rounded by half
+//!   its side give the cylinder), and a fillet that does not fit its pieces is an error;
 //! - a point rotary inertia counts about its body's one free rotation axis;
 //! - general contact makes every node of the part's exterior faces a candidate;
 //! - `*OUTPUT, FIELD` with `TIME INTERVAL=t` or `NUMBER INTERVAL=n` (the step's period over n)

@@ -343,6 +343,75 @@ fn a_circle_traversed_counter_clockwise_faces_inwards_and_is_refused() {
     assert!(message.contains("lie at"), "{message}");
 }
 
+/// `FILLET RADIUS`: the square of side 0.4 about the drum's axis with its corners rounded by
+/// fillets of 0.2, which consume its sides, is the drum's circle (read to the cylinder of the
+/// four quarter circles); fillets of 0.05 leave a closed polyline of four sides and four
+/// quarter circles about points 0.15 in from the corners; fillets that do not fit the sides
+/// are refused at the corner's line.
+#[test]
+fn a_square_with_fillets_of_half_its_side_is_the_drum_circle() {
+    let circle = "*Surface, name=drum, type=segments\nSTART,  0.2,  0.\nCIRCL,  0., -0.2, 0., 0.\nCIRCL, -0.2,  0., 0., 0.\nCIRCL,  0.,  0.2, 0., 0.\nCIRCL,  0.2,  0., 0., 0.";
+    let square = |radius: f64| {
+        format!(
+            "*Surface, name=drum, type=segments, fillet radius={radius}\nSTART, 0.2, 0.2\n\
+             LINE, 0.2, -0.2\nLINE, -0.2, -0.2\nLINE, -0.2, 0.2\nLINE, 0.2, 0.2"
+        )
+    };
+    let drum = |model: &skid_cases::model_spec::ModelSpec| {
+        let body = model.rigid_bodies.iter().find(|b| b.name == "drum_ref");
+        body.expect("drum_ref").clone()
+    };
+    let reference = drum(&variant(circle, circle).expect("circle").model);
+    let mut rounded = drum(&variant(circle, &square(0.2)).expect("rounded square").model);
+    let Some(RigidSurfaceSpec::Cylinder { radius, .. }) = rounded.surface.as_mut() else {
+        panic!("not the cylinder: {:?}", rounded.surface);
+    };
+    assert!((*radius - 0.2).abs() < 1e-15, "{radius}");
+    *radius = 0.2;
+    assert_eq!(rounded, reference);
+
+    let rounded = drum(
+        &variant(circle, &square(0.05))
+            .expect("rounded corners")
+            .model,
+    );
+    let Some(RigidSurfaceSpec::Polyline {
+        points,
+        centres,
+        closed: true,
+    }) = rounded.surface
+    else {
+        panic!("not a closed polyline: {:?}", rounded.surface);
+    };
+    assert_eq!(points.len(), 8);
+    let mut fillets: Vec<[f64; 2]> = centres.iter().flatten().copied().collect();
+    fillets.sort_by(|a, b| a.partial_cmp(b).expect("finite"));
+    let expected = [[-0.15, -0.15], [-0.15, 0.15], [0.15, -0.15], [0.15, 0.15]];
+    assert_eq!(fillets.len(), 4, "{centres:?}");
+    for (c, e) in fillets.iter().zip(expected) {
+        assert!(
+            (c[0] - e[0]).abs() < 1e-15 && (c[1] - e[1]).abs() < 1e-15,
+            "{fillets:?}"
+        );
+    }
+
+    // The first side, on the line after START, is the one both its fillets overflow.
+    let mesh = std::fs::read_to_string(repo("cases/inp/2d-pad-mesh.inc")).expect("mesh");
+    let deck = std::fs::read_to_string(repo("cases/inp/2d-analytic-by-hand.inp")).expect("deck");
+    let deck = deck.replace("*include, input=2d-pad-mesh.inc\n", &mesh);
+    let header = deck
+        .lines()
+        .position(|l| l == circle.lines().next().expect("header"));
+    let side = format!(":{}: *SURFACE", header.expect("drum surface") + 3);
+    let message = variant(circle, &square(0.25)).expect_err("too large");
+    assert!(
+        message.contains(&side) && message.contains("overlap"),
+        "{side} {message}"
+    );
+    let message = variant(circle, &square(-0.1)).expect_err("negative");
+    assert!(message.contains("FILLET RADIUS must be"), "{message}");
+}
+
 /// Rigid line elements: a regular polygon is the faceted drum, whatever its orientation in
 /// the plane; facing inwards it is refused; any other polygon is a closed polyline.
 #[test]

@@ -15,9 +15,11 @@ use skid_contact::RigidPolyline;
 use skid_contact::surface::AnalyticCylinder;
 use std::f64::consts::TAU;
 
-use super::fields::{allow_parameters, at_most, field, line_error, real};
+use super::fields::{allow_parameters, at_most, field, line_error, real, real_parameter};
 use super::keywords::{Block, DeckError};
 use crate::model_spec::{ChartSpec, RigidSurfaceSpec, profile_polyline};
+
+mod fillet;
 
 /// One piece of a profile, from the end of the previous one.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,8 +69,11 @@ pub fn read_analytical(
     kind: AnalyticalKind,
 ) -> Result<AnalyticalSurface, DeckError> {
     allow_parameters(block, &["NAME", "TYPE", "FILLET RADIUS"])?;
-    if block.parameter("FILLET RADIUS").is_some() {
-        return Err(block.error("FILLET RADIUS is not supported: skid's surfaces have no fillets"));
+    let fillet_radius = real_parameter(block, "FILLET RADIUS")?.unwrap_or(0.0);
+    if !(fillet_radius.is_finite() && fillet_radius >= 0.0) {
+        return Err(block.error(format!(
+            "FILLET RADIUS must be finite and >= 0, got {fillet_radius}"
+        )));
     }
     let mut lines = block.data.iter();
     let point = |line: &super::keywords::DataLine, first: usize, what: &str| {
@@ -119,7 +124,10 @@ pub fn read_analytical(
         real(block, start_line, 2, "start y")?,
     );
     let mut pieces = Vec::new();
+    // the data line of each point of the profile: its start, then each piece's end
+    let mut point_lines = vec![start_line];
     for line in lines {
+        point_lines.push(line);
         let word = field(line, 0).unwrap_or_default().to_ascii_uppercase();
         let end = || {
             Ok::<_, DeckError>(Vector2::new(
@@ -157,6 +165,27 @@ pub fn read_analytical(
     if pieces.is_empty() {
         return Err(block.error("the profile needs at least one LINE or CIRCL after START"));
     }
+    let (start, pieces) = if fillet_radius > 0.0 {
+        let size = pieces
+            .iter()
+            .map(|p| match p {
+                Piece::Line { end } | Piece::Arc { end, .. } => end.norm(),
+            })
+            .fold(start.norm(), f64::max);
+        let tol = 1e-9 * size;
+        let closed = pieces.last().is_some_and(|p| match p {
+            Piece::Line { end } | Piece::Arc { end, .. } => (end - start).norm() <= tol,
+        });
+        fillet::fillet(&start, &pieces, closed, fillet_radius, tol).map_err(|(k, why)| {
+            line_error(
+                block,
+                point_lines[k],
+                format!("the corner of the profile at this point: {why}"),
+            )
+        })?
+    } else {
+        (start, pieces)
+    };
     Ok(AnalyticalSurface {
         kind,
         origin,
