@@ -159,7 +159,8 @@ enum Command {
         /// Output directory (the runs go to <out>/runs/).
         #[arg(long, default_value = "out/bench")]
         out: PathBuf,
-        /// Time-step levels per case and contact solve (at least 2).
+        /// Time-step levels per case and method (1: each case at its own time step only,
+        /// with the cases' total cost and no errors).
         #[arg(long, default_value_t = 5)]
         levels: usize,
         /// Ratio of successive time steps.
@@ -171,7 +172,8 @@ enum Command {
         /// Timed repetitions of runs shorter than 2 s (after one warm-up).
         #[arg(long, default_value_t = 5)]
         repeats: usize,
-        /// Methods to compare (comma-separated): reduced, global (the contact solves), quasi-static
+        /// Methods to compare (comma-separated): case (the case's own contact solve setting),
+        /// reduced, global (the contact solves), quasi-static
         /// (the pad without inertia, global solve), quasi-static-adaptive (the same with adaptive
         /// increments, tolerance 1e-6 scaled by the square of the level's factor).
         #[arg(long, value_delimiter = ',', default_value = "reduced,global")]

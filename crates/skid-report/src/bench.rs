@@ -13,6 +13,10 @@
 //! - `t_stop`, relative, which the pad vibration left at the stop moves by up to 1 %: a
 //!   difference inside that band is not a discretisation error.
 //!
+//! A bench of one level (`levels = 1`, `coarser = 0`) runs each case at its own time step only,
+//! with no reference and no errors: the cost of a set of cases as they are written, reported
+//! with its total (the cases run one after another).
+//!
 //! A run shorter than [`REPEAT_BELOW_S`] is run once more as a warm-up and then `repeats`
 //! times, and its wall time is the median (the solver's own wall time, without process start
 //! or output of the report). The record keeps every measured time and the split of the median
@@ -37,7 +41,8 @@ pub const BENCH_JSON: &str = "bench.json";
 /// What to run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BenchSettings {
-    /// Time-step levels per case and contact solve (at least 2).
+    /// Time-step levels per case and contact solve (at least 1; a single level is the case's
+    /// own time step, measured against no reference).
     pub levels: usize,
     /// Ratio between successive time steps (> 1).
     pub ratio: f64,
@@ -64,6 +69,8 @@ impl Default for BenchSettings {
 /// How a case is run in the bench.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BenchMethod {
+    /// The case as it is, with its own contact solve setting.
+    Case,
     /// The case as it is, reduced contact solve.
     Reduced,
     /// The case as it is, global contact solve.
@@ -78,7 +85,8 @@ pub enum BenchMethod {
 
 impl BenchMethod {
     /// Every method, in the order of the report.
-    pub const ALL: [Self; 4] = [
+    pub const ALL: [Self; 5] = [
+        Self::Case,
         Self::Reduced,
         Self::Global,
         Self::QuasiStatic,
@@ -88,6 +96,7 @@ impl BenchMethod {
     /// The name the method has on the command line and in the records.
     pub fn label(self) -> &'static str {
         match self {
+            Self::Case => "case",
             Self::Reduced => "reduced",
             Self::Global => "global",
             Self::QuasiStatic => "quasi-static",
@@ -121,6 +130,7 @@ impl BenchMethod {
     /// Sets the case up to run by this method.
     fn apply(self, case: &mut Case) {
         let (solve, quasi_static) = match self {
+            Self::Case => (case.solver.contact_solve, case.pad.quasi_static),
             Self::Reduced => (ContactSolveSpec::Reduced, case.pad.quasi_static),
             Self::Global => (ContactSolveSpec::Global, case.pad.quasi_static),
             Self::QuasiStatic | Self::QuasiStaticAdaptive => (ContactSolveSpec::Global, true),
@@ -143,6 +153,9 @@ pub struct BenchRecord {
     pub method: String,
     /// Time step of the dynamic steps, s.
     pub dt: f64,
+    /// `dt` over the case's own time step (absent in records written before it was kept).
+    #[serde(default)]
+    pub dt_factor: Option<f64>,
     /// `"completed"` or `"failed"`.
     pub status: String,
     /// Median wall time, s.
@@ -265,9 +278,9 @@ pub fn run_bench(
 ) -> Result<Vec<BenchRecord>, BenchError> {
     let ratio_ok = settings.ratio.partial_cmp(&1.0) == Some(std::cmp::Ordering::Greater)
         && settings.ratio.is_finite();
-    if settings.levels < 2 || !ratio_ok || settings.coarser >= settings.levels {
+    if settings.levels < 1 || !ratio_ok || settings.coarser >= settings.levels {
         return Err(BenchError::Settings(format!(
-            "expected at least 2 levels, a finite ratio above 1 and fewer coarser levels than \
+            "expected at least 1 level, a finite ratio above 1 and fewer coarser levels than \
              levels, got {} levels, ratio {}, {} coarser",
             settings.levels, settings.ratio, settings.coarser
         )));
@@ -323,6 +336,7 @@ pub fn run_bench(
                     case: case.name.clone(),
                     method: label.into(),
                     dt: dt * factor,
+                    dt_factor: Some(factor),
                     status: summary.status.clone(),
                     wall_time_s: median(&times),
                     wall_times_s: times,
@@ -337,10 +351,15 @@ pub fn run_bench(
                     deceleration_error: None,
                     e_slide: None,
                     t_stop_difference: None,
-                    reference: k + 1 == settings.levels,
+                    reference: settings.levels > 1 && k + 1 == settings.levels,
                 };
                 progress(&record);
                 runs.push((record, dir));
+            }
+            if settings.levels == 1 {
+                // no ladder: nothing to measure against
+                records.extend(runs.into_iter().map(|(r, _)| r));
+                continue;
             }
             let counterpart = method
                 .fixed_counterpart()
@@ -473,9 +492,60 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
             percent(r.t_stop_difference),
         );
     }
+    md.push_str(&own_time_step(records));
     md.push_str(&model_change(records));
     let path = out.join(BENCH_MD);
     write_atomic(&path, &md).map_err(|source| BenchError::Write { path, source })
+}
+
+/// The cases at their own time step (`dt_factor` 1), method by method, with the sum of their
+/// median wall times: what running them one after another costs.
+fn own_time_step(records: &[BenchRecord]) -> String {
+    use crate::format::show;
+    use std::fmt::Write as _;
+    let own: Vec<&BenchRecord> = records
+        .iter()
+        .filter(|r| r.dt_factor.is_some_and(|f| (f - 1.0).abs() < 1e-12))
+        .collect();
+    if own.is_empty() {
+        return String::new();
+    }
+    let mut md = String::from(
+        "\n## The cases at their own time step\n\nEach case as written (its own time step), \
+         by method; the total is the sum of the median wall times, the cost of running the \
+         cases one after another.\n\n\
+         | method | case | status | wall [s] | increments | Newton iterations | t_stop [s] |\n\
+         |---|---|---|---|---|---|---|\n",
+    );
+    let mut methods: Vec<&str> = own.iter().map(|r| r.method.as_str()).collect();
+    methods.sort_unstable();
+    methods.dedup();
+    for method in methods {
+        let rows: Vec<&&BenchRecord> = own.iter().filter(|r| r.method == method).collect();
+        for r in &rows {
+            let _ = writeln!(
+                md,
+                "| {method} | {} | {} | {:.4} | {} | {} | {} |",
+                r.case,
+                r.status,
+                r.wall_time_s,
+                r.increments,
+                r.newton_iterations,
+                show(r.t_stop)
+            );
+        }
+        let total: f64 = rows.iter().map(|r| r.wall_time_s).sum();
+        let completed = rows.iter().all(|r| r.status == "completed");
+        let _ = writeln!(
+            md,
+            "| {method} | **total of {} cases** | {} | **{total:.4}** | {} | {} | |",
+            rows.len(),
+            if completed { "completed" } else { "failed" },
+            rows.iter().map(|r| r.increments).sum::<usize>(),
+            rows.iter().map(|r| r.newton_iterations).sum::<usize>(),
+        );
+    }
+    md
 }
 
 /// What the quasi-static pad changes in the answer: for every case with both, the quasi-static
@@ -577,14 +647,76 @@ mod tests {
         )
         .expect("records");
         assert_eq!(written, records);
-        // a ladder of one level has no reference to measure against
+        // as many coarser levels as levels leave no level at the case's time step
         let bad = BenchSettings {
             levels: 1,
-            ..settings
+            ..settings.clone()
         };
         assert!(matches!(
             run_bench(&[], &bad, dir.path(), |_| ()),
             Err(BenchError::Settings(_))
         ));
+    }
+
+    /// One level: each case at its own time step, by the case's own contact solve, with no
+    /// reference and no errors; the report sums the cases' median wall times.
+    #[test]
+    fn one_level_runs_the_cases_as_written_and_totals_their_cost() {
+        let overrides = ["steps[1].duration=0.005".to_string()];
+        let mut cases = Vec::new();
+        for (name, text) in [
+            (
+                "2d-analytic",
+                include_str!("../../../cases/drum/2d-analytic.json"),
+            ),
+            ("2d-r2d2", include_str!("../../../cases/drum/2d-r2d2.json")),
+        ] {
+            let file = PathBuf::from(format!("{name}.json"));
+            let case = skid_cases::validate::parse_case(text, &file, &overrides).expect("case");
+            cases.push((case, file));
+        }
+        let dir = tempfile::tempdir().expect("tempdir");
+        let settings = BenchSettings {
+            levels: 1,
+            ratio: 2.0,
+            coarser: 0,
+            repeats: 3,
+            methods: vec![BenchMethod::parse("case").expect("method")],
+        };
+        let records = run_bench(&cases, &settings, dir.path(), |_| ()).expect("bench");
+        assert_eq!(records.len(), 2);
+        for (r, (case, _)) in records.iter().zip(&cases) {
+            assert_eq!(r.case, case.name);
+            assert_eq!(r.dt_factor, Some(1.0));
+            assert!((r.dt - 1e-4).abs() < 1e-15, "{}", r.dt);
+            assert!(!r.reference && r.deceleration_error.is_none() && r.e_slide.is_none());
+            // 5 preload increments and 50 of 0.1 ms
+            assert_eq!((r.status.as_str(), r.increments), ("completed", 55));
+        }
+        write_bench_report(&records, dir.path()).expect("report");
+        let md = std::fs::read_to_string(dir.path().join(BENCH_MD)).expect("bench.md");
+        let total = md
+            .lines()
+            .find(|l| l.starts_with("| case | **total of 2 cases** | completed |"))
+            .expect("total line");
+        let wall: f64 = total
+            .split('|')
+            .nth(4)
+            .expect("wall column")
+            .trim()
+            .trim_matches('*')
+            .parse()
+            .expect("number");
+        let sum = records[0].wall_time_s + records[1].wall_time_s;
+        assert!((wall - sum).abs() < 1e-4, "{total} against {sum}");
+        assert!(total.contains("| 110 |"), "{total}");
+        // a record written before dt_factor was kept reads, and counts in no total
+        let old = r#"[{"case":"a","method":"reduced","dt":1e-4,"status":"completed",
+            "wall_time_s":1.0,"wall_times_s":[1.0],"assembly_s":0.0,"linear_solve_s":0.0,
+            "contact_solve_s":0.0,"increments":1,"newton_iterations":1,"contact_fallbacks":0,
+            "t_stop":null,"deceleration":null,"deceleration_error":null,"e_slide":null,
+            "t_stop_difference":null,"reference":true}]"#;
+        let old: Vec<BenchRecord> = serde_json::from_str(old).expect("old record");
+        assert!(own_time_step(&old).is_empty());
     }
 }
