@@ -33,6 +33,15 @@ enum Piece {
     },
 }
 
+impl Piece {
+    /// Where the piece ends.
+    fn end(&self) -> Vector2<f64> {
+        match self {
+            Self::Line { end } | Self::Arc { end, .. } => *end,
+        }
+    }
+}
+
 /// Which analytical surface.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AnalyticalKind {
@@ -168,14 +177,12 @@ pub fn read_analytical(
     let (start, pieces) = if fillet_radius > 0.0 {
         let size = pieces
             .iter()
-            .map(|p| match p {
-                Piece::Line { end } | Piece::Arc { end, .. } => end.norm(),
-            })
+            .map(|p| p.end().norm())
             .fold(start.norm(), f64::max);
         let tol = 1e-9 * size;
-        let closed = pieces.last().is_some_and(|p| match p {
-            Piece::Line { end } | Piece::Arc { end, .. } => (end - start).norm() <= tol,
-        });
+        let closed = pieces
+            .last()
+            .is_some_and(|p| (p.end() - start).norm() <= tol);
         fillet::fillet(&start, &pieces, closed, fillet_radius, tol).map_err(|(k, why)| {
             line_error(
                 block,
@@ -338,9 +345,7 @@ impl AnalyticalSurface {
     ) -> Result<(Vec<[f64; 2]>, Vec<Option<[f64; 2]>>, bool, RigidPolyline), String> {
         let tol = 1e-9 * self.size().max(reference.norm());
         let mut points: Vec<Vector2<f64>> = std::iter::once(self.start)
-            .chain(self.pieces.iter().map(|p| match p {
-                Piece::Line { end } | Piece::Arc { end, .. } => *end,
-            }))
+            .chain(self.pieces.iter().map(Piece::end))
             .collect();
         // the centre of piece k, from point k to k + 1
         let centres: Vec<Option<Vector2<f64>>> = self
@@ -436,9 +441,7 @@ impl AnalyticalSurface {
     fn size(&self) -> f64 {
         self.pieces
             .iter()
-            .map(|p| match p {
-                Piece::Line { end } | Piece::Arc { end, .. } => end.norm(),
-            })
+            .map(|p| p.end().norm())
             .fold(self.start.norm() + self.origin.norm(), f64::max)
     }
 }

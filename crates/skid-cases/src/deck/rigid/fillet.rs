@@ -204,11 +204,8 @@ pub(super) fn fillet(
     tol: f64,
 ) -> Result<(Vector2<f64>, Vec<Piece>), (usize, String)> {
     let m = pieces.len();
-    let end_of = |p: &Piece| match p {
-        Piece::Line { end } | Piece::Arc { end, .. } => *end,
-    };
     let points: Vec<Vector2<f64>> = std::iter::once(*start)
-        .chain(pieces.iter().map(end_of))
+        .chain(pieces.iter().map(Piece::end))
         .collect();
     let curves = (0..m)
         .map(|k| {
@@ -320,9 +317,7 @@ mod tests {
             .iter()
             .map(|p| {
                 let curve = Curve::of(&from, p).expect("piece");
-                let end = match p {
-                    Piece::Line { end } | Piece::Arc { end, .. } => *end,
-                };
+                let end = p.end();
                 let t = (curve.tangent(&from), curve.tangent(&end));
                 from = end;
                 t
@@ -350,9 +345,7 @@ mod tests {
                 let (a, b) = ((from - centre).norm(), (end - centre).norm());
                 assert!((a - b).abs() < 1e-12, "arc ends at {a} and {b}");
             }
-            from = match p {
-                Piece::Line { end } | Piece::Arc { end, .. } => *end,
-            };
+            from = p.end();
         }
     }
 
@@ -430,9 +423,7 @@ mod tests {
             if let Piece::Arc { centre, .. } = p {
                 radii.push((from - centre).norm());
             }
-            from = match p {
-                Piece::Line { end } | Piece::Arc { end, .. } => *end,
-            };
+            from = p.end();
         }
         radii.sort_by(f64::total_cmp);
         let expected = [0.05, 0.05, 0.05, 0.5_f64.sqrt(), 0.5_f64.sqrt()];
