@@ -156,7 +156,7 @@ fn a_run_that_cannot_converge_exits_1_and_says_where() {
 }
 
 #[test]
-fn bench_rejects_an_unknown_method_and_a_ladder_without_reference() {
+fn bench_rejects_an_unknown_method_and_a_ladder_without_the_case_time_step() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = skid()
         .args(["bench", CASE, "--methods", "dense", "--out"])
@@ -167,16 +167,20 @@ fn bench_rejects_an_unknown_method_and_a_ladder_without_reference() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         stderr.contains(
-            "expected one of reduced, global, quasi-static, quasi-static-adaptive, got \"dense\""
+            "expected one of case, reduced, global, quasi-static, quasi-static-adaptive, got \"dense\""
         ),
         "{stderr}"
     );
     let out = skid()
-        .args(["bench", CASE, "--levels", "1", "--coarser", "0", "--out"])
+        .args(["bench", CASE, "--levels", "1", "--coarser", "1", "--out"])
         .arg(dir.path())
         .output()
         .expect("runs");
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("at least 2 levels"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("fewer coarser levels than levels, got 1 levels"),
+        "{stderr}"
+    );
     assert!(!dir.path().join("bench.json").exists());
 }
