@@ -447,7 +447,8 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
     let mut md = String::from("# Work against error (`skid bench`)\n\n");
     md.push_str(
         "Each case at a ladder of time steps (every dynamic step's dt scaled alike) with each \
-         method (`reduced` and `global`: the contact solves on the case as it is; \
+         method (`case`: the case as it is, with its own contact solve; `reduced` and \
+         `global`: the contact solves on the case as it is; \
          `quasi-static`: the pad without inertia, global solve; `quasi-static-adaptive`: the \
          same with adaptive increments, dt being the first one and the tolerance 1e-6 times \
          the square of the level's dt ratio to the case's); the finest level of a case and \
