@@ -183,15 +183,14 @@ impl ContactRows {
                 }
             }
         }
-        // W = H_C G, then its symmetric part (W + W^T) / 2 in place
-        let mut w = DMatrix::from_fn(m, m, |i, j| {
-            row(i).iter().map(|&(k, c)| c * g[(k, j)]).sum::<f64>()
-        });
+        // W = H_C G, symmetric: its lower triangle, mirrored
+        let mut w = DMatrix::<f64>::zeros(m, m);
         for j in 0..m {
-            for i in j + 1..m {
-                let mean = (w[(i, j)] + w[(j, i)]) * 0.5;
-                w[(i, j)] = mean;
-                w[(j, i)] = mean;
+            let g_j = &g.as_slice()[j * size..(j + 1) * size];
+            for i in j..m {
+                let value: f64 = row(i).iter().map(|&(k, c)| c * g_j[k]).sum();
+                w[(i, j)] = value;
+                w[(j, i)] = value;
             }
         }
         Ok(w)
