@@ -1,5 +1,7 @@
 //! Analytical surfaces beyond the drum's: surfaces of revolution (the 3D drum as the revolution
-//! of the straight profile `r = R` spins down as the analytical cylinder does, bit for bit) and
+//! of the straight profile `r = R` spins down as the analytical cylinder does, its slip measured
+//! in lengths in the tangent plane of each increment's start; the pushed block slides round a
+//! revolved disc as on the plane) and
 //! extruded profiles (the pushed block on an extruded straight profile slides as on the plane);
 //! a deck's revolved profile of lines that is no cylinder, and its `TYPE=CYLINDER` profile of
 //! lines that is no plane through the reference node, read to them (profiles in the body frame,
@@ -77,8 +79,17 @@ fn the_drum_as_a_revolved_line_spins_down_as_the_cylinder() {
         omega(&revolved, dir.path()),
     );
     assert!(a.len() > 100, "{} rows", a.len());
-    // the same gap, normal, curvature and discrete gradient, bit for bit
-    assert_eq!(a, b);
+    // The same gap, normal, curvature and discrete gradient; the slip differs: the cylinder's
+    // is the increment of its arc length, the revolution's is measured in the tangent plane of
+    // the increment's start point, which the drum turns by 6 mrad in an increment (friction
+    // along the start's tangent: 4e-3 rad/s apart after 10 ms, measured).
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert!(
+            (x - y).abs() <= 1e-4 * 60.0,
+            "omega {x} on the cylinder, {y} revolved"
+        );
+    }
     assert!(a[a.len() - 1] < 59.0, "the drum slows: {}", a[a.len() - 1]);
     // drawn as one band of quadrilaterals between the profile's two rings, on the cylinder
     let fields = dir.path().join("fields");
@@ -288,15 +299,14 @@ fn a_profile_of_lines_swept_along_its_generator_is_an_extrusion() {
     );
 }
 
-/// The pushed block of `3d-block-pushed-on-flat.json` on the extrusion of a straight profile
-/// of two segments instead of the plane y = 0: the same run to round-off.
-#[test]
-fn the_pushed_block_slides_on_an_extruded_line_as_on_the_plane() {
+/// The pushed block of `3d-block-pushed-on-flat.json` (30 ms of it) and the same scene with
+/// its ground's surface replaced by `surface` and its reference point moved to `reference`.
+fn pushed_block_on(surface: RigidSurfaceSpec, reference: [f64; 3]) -> (ModelSpec, ModelSpec) {
     let path = repo("cases/verification/3d-block-pushed-on-flat.json");
     let text = std::fs::read_to_string(&path).expect("scene");
     let plane = parse_model(&text, &path, &["steps[0].duration=0.03".to_string()]).expect("model");
-    let mut extruded = plane.clone();
-    let ground = extruded
+    let mut other = plane.clone();
+    let ground = other
         .rigid_bodies
         .iter_mut()
         .find(|b| b.name == "ground")
@@ -305,26 +315,41 @@ fn the_pushed_block_slides_on_an_extruded_line_as_on_the_plane() {
         ground.surface,
         Some(RigidSurfaceSpec::Plane { .. })
     ));
-    ground.surface = Some(RigidSurfaceSpec::Extrusion {
-        axis: [0.0, 0.0, 1.0],
-        reference: [1.0, 0.0, 0.0],
-        // walked towards -x: the outside (on the right) is up
-        profile: vec![[2.0, 0.0], [0.0025, 0.0], [-2.0, 0.0]],
-        centres: Vec::new(),
-        closed: false,
-    });
-    let column = |model: &ModelSpec, name: &str| {
-        let dir = tempfile::tempdir().expect("tempdir");
-        let summary = run_model(model, Path::new("block.json"), dir.path()).expect("runs");
-        assert!(summary.error.is_none(), "{:?}", summary.error);
-        let path = dir.path().join("history.csv");
-        let text = std::fs::read_to_string(&path).expect("history");
-        let table = CsvTable::new(&text, &path).expect("table");
-        let c = table.column(name).expect("column");
-        table
-            .map(|row| row.expect("row").number::<f64>(c).expect("number"))
-            .collect::<Vec<f64>>()
-    };
+    ground.surface = Some(surface);
+    ground.reference_point = reference.to_vec();
+    (plane, other)
+}
+
+/// The history column `name` of `model`'s run.
+fn history_column(model: &ModelSpec, name: &str) -> Vec<f64> {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let summary = run_model(model, Path::new("block.json"), dir.path()).expect("runs");
+    assert!(summary.error.is_none(), "{:?}", summary.error);
+    let path = dir.path().join("history.csv");
+    let text = std::fs::read_to_string(&path).expect("history");
+    let table = CsvTable::new(&text, &path).expect("table");
+    let c = table.column(name).expect("column");
+    table
+        .map(|row| row.expect("row").number::<f64>(c).expect("number"))
+        .collect()
+}
+
+/// The pushed block of `3d-block-pushed-on-flat.json` on the extrusion of a straight profile
+/// of two segments instead of the plane y = 0: the same run to round-off.
+#[test]
+fn the_pushed_block_slides_on_an_extruded_line_as_on_the_plane() {
+    let (plane, extruded) = pushed_block_on(
+        RigidSurfaceSpec::Extrusion {
+            axis: [0.0, 0.0, 1.0],
+            reference: [1.0, 0.0, 0.0],
+            // walked towards -x: the outside (on the right) is up
+            profile: vec![[2.0, 0.0], [0.0025, 0.0], [-2.0, 0.0]],
+            centres: Vec::new(),
+            closed: false,
+        },
+        [0.0, 0.0, 0.0],
+    );
+    let column = history_column;
     for name in ["plate.u_x", "block-ground.tangential_force_1"] {
         let (a, b) = (column(&plane, name), column(&extruded, name));
         assert_eq!(a.len(), b.len());
@@ -338,4 +363,43 @@ fn the_pushed_block_slides_on_an_extruded_line_as_on_the_plane() {
             );
         }
     }
+}
+
+/// The pushed block on the plane y = 0 given as a disc of revolution about the vertical axis
+/// 0.05 m behind it (its chart radius 1 m, twenty times the block's distance from the axis):
+/// the block is pushed round the axis, so friction acts along the circumferential coordinate,
+/// whose increments are lengths only at the chart radius. Slip is measured in the tangent plane
+/// of each increment's start point, so the block slides as on the plane: the same motion, and
+/// the same contacts sliding (friction weighed by the angle's increments, 20 times mu N, would
+/// hold the block under its 9 N push).
+#[test]
+fn the_pushed_block_slides_round_a_revolved_disc_as_on_the_plane() {
+    let (plane, disc) = pushed_block_on(
+        RigidSurfaceSpec::Revolution {
+            axis: [0.0, 1.0, 0.0],
+            // walked towards the axis: the outside (on the right) is up
+            profile: vec![[1.0, 0.0], [0.001, 0.0]],
+            centres: Vec::new(),
+            closed: false,
+            radius: None,
+        },
+        [0.0, 0.0, -0.05],
+    );
+    let (a, b) = (
+        history_column(&plane, "plate.u_x"),
+        history_column(&disc, "plate.u_x"),
+    );
+    assert_eq!(a.len(), b.len());
+    let travel = a.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    assert!(travel > 0.05, "the block slides: {travel} m");
+    for (x, y) in a.iter().zip(&b) {
+        assert!(
+            (x - y).abs() <= 1e-9 * travel,
+            "u_x {x} on the plane, {y} on the disc"
+        );
+    }
+    // every contact slides (or sticks) when it does on the plane
+    let sliding = |model: &ModelSpec| history_column(model, "block-ground.sliding");
+    assert_eq!(sliding(&plane), sliding(&disc));
+    assert!(sliding(&disc).iter().any(|&n| n > 0.0), "contacts slide");
 }

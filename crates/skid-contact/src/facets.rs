@@ -251,7 +251,8 @@ impl RigidSurface for FacetedCylinder {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::kinematics::{RotatingFrame, evaluate, slip_increment};
+    use crate::kinematics::{RotatingFrame, evaluate};
+    use crate::surface::unwrapped_increment;
     use approx::assert_relative_eq;
 
     const R: f64 = 0.2;
@@ -274,7 +275,7 @@ pub(crate) mod tests {
             yp[k] += h;
             ym[k] -= h;
             let (pp, pm) = (project(surface, &yp), project(surface, &ym));
-            let slip = slip_increment(surface, &pm.coords, &pp.coords);
+            let slip = unwrapped_increment(surface.coords_period(), pp.coords - pm.coords);
             let fd = [pp.gap - pm.gap, slip[0], slip[1]].map(|d| d / (2.0 * h));
             let exact = gradients(&p).map(|g| g[k]);
             for (f, e) in fd.iter().zip(exact) {
@@ -481,7 +482,7 @@ pub(crate) mod tests {
         );
         assert_relative_eq!(last.coords[0], 72.0 * l, epsilon = 1e-11);
         assert_relative_eq!(first.coords[0], 0.0, epsilon = 1e-11);
-        let slip = slip_increment(&drum, &last.coords, &first.coords);
+        let slip = unwrapped_increment(drum.coords_period(), first.coords - last.coords);
         assert_relative_eq!(slip[0], 0.0, epsilon = 1e-11);
     }
 
@@ -504,7 +505,7 @@ pub(crate) mod tests {
                     f.gap,
                     c.gap
                 );
-                let arc = slip_increment(&drum, &c.coords, &f.coords);
+                let arc = unwrapped_increment(drum.coords_period(), f.coords - c.coords);
                 assert!(
                     arc[0].abs() <= 1e-5 * TAU * R,
                     "arc {} vs {}",
@@ -548,10 +549,10 @@ pub(crate) mod tests {
                         axis: Vector3::z(),
                         angle: theta,
                     };
-                    evaluate(&drum, &frame, x).expect("kinematics")
+                    evaluate(&drum, &frame, x, &Vector2::zeros()).expect("kinematics")
                 };
                 let (k, plus, minus) = (at(angle), at(angle + h), at(angle - h));
-                let slip = slip_increment(&drum, &minus.coords, &plus.coords);
+                let slip = unwrapped_increment(drum.coords_period(), plus.coords - minus.coords);
                 let fd = [plus.gap - minus.gap, slip[0], slip[1]].map(|d| d / (2.0 * h));
                 for (f, e) in fd.iter().zip(k.d_dangle) {
                     assert!(
@@ -571,7 +572,7 @@ pub(crate) mod tests {
         };
         let mid = 1.5 * TAU / 72.0;
         let y = polar(drum.apothem() + 0.001, mid, 0.0) + polar(0.003, mid + PI / 2.0, 0.0);
-        let k = evaluate(&drum, &frame, &y).expect("kinematics");
+        let k = evaluate(&drum, &frame, &y, &Vector2::zeros()).expect("kinematics");
         assert_relative_eq!(k.d_dangle[0], 0.003, epsilon = 1e-14);
         assert_relative_eq!(k.d_dangle[1], -(drum.apothem() + 0.001), epsilon = 1e-14);
     }

@@ -14,7 +14,7 @@
 
 use nalgebra::{Matrix3, Rotation3, Unit, Vector2, Vector3};
 
-use crate::surface::{DiscreteGradient, RigidSurface};
+use crate::surface::{DiscreteGradient, RigidSurface, unwrapped_increment};
 
 /// Placement of a rigid body rotating about a fixed axis.
 #[derive(Clone, Copy, Debug)]
@@ -60,22 +60,26 @@ impl RotatingFrame {
     }
 }
 
-/// Gap, convected coordinates and their exact first and second derivatives for one slave node.
+/// Gap, slip and their exact first and second derivatives for one slave node, with the
+/// convected coordinates of its closest point.
 #[derive(Clone, Debug)]
 pub struct ContactKinematics {
     /// Signed gap `g` (`> 0` open).
     pub gap: f64,
     /// Convected surface coordinates `xi` of the closest point (body frame).
     pub coords: Vector2<f64>,
+    /// The slip `s` since the contact point the kinematics were evaluated from (see
+    /// [`RigidSurface::slip`]): two lengths along the surface.
+    pub slip: Vector2<f64>,
     /// World-frame outward unit normal of the surface at the closest point, `Q dg/dy` normalised.
     pub normal: Vector3<f64>,
-    /// Derivatives of `[g, xi_0, xi_1]` with respect to the slave node's world position `x`:
+    /// Derivatives of `[g, s_0, s_1]` with respect to the slave node's world position `x`:
     /// `Q df/dy`.
     pub d_dx: [Vector3<f64>; 3],
-    /// Derivatives of `[g, xi_0, xi_1]` with respect to the body's rotation angle `theta`:
+    /// Derivatives of `[g, s_0, s_1]` with respect to the body's rotation angle `theta`:
     /// `-(df/dy) . (e x y)`.
     pub d_dangle: [f64; 3],
-    /// Second derivatives of `[g, xi_0, xi_1]` with respect to `x`: `Q F Q^T`.
+    /// Second derivatives of `[g, s_0, s_1]` with respect to `x`: `Q F Q^T`.
     pub d2_dx2: [Matrix3<f64>; 3],
     /// Mixed second derivatives with respect to `x` and `theta`: `e x (Q G) - Q F w`.
     pub d2_dx_dangle: [Vector3<f64>; 3],
@@ -83,7 +87,8 @@ pub struct ContactKinematics {
     pub d2_dangle2: [f64; 3],
 }
 
-/// Evaluate gap, convected coordinates and their exact first and second derivatives for a node at world
+/// Evaluate gap, slip since the contact point of convected coordinates `from` (see
+/// [`RigidSurface::slip`]) and their exact first and second derivatives for a node at world
 /// position `x` (2D problems pass `z = 0` and a `z` axis).
 ///
 /// Returns `None` if the frame is degenerate (zero or non-finite axis, non-finite centre or angle)
@@ -92,21 +97,15 @@ pub fn evaluate(
     surface: &dyn RigidSurface,
     frame: &RotatingFrame,
     x: &Vector3<f64>,
+    from: &Vector2<f64>,
 ) -> Option<ContactKinematics> {
     let (axis, rotation) = frame.orientation()?;
     let y = rotation.inverse_transform_vector(&(x - frame.center));
     let projection = surface.project(&y)?;
+    let slip = surface.slip(from, &y, &projection);
     let body_velocity = axis.cross(&y);
-    let gradients = [
-        projection.gap_gradient,
-        projection.coords_gradient[0],
-        projection.coords_gradient[1],
-    ];
-    let hessians = [
-        projection.gap_hessian,
-        projection.coords_hessian[0],
-        projection.coords_hessian[1],
-    ];
+    let gradients = [projection.gap_gradient, slip.gradient[0], slip.gradient[1]];
+    let hessians = [projection.gap_hessian, slip.hessian[0], slip.hessian[1]];
     let world = rotation.matrix();
     let mut d2_dx_dangle = [Vector3::zeros(); 3];
     let mut d2_dangle2 = [0.0; 3];
@@ -125,6 +124,7 @@ pub fn evaluate(
     Some(ContactKinematics {
         gap: projection.gap,
         coords: projection.coords,
+        slip: slip.value,
         normal,
         d_dx: gradients.map(|g| rotation * g),
         d_dangle: gradients.map(|g| -g.dot(&body_velocity)),
@@ -183,14 +183,16 @@ pub struct IncrementStart {
     pub offset: Vector3<f64>,
 }
 
-/// Rotation column of a node's rows `f = [g, xi_0, xi_1]` over an increment that makes them a
-/// discrete gradient. With the end-point `df/dx` (`end.d_dx`) in the node and translation
-/// columns, the body now at `theta_1 = frame.angle` and the node at offset `r_1 = x_1 - c_1`:
+/// Rotation column of a node's rows `f = [g, s_0, s_1]` over an increment that makes them a
+/// discrete gradient. With the end-point `df/dx` (`end.d_dx`, the kinematics evaluated from the
+/// contact point at the start `y_0`, so that `end.slip` is the slip over the increment) in the
+/// node and translation columns, the body now at `theta_1 = frame.angle` and the node at offset
+/// `r_1 = x_1 - c_1`:
 ///
 /// `col = (f(y_1) - f(y_0) - df/dx . (r_1 - r_0)) / (theta_1 - theta_0)`,
 ///
-/// so that `H dz = f(y_1) - f(y_0)` exactly (`xi` differences unwrapped, see
-/// [`slip_increment`]), and a contact force along the rows does exactly the work `p . df` of the
+/// so that `H dz = f(y_1) - f(y_0)` exactly (the slip from `y_0`, see
+/// [`RigidSurface::slip`]), and a contact force along the rows does exactly the work `p . df` of the
 /// contact law. Where `f` is affine between `Q_1^T r_0` and `y_1` (on one flat facet or plane)
 /// the column is the secant in the rotation, `(f(Q_1^T r_0) - f(Q_0^T r_0)) / dtheta`, which
 /// tends to `df/dtheta`; the end-point `df/dtheta` would miss the second-order term
@@ -216,43 +218,19 @@ pub fn rotation_column(
     let axis = frame.unit_axis()?;
     let start_rotation = Rotation3::from_axis_angle(&axis, start.angle);
     let before = surface.project(&start_rotation.inverse_transform_vector(&start.offset))?;
-    let change = |gap: f64, coords: &Vector2<f64>| {
-        let slip = slip_increment(surface, &before.coords, coords);
-        [gap - before.gap, slip[0], slip[1]]
-    };
     let moved = end_offset - start.offset;
-    let whole = change(end.gap, &end.coords);
+    let whole = [end.gap - before.gap, end.slip[0], end.slip[1]];
     let column: [f64; 3] = std::array::from_fn(|k| (whole[k] - end.d_dx[k].dot(&moved)) / turn);
     let bound = MAX_COLUMN_LEVER * start.offset.norm();
     if column.iter().all(|c| c.abs() <= bound) {
         return Some(column);
     }
     let rotation = Rotation3::from_axis_angle(&axis, frame.angle);
-    let turned = surface.project(&rotation.inverse_transform_vector(&start.offset))?;
-    let secant = change(turned.gap, &turned.coords).map(|d| d / turn);
+    let y_turned = rotation.inverse_transform_vector(&start.offset);
+    let turned = surface.project(&y_turned)?;
+    let slip = surface.slip(&before.coords, &y_turned, &turned).value;
+    let secant = [turned.gap - before.gap, slip[0], slip[1]].map(|d| d / turn);
     secant.iter().all(|c| c.is_finite()).then_some(secant)
-}
-
-/// Slip increment `current - previous` between two convected-coordinate states, each periodic
-/// component unwrapped with its surface period `p` into `(-p/2, p/2]`.
-pub fn slip_increment(
-    surface: &dyn RigidSurface,
-    previous: &Vector2<f64>,
-    current: &Vector2<f64>,
-) -> Vector2<f64> {
-    let periods = surface.coords_period();
-    let mut increment = current - previous;
-    for (component, period) in increment.iter_mut().zip(periods) {
-        if let Some(p) = period.filter(|p| p.is_finite() && *p > 0.0) {
-            *component -= p * (*component / p).round();
-            if *component <= -0.5 * p {
-                *component += p;
-            } else if *component > 0.5 * p {
-                *component -= p;
-            }
-        }
-    }
-    increment
 }
 
 #[cfg(test)]
@@ -263,12 +241,23 @@ mod tests {
     use approx::assert_relative_eq;
     use std::f64::consts::PI;
 
+    /// The kinematics at `x`, the slip measured from the coordinates' origin.
     fn eval(
         surface: &dyn RigidSurface,
         frame: &RotatingFrame,
         x: &Vector3<f64>,
     ) -> Result<ContactKinematics, ContactError> {
-        evaluate(surface, frame, x).ok_or(ContactError::InvalidSurface("undefined".into()))
+        eval_from(surface, frame, x, &Vector2::zeros())
+    }
+
+    /// The kinematics at `x`, the slip measured from the contact point of coordinates `from`.
+    fn eval_from(
+        surface: &dyn RigidSurface,
+        frame: &RotatingFrame,
+        x: &Vector3<f64>,
+        from: &Vector2<f64>,
+    ) -> Result<ContactKinematics, ContactError> {
+        evaluate(surface, frame, x, from).ok_or(ContactError::InvalidSurface("undefined".into()))
     }
 
     /// Differences of `[g, xi_0, xi_1]` between two states, with `xi` unwrapped.
@@ -277,7 +266,7 @@ mod tests {
         plus: &ContactKinematics,
         minus: &ContactKinematics,
     ) -> [f64; 3] {
-        let slip = slip_increment(surface, &minus.coords, &plus.coords);
+        let slip = unwrapped_increment(surface.coords_period(), plus.coords - minus.coords);
         [plus.gap - minus.gap, slip[0], slip[1]]
     }
 
@@ -434,7 +423,7 @@ mod tests {
                 angle: theta1,
             };
             let k0 = eval(&drum, &start, &(c0 + r0))?;
-            let k1 = eval(&drum, &end, &(c1 + r1))?;
+            let k1 = eval_from(&drum, &end, &(c1 + r1), &k0.coords)?;
             let change = difference(&drum, &k1, &k0);
             let begin = IncrementStart {
                 angle: theta0,
@@ -467,7 +456,7 @@ mod tests {
             angle: theta0 + 1e-6,
             ..start
         };
-        let still = eval(&drum, &close, &(c0 + r0))?;
+        let still = eval_from(&drum, &close, &(c0 + r0), &k0.coords)?;
         let limit = rotation_column(&drum, &close, &begin, &r0, &still).ok_or_else(none)?;
         for (secant, derivative) in limit.iter().zip(k0.d_dangle).take(2) {
             assert_relative_eq!(*secant, derivative, epsilon = 1e-6);
@@ -498,7 +487,11 @@ mod tests {
             angle: 0.0,
             offset: r0,
         };
-        let end = eval(&drum, &frame, &r1)?;
+        let unturned = RotatingFrame {
+            angle: 0.0,
+            ..frame
+        };
+        let end = eval_from(&drum, &frame, &r1, &eval(&drum, &unturned, &r0)?.coords)?;
         let column = rotation_column(&drum, &frame, &begin, &r1, &end)
             .ok_or_else(|| ContactError::InvalidSurface("no rotation column".into()))?;
         for c in column {
@@ -594,7 +587,7 @@ mod tests {
         let mut previous = at(0.0)?.coords;
         for step in 1..=63 {
             let current = at(step as f64 * 0.1)?.coords;
-            total += slip_increment(&drum, &previous, &current)[0];
+            total += unwrapped_increment(drum.coords_period(), current - previous)[0];
             previous = current;
         }
         assert_relative_eq!(total, -6.3 * radius, epsilon = 1e-12);
@@ -607,13 +600,13 @@ mod tests {
         let period = 0.4 * PI;
         let before = Vector2::new(0.2 * (PI - 0.01), 0.3);
         let after = Vector2::new(0.2 * (-PI + 0.02), 0.1);
-        let slip = slip_increment(&drum, &before, &after);
+        let slip = unwrapped_increment(drum.coords_period(), after - before);
         assert_relative_eq!(slip[0], 0.2 * 0.03, epsilon = 1e-14);
         assert_relative_eq!(slip[1], -0.2, epsilon = 1e-15);
-        let back = slip_increment(&drum, &after, &before);
+        let back = unwrapped_increment(drum.coords_period(), before - after);
         assert_relative_eq!(back[0], -0.2 * 0.03, epsilon = 1e-14);
         // exactly half a period maps to +p/2 (the interval is (-p/2, p/2])
-        let half = slip_increment(&drum, &Vector2::zeros(), &Vector2::new(-0.5 * period, 0.0));
+        let half = unwrapped_increment(drum.coords_period(), Vector2::new(-0.5 * period, 0.0));
         assert_relative_eq!(half[0], 0.5 * period, epsilon = 1e-15);
         Ok(())
     }
@@ -626,17 +619,17 @@ mod tests {
             axis: Vector3::z(),
             angle: 0.3,
         };
-        assert!(evaluate(&drum, &frame, &Vector3::new(1.0, 2.0, 0.5)).is_none());
+        assert!(eval(&drum, &frame, &Vector3::new(1.0, 2.0, 0.5)).is_err());
         let no_axis = RotatingFrame {
             axis: Vector3::zeros(),
             ..frame
         };
-        assert!(evaluate(&drum, &no_axis, &Vector3::new(0.0, 0.0, 0.0)).is_none());
+        assert!(eval(&drum, &no_axis, &Vector3::new(0.0, 0.0, 0.0)).is_err());
         let nan_angle = RotatingFrame {
             angle: f64::NAN,
             ..frame
         };
-        assert!(evaluate(&drum, &nan_angle, &Vector3::new(0.0, 0.0, 0.0)).is_none());
+        assert!(eval(&drum, &nan_angle, &Vector3::new(0.0, 0.0, 0.0)).is_err());
         Ok(())
     }
 }

@@ -37,10 +37,13 @@ pub use extrusion::RigidExtrusion;
 pub use facets::FacetedCylinder;
 pub use kinematics::{
     ContactKinematics, IncrementStart, MAX_COLUMN_LEVER, MIN_SECANT_TURN, RotatingFrame, evaluate,
-    gap_discrete_gradient, rotation_column, slip_increment,
+    gap_discrete_gradient, rotation_column,
 };
 pub use plane::RigidPlane;
 pub use polyline::RigidPolyline;
 pub use revolution::RigidRevolution;
-pub use surface::{AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, SurfaceShape};
+pub use surface::{
+    AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, Slip, SurfaceShape,
+    unwrapped_increment,
+};
 pub use triangles::{CylinderChart, SurfaceChart, TriangulatedSurface};

@@ -446,6 +446,41 @@ impl RigidPolyline {
 }
 
 impl RigidPolyline {
+    /// The point at arc length `s` from the first vertex and the unit tangent there, towards
+    /// growing arc length (at a vertex, the tangent of the piece that starts there): `s` clamped
+    /// to the ends of an open polyline, taken modulo the length of a closed one; `None` for a
+    /// non-finite `s`. On a straight piece from `P_k` (arc length `s_k`) the point is
+    /// `P_k + (s - s_k) t_k`; on an arc it is the start turned about the centre by
+    /// `sweep (s - s_k) / L_k`.
+    pub(crate) fn point_at(&self, s: f64) -> Option<(Vector2<f64>, Vector2<f64>)> {
+        if !s.is_finite() {
+            return None;
+        }
+        let s = if self.closed {
+            s.rem_euclid(self.length)
+        } else {
+            s.clamp(0.0, self.length)
+        };
+        let k = self
+            .segments
+            .partition_point(|segment| segment.arc <= s)
+            .saturating_sub(1);
+        let segment = &self.segments[k];
+        let along = (s - segment.arc).clamp(0.0, segment.length);
+        Some(match &segment.bend {
+            None => (segment.start + segment.tangent * along, segment.tangent),
+            Some(bend) => {
+                let (sin, cos) = (bend.sweep * along / segment.length).sin_cos();
+                let direction = Vector2::new(
+                    bend.from.x * cos - bend.from.y * sin,
+                    bend.from.x * sin + bend.from.y * cos,
+                );
+                let tangent = Vector2::new(-direction.y, direction.x) * bend.turn();
+                (bend.centre + direction * bend.radius, tangent)
+            }
+        })
+    }
+
     /// The straight segment whose interior holds the closest point to `q`, with its outward
     /// normal; `None` where the closest point is a vertex or on an arc (or `q` is not finite).
     pub(crate) fn interior_segment(&self, q: &Vector2<f64>) -> Option<(usize, Vector2<f64>)> {
@@ -585,8 +620,8 @@ impl RigidSurface for RigidPolyline {
 mod tests {
     use super::*;
     use crate::facets::tests::check_gradients;
-    use crate::kinematics::slip_increment;
     use crate::plane::RigidPlane;
+    use crate::surface::unwrapped_increment;
 
     fn project(surface: &dyn RigidSurface, y: &Vector3<f64>) -> Projection {
         surface.project(y).expect("projection defined")
@@ -712,9 +747,55 @@ mod tests {
         let after = project(&square, &Vector3::new(-0.99, -1.1, 0.0));
         assert!((before.coords[0] - 7.99).abs() < 1e-12);
         assert!((after.coords[0] - 0.01).abs() < 1e-12);
-        let slip = slip_increment(&square, &before.coords, &after.coords);
+        let slip = unwrapped_increment(square.coords_period(), after.coords - before.coords);
         assert!((slip[0] - 0.02).abs() < 1e-12);
         check_gradients(&square, &Vector3::new(0.2, 1.3, 0.0), 1e-6);
+        Ok(())
+    }
+
+    /// `point_at` walks the pieces: each point projects back to its arc length with no gap,
+    /// the tangent is the derivative of the point in the arc length, a closed polyline wraps
+    /// and an open one stops at its ends.
+    #[test]
+    fn the_point_at_an_arc_length_lies_on_the_polyline() -> Result<(), ContactError> {
+        let step = rounded();
+        let length = step.length;
+        let h = 1e-6;
+        // (points between the vertices: the tangent turns at the corner between the convex
+        // arc and the lower floor)
+        for i in 0..40 {
+            let s = length * (i as f64 + 0.5) / 40.0;
+            let (point, tangent) = step.point_at(s).expect("finite");
+            let back = project(&step, &Vector3::new(point.x, point.y, 0.0));
+            assert!(back.gap.abs() < 1e-12, "s = {s}: gap {}", back.gap);
+            assert!(
+                (back.coords[0] - s).abs() < 1e-12,
+                "s = {s}: {}",
+                back.coords[0]
+            );
+            let ahead = step.point_at(s + h).expect("finite").0;
+            let behind = step.point_at(s - h).expect("finite").0;
+            assert!(
+                ((ahead - behind) / (2.0 * h) - tangent).norm() < 1e-6,
+                "s = {s}"
+            );
+            assert!((tangent.norm() - 1.0).abs() < 1e-12);
+        }
+        assert_eq!(step.point_at(-1.0), step.point_at(0.0));
+        assert_eq!(step.point_at(length + 1.0), step.point_at(length));
+        assert_eq!(step.point_at(f64::NAN), None);
+        let square = RigidPolyline::new(
+            vec![
+                Vector2::new(-1.0, -1.0),
+                Vector2::new(1.0, -1.0),
+                Vector2::new(1.0, 1.0),
+                Vector2::new(-1.0, 1.0),
+            ],
+            true,
+        )?;
+        let (wrapped, tangent) = square.point_at(8.5).expect("finite");
+        assert!((wrapped - Vector2::new(-0.5, -1.0)).norm() < 1e-15);
+        assert_eq!(tangent, Vector2::new(1.0, 0.0));
         Ok(())
     }
 

@@ -2,11 +2,14 @@
 //! half-plane revolved about an axis through the body origin, such as a stepped drum, a cone,
 //! a roller with flanges or a spherical indenter.
 
-use nalgebra::{Matrix2x3, Vector2, Vector3};
+use nalgebra::{Matrix2x3, Matrix3, Vector2, Vector3};
 
 use crate::error::ContactError;
 use crate::polyline::{RigidPolyline, lift_from_plane};
-use crate::surface::{AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, SurfaceShape};
+use crate::surface::{
+    AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, Slip, SurfaceShape,
+    unwrapped_increment,
+};
 
 /// The surface swept by the [`RigidPolyline`] `profile` of the `r-z` half-plane (`r >= 0` the
 /// distance from the unit axis `e`, `z = e.y`; its outside on the right walking along it with
@@ -20,7 +23,9 @@ use crate::surface::{AnalyticCylinder, DiscreteGradient, Projection, RigidSurfac
 /// `(r, z)` Hessian; `d^2 r/dy^2 = w w^T / r`). The coordinates are `xi_0 = R theta`, the angle
 /// about `e` scaled by the chart radius `R` as on [`AnalyticCylinder`] (so that slip is a length
 /// on the surface where `r = R`, and `r/R` of one elsewhere), and `xi_1 = s`, the profile's arc
-/// length. The projection is undefined on the axis (`r ~ 0`).
+/// length; friction measures slip in lengths in the tangent plane of the increment's start
+/// point instead (see [`RigidSurface::slip`] below). The projection is undefined on the axis
+/// (`r ~ 0`).
 #[derive(Clone, Debug)]
 pub struct RigidRevolution {
     profile: RigidPolyline,
@@ -99,6 +104,35 @@ impl RigidSurface for RigidRevolution {
         ]
     }
 
+    /// The slip in the tangent plane at the start point `p_0`, whose coordinates `from` give
+    /// its angle `theta_0 = xi_0 / R` about the axis and its arc length `xi_1` along the
+    /// profile, where the profile is at `(r_0, z_0)` with unit tangent `(t_r, t_z)`: with
+    /// `u_0 = cos theta_0 b_1 + sin theta_0 b_2` and `p_0 = r_0 u_0 + z_0 e`, the
+    /// circumferential and meridional unit tangents `t_0 = e x u_0` and `t_1 = t_r u_0 + t_z e`
+    /// give `s_k = t_k . (y - p_0)`, gradients `t_k` and no curvature. The angle's increments
+    /// are no lengths (`R dtheta` is one only where `r = R`: friction would be weighed by
+    /// `R / r`); these are, at every radius, and orthonormal, as a plane's coordinates are.
+    fn slip(&self, from: &Vector2<f64>, y: &Vector3<f64>, to: &Projection) -> Slip {
+        let Some((point, tangent)) = self.profile.point_at(from.y) else {
+            return Slip {
+                value: unwrapped_increment(self.coords_period(), to.coords - from),
+                gradient: to.coords_gradient,
+                hessian: to.coords_hessian,
+            };
+        };
+        let e = self.chart.axis();
+        let b1 = self.chart.reference_direction();
+        let (sin, cos) = (from.x / self.chart.radius()).sin_cos();
+        let u = b1 * cos + e.cross(&b1) * sin;
+        let start = u * point.x + e * point.y;
+        let tangents = [e.cross(&u), u * tangent.x + e * tangent.y];
+        Slip {
+            value: Vector2::new(tangents[0].dot(&(y - start)), tangents[1].dot(&(y - start))),
+            gradient: tangents,
+            hessian: [Matrix3::zeros(); 2],
+        }
+    }
+
     /// Where both points are closest to the interior of one profile segment, of outward normal
     /// `n = (n_r, n_z)`, the gap is `n_r r + n_z z` plus a constant, and with the cylinder's
     /// `r_end - r_start = (y_perp,start + y_perp,end)/S . (y_end - y_start)`
@@ -157,6 +191,50 @@ mod tests {
         )
         .expect("profile");
         RigidRevolution::new(Vector3::new(0.0, 0.0, 2.0), profile, 0.2).expect("revolution")
+    }
+
+    /// Slip is measured in lengths in the tangent plane of the start point: none at the start;
+    /// a turn `dtheta` about the axis at radius `r` slips `r sin(dtheta)` round it (not the chart's
+    /// `R dtheta`, `R = 0.2` here); a move along the cone's generator slips its length along
+    /// the profile; the two directions are orthonormal and tangent to the surface at the start.
+    #[test]
+    fn slip_is_measured_in_lengths_in_the_start_tangent_plane() {
+        let surface = stepped();
+        // the cone runs from (r, z) = (0.2, 0) to (0.25, 0.05)
+        let point = |theta: f64, r: f64, z: f64| Vector3::new(r * theta.cos(), r * theta.sin(), z);
+        let start = point(0.3, 0.225, 0.025);
+        let from = project(&surface, &start);
+        assert!(from.gap.abs() < 1e-15);
+        let slip = |y: Vector3<f64>| surface.slip(&from.coords, &y, &project(&surface, &y));
+        let still = slip(start);
+        assert!(still.value.norm() < 1e-15, "{}", still.value);
+        let [round, along] = still.gradient;
+        assert!((round.norm() - 1.0).abs() < 1e-15 && (along.norm() - 1.0).abs() < 1e-15);
+        assert!(round.dot(&along).abs() < 1e-15);
+        assert!(round.dot(&from.gap_gradient).abs() < 1e-15);
+        assert!(along.dot(&from.gap_gradient).abs() < 1e-15);
+        assert_eq!(still.hessian, [Matrix3::zeros(); 2]);
+        let turn = 0.01;
+        let turned = slip(point(0.3 + turn, 0.225, 0.025));
+        assert!(
+            (turned.value.x - 0.225 * turn.sin()).abs() < 1e-15,
+            "{}",
+            turned.value
+        );
+        let step = 0.01 / 2f64.sqrt();
+        let moved = slip(point(0.3, 0.225 + step, 0.025 + step));
+        assert!(
+            (moved.value - Vector2::new(0.0, 0.01)).norm() < 1e-15,
+            "{}",
+            moved.value
+        );
+        // the gradients are those of the value, which is linear in y
+        let y = point(0.32, 0.231, 0.03);
+        let h = Vector3::new(1e-3, -2e-3, 0.5e-3);
+        let change = slip(y + h).value - slip(y).value;
+        for k in 0..2 {
+            assert!((change[k] - still.gradient[k].dot(&h)).abs() < 1e-15);
+        }
     }
 
     /// The straight profile r = R is the analytical cylinder: the same gap, coordinates (the

@@ -119,6 +119,47 @@ pub trait RigidSurface: Send + Sync + std::fmt::Debug {
     ) -> Option<DiscreteGradient> {
         None
     }
+    /// The slip from the surface point of convected coordinates `from` (the contact point at
+    /// the start of an increment) to the body-frame point `y` of projection `to`: two lengths
+    /// along the surface, the friction law's tangential displacements, with their gradients and
+    /// Hessians in `y`. The default, right where the coordinates are lengths on the surface
+    /// (arc lengths, plane coordinates): the coordinates' increments `to.coords - from`, each
+    /// periodic one unwrapped into `(-p/2, p/2]`, with the coordinates' own derivatives.
+    fn slip(&self, from: &Vector2<f64>, _y: &Vector3<f64>, to: &Projection) -> Slip {
+        Slip {
+            value: unwrapped_increment(self.coords_period(), to.coords - from),
+            gradient: to.coords_gradient,
+            hessian: to.coords_hessian,
+        }
+    }
+}
+
+/// The slip of [`RigidSurface::slip`]: its two components, their gradients and their
+/// (symmetric) Hessians in the body-frame point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Slip {
+    /// The two tangential displacements, lengths along the surface.
+    pub value: Vector2<f64>,
+    /// The gradient of each component.
+    pub gradient: [Vector3<f64>; 2],
+    /// The Hessian of each component.
+    pub hessian: [Matrix3<f64>; 2],
+}
+
+/// `increment` with each component that has a period `p` (finite, positive) unwrapped into
+/// `(-p/2, p/2]`.
+pub fn unwrapped_increment(periods: [Option<f64>; 2], mut increment: Vector2<f64>) -> Vector2<f64> {
+    for (component, period) in increment.iter_mut().zip(periods) {
+        if let Some(p) = period.filter(|p| p.is_finite() && *p > 0.0) {
+            *component -= p * (*component / p).round();
+            if *component <= -0.5 * p {
+                *component += p;
+            } else if *component > 0.5 * p {
+                *component -= p;
+            }
+        }
+    }
+    increment
 }
 
 /// A discrete gradient `G(y_start, y_end)` of the gap (see

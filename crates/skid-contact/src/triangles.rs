@@ -482,7 +482,7 @@ impl RigidSurface for TriangulatedSurface {
 mod tests {
     use super::*;
     use crate::facets::tests::check_gradients;
-    use crate::kinematics::slip_increment;
+    use crate::surface::unwrapped_increment;
     use approx::assert_relative_eq;
     use proptest::prelude::*;
     use std::f64::consts::{PI, TAU};
@@ -783,7 +783,7 @@ mod tests {
         let before = project(&mesh, &Vector3::new(-d - 0.001, 0.004, 0.01));
         let after = project(&mesh, &Vector3::new(-d - 0.002, -0.003, -0.02));
         assert!(before.coords[0] > 0.0 && after.coords[0] < 0.0);
-        let slip = slip_increment(&mesh, &before.coords, &after.coords);
+        let slip = unwrapped_increment(mesh.coords_period(), after.coords - before.coords);
         let expected = R * ((0.004 / d).atan() + (0.003 / d).atan());
         assert_relative_eq!(slip[0], expected, epsilon = 1e-14);
         assert_relative_eq!(slip[1], -0.03, epsilon = 1e-15);

@@ -2,8 +2,8 @@
 //! linearised in the global unknowns.
 //!
 //! For every contact candidate `c` (a slave node of a pair) the local quantities
-//! `u_c = (g, Delta s_1[, Delta s_2])` (normal gap at the end of the increment and the slip
-//! increment in the master surface's convected coordinates) are linearised in the global
+//! `u_c = (g, s_1[, s_2])` (normal gap at the end of the increment and the slip over the
+//! increment, lengths along the master surface, see `RigidSurface::slip`) are linearised in the global
 //! unknowns: `u_c(x + dx) ~ u_c(x) + H_c dx`. The rows of `H` hold the derivatives with respect
 //! to the node's components and the carrying body's translation and rotation, and each row's
 //! second derivatives give the stiffness of the contact forces on a curved, turning surface.
@@ -11,7 +11,6 @@
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 use skid_contact::kinematics::{
     ContactKinematics, IncrementStart, evaluate, gap_discrete_gradient, rotation_column,
-    slip_increment,
 };
 use skid_fem::cell::embed;
 
@@ -245,7 +244,7 @@ pub fn contact_rows<const D: usize>(
             start.map(|x0| embed(&(body.reference_point + dofs.body_displacement(x0, pair.body))));
         for &node in &pair.nodes {
             let pos = model.node_position(x, node);
-            let mut kin = evaluate(pair.surface.as_ref(), &frame, &pos)
+            let mut kin = evaluate(pair.surface.as_ref(), &frame, &pos, &previous[k])
                 .ok_or(IncrementFailure::NoProjection { pair: p, node })?;
             if let (Some(x0), Some(c0)) = (start, start_center) {
                 let offset = model.node_position(x0, node) - c0;
@@ -271,7 +270,6 @@ pub fn contact_rows<const D: usize>(
                     }
                 }
             }
-            let slip = slip_increment(pair.surface.as_ref(), &previous[k], &kin.coords);
             for comp in 0..components {
                 let mut row: Vec<(usize, f64)> = Vec::with_capacity(2 * D + 1);
                 let mut add = |eq: Option<usize>, c: f64| {
@@ -293,7 +291,11 @@ pub fn contact_rows<const D: usize>(
                 add(dofs.body_rotation(pair.body), kin.d_dangle[comp]);
                 out.rows.push(row);
                 push_local_curvature::<D>(&kin, comp, &mut out.curvature);
-                u.push(if comp == 0 { kin.gap } else { slip[comp - 1] });
+                u.push(if comp == 0 {
+                    kin.gap
+                } else {
+                    kin.slip[comp - 1]
+                });
             }
             out.coords.push(kin.coords);
             out.mu.push(pair.mu);
