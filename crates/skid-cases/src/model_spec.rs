@@ -306,7 +306,8 @@ pub enum RigidSurfaceSpec {
         /// Whether the last point joins the first.
         #[serde(default)]
         closed: bool,
-        /// Radius of the circumferential coordinate, m (absent: the profile's largest `r`).
+        /// Radius of the circumferential coordinate, m (absent: the profile's largest `r`); it
+        /// labels contact points only: friction measures slip in lengths at every radius.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         radius: Option<f64>,
     },

@@ -14,7 +14,7 @@
 
 use nalgebra::{Matrix3, Rotation3, Unit, Vector2, Vector3};
 
-use crate::surface::{DiscreteGradient, RigidSurface, unwrapped_increment};
+use crate::surface::{DiscreteGradient, RigidSurface};
 
 /// Placement of a rigid body rotating about a fixed axis.
 #[derive(Clone, Copy, Debug)]
@@ -237,7 +237,7 @@ pub fn rotation_column(
 mod tests {
     use super::*;
     use crate::error::ContactError;
-    use crate::surface::AnalyticCylinder;
+    use crate::surface::{AnalyticCylinder, unwrapped_increment};
     use approx::assert_relative_eq;
     use std::f64::consts::PI;
 
