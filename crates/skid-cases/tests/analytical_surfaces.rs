@@ -374,16 +374,31 @@ fn the_pushed_block_slides_on_an_extruded_line_as_on_the_plane() {
 /// hold the block under its 9 N push).
 #[test]
 fn the_pushed_block_slides_round_a_revolved_disc_as_on_the_plane() {
+    slides_on_a_disc_as_on_the_plane(0.001, [0.0, 0.0, -0.05]);
+}
+
+/// The pushed block on a disc that reaches the axis, with the axis through the middle node of
+/// the block's bottom face: that node's projection is taken on the axis, the others' round it,
+/// and the block slides as on the plane.
+#[test]
+fn a_node_on_the_axis_of_a_revolved_disc_slides_as_on_the_plane() {
+    slides_on_a_disc_as_on_the_plane(0.0, [0.0, 0.0, 0.0]);
+}
+
+/// The pushed block on the plane and on the disc of revolution of the profile from r = 1 in
+/// to `inner` about the vertical axis through `reference` (the ground's reference point): the
+/// same motion to 1e-9 of its travel, and the same contacts sliding.
+fn slides_on_a_disc_as_on_the_plane(inner: f64, reference: [f64; 3]) {
     let (plane, disc) = pushed_block_on(
         RigidSurfaceSpec::Revolution {
             axis: [0.0, 1.0, 0.0],
             // walked towards the axis: the outside (on the right) is up
-            profile: vec![[1.0, 0.0], [0.001, 0.0]],
+            profile: vec![[1.0, 0.0], [inner, 0.0]],
             centres: Vec::new(),
             closed: false,
             radius: None,
         },
-        [0.0, 0.0, -0.05],
+        reference,
     );
     let (a, b) = (
         history_column(&plane, "plate.u_x"),

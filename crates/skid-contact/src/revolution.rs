@@ -24,13 +24,19 @@ use crate::surface::{
 /// about `e` scaled by the chart radius `R` as on [`AnalyticCylinder`] (so that slip is a length
 /// on the surface where `r = R`, and `r/R` of one elsewhere), and `xi_1 = s`, the profile's arc
 /// length; friction measures slip in lengths in the tangent plane of the increment's start
-/// point instead (see [`RigidSurface::slip`] below). The projection is undefined on the axis
-/// (`r ~ 0`).
+/// point instead (see [`RigidSurface::slip`] below). On the axis the point is taken a round-off
+/// distance off it (see [`RigidSurface::project`] below).
 #[derive(Clone, Debug)]
 pub struct RigidRevolution {
     profile: RigidPolyline,
     chart: AnalyticCylinder,
+    /// The profile's largest distance from the origin of the `r-z` plane, its length scale.
+    size: f64,
 }
+
+/// Distance from the axis, relative to the profile's size, below which a point is projected as
+/// on the axis (see [`RigidRevolution::project`]).
+const ON_AXIS: f64 = 1e-12;
 
 impl RigidRevolution {
     /// The revolution of `profile` (in `(r, z)`, `r >= 0`) about `axis`, with the chart radius
@@ -44,7 +50,7 @@ impl RigidRevolution {
         profile: RigidPolyline,
         radius: f64,
     ) -> Result<Self, ContactError> {
-        let (low, _) = profile.bounds();
+        let (low, high) = profile.bounds();
         if low.x < 0.0 || low.x.is_nan() {
             return Err(ContactError::InvalidSurface(format!(
                 "a profile of revolution lies at r >= 0, this one reaches r = {}",
@@ -52,6 +58,7 @@ impl RigidRevolution {
             )));
         }
         Ok(Self {
+            size: low.abs().sup(&high.abs()).max(),
             profile,
             chart: AnalyticCylinder::new(radius, axis)?,
         })
@@ -68,14 +75,27 @@ impl RigidSurface for RigidRevolution {
         }
     }
 
+    /// A point on the axis (`r` below [`ON_AXIS`] times the profile's size) is projected as if
+    /// it stood that far off the axis towards the reference direction `b_1`: the gap and its
+    /// derivatives are continuous there wherever the surface is smooth on the axis (a profile
+    /// that meets it at a right angle, as a sphere's pole), and the limits of `f_r / r` come out
+    /// of the profile's own derivatives; the angle, undefined on the axis, is taken as 0.
     fn project(&self, y: &Vector3<f64>) -> Option<Projection> {
-        // the angle and its derivatives, and r > 0, from the chart cylinder
-        let around = self.chart.project(y)?;
         let e = self.chart.axis();
         let z = e.dot(y);
         let radial = y - e * z;
-        let r = radial.norm();
-        let (u, w) = (radial / r, e.cross(&(radial / r)));
+        let on_axis = ON_AXIS * self.size;
+        // the unit radial direction u exactly b_1 on the axis (from the rounded radial part it
+        // would be off by round-off over ON_AXIS)
+        let (r, u, around) = match radial.norm() {
+            r if r < on_axis => {
+                let u = self.chart.reference_direction();
+                (on_axis, u, self.chart.project(&(e * z + u * on_axis))?)
+            }
+            // the angle and its derivatives from the chart cylinder
+            r => (r, radial / r, self.chart.project(y)?),
+        };
+        let w = e.cross(&u);
         let meridian = self.profile.project(&Vector3::new(r, z, 0.0))?;
         // [u e]^T: rows u and e map (r, z) derivatives to y
         let frame = Matrix2x3::from_rows(&[u.transpose(), e.transpose()]);
@@ -358,11 +378,32 @@ mod tests {
             assert!((p.gap_gradient - y.normalize()).norm() < 1e-14);
             check_gradients(&sphere, &y, 1e-6);
         }
+        // on the axis, above a pole, at it and inside: the sphere's gap, normal and curvature
+        // (I - n n^T) / |y|, also in the limit f_r / r of the profile's curvature
+        let e = Vector3::new(0.1, 0.0, 1.0).normalize();
+        for t in [0.45, -0.7, r, 0.1] {
+            let y = e * t;
+            let p = project(&sphere, &y);
+            let n = e * t.signum();
+            assert!((p.gap - (t.abs() - r)).abs() < 1e-15, "{t}: {}", p.gap);
+            assert!(
+                (p.gap_gradient - n).norm() < 1e-11,
+                "{t}: {}",
+                p.gap_gradient
+            );
+            let curvature = (Matrix3::identity() - n * n.transpose()) / t.abs();
+            assert!(
+                (p.gap_hessian - curvature).norm() < 1e-9,
+                "{t}: {}",
+                p.gap_hessian
+            );
+            assert!(p.coords.iter().all(|c| c.is_finite()));
+        }
         Ok(())
     }
 
     /// On the cone the gap is the distance to it in the meridian half-plane, its normal the
-    /// profile's normal turned about the axis; the axis itself has no projection.
+    /// profile's normal turned about the axis.
     #[test]
     fn the_gap_is_measured_in_the_meridian_plane() {
         let surface = stepped();
@@ -374,7 +415,6 @@ mod tests {
         assert!((p.gap - along).abs() < 1e-15, "{} vs {along}", p.gap);
         let normal = Vector3::new(0.0, 1.0, -1.0) / 2f64.sqrt();
         assert!((p.gap_gradient - normal).norm() < 1e-15);
-        assert!(surface.project(&Vector3::new(0.0, 0.0, 0.3)).is_none());
         assert_eq!(surface.coords_period()[1], None);
         assert!(
             RigidRevolution::new(
