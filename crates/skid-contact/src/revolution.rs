@@ -8,7 +8,6 @@ use crate::error::ContactError;
 use crate::polyline::{RigidPolyline, lift_from_plane};
 use crate::surface::{
     AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, Slip, SurfaceShape,
-    unwrapped_increment,
 };
 
 /// The surface swept by the [`RigidPolyline`] `profile` of the `r-z` half-plane (`r >= 0` the
@@ -134,11 +133,7 @@ impl RigidSurface for RigidRevolution {
     /// `R / r`); these are, at every radius, and orthonormal, as a plane's coordinates are.
     fn slip(&self, from: &Vector2<f64>, y: &Vector3<f64>, to: &Projection) -> Slip {
         let Some((point, tangent)) = self.profile.point_at(from.y) else {
-            return Slip {
-                value: unwrapped_increment(self.coords_period(), to.coords - from),
-                gradient: to.coords_gradient,
-                hessian: to.coords_hessian,
-            };
+            return Slip::of_coordinates(self.coords_period(), from, to);
         };
         let e = self.chart.axis();
         let b1 = self.chart.reference_direction();

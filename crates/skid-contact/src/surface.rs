@@ -126,11 +126,7 @@ pub trait RigidSurface: Send + Sync + std::fmt::Debug {
     /// (arc lengths, plane coordinates): the coordinates' increments `to.coords - from`, each
     /// periodic one unwrapped into `(-p/2, p/2]`, with the coordinates' own derivatives.
     fn slip(&self, from: &Vector2<f64>, _y: &Vector3<f64>, to: &Projection) -> Slip {
-        Slip {
-            value: unwrapped_increment(self.coords_period(), to.coords - from),
-            gradient: to.coords_gradient,
-            hessian: to.coords_hessian,
-        }
+        Slip::of_coordinates(self.coords_period(), from, to)
     }
 }
 
@@ -144,6 +140,18 @@ pub struct Slip {
     pub gradient: [Vector3<f64>; 2],
     /// The Hessian of each component.
     pub hessian: [Matrix3<f64>; 2],
+}
+
+impl Slip {
+    /// The increments of the coordinates from `from` to those of `to`, each with a period in
+    /// `periods` unwrapped (see [`unwrapped_increment`]), with the coordinates' derivatives.
+    pub fn of_coordinates(periods: [Option<f64>; 2], from: &Vector2<f64>, to: &Projection) -> Self {
+        Self {
+            value: unwrapped_increment(periods, to.coords - from),
+            gradient: to.coords_gradient,
+            hessian: to.coords_hessian,
+        }
+    }
 }
 
 /// `increment` with each component that has a period `p` (finite, positive) unwrapped into
