@@ -726,11 +726,9 @@ mod tests {
         assert!((on.gap_gradient - bisector).norm() < 1e-12);
     }
 
-    /// A closed square, counter-clockwise: outside positive, inside negative, and the arc
-    /// length wraps with the period of its perimeter.
-    #[test]
-    fn a_closed_polyline_wraps_its_arc_length() -> Result<(), ContactError> {
-        let square = RigidPolyline::new(
+    /// The closed square of side 2 about the origin, counter-clockwise from (-1, -1).
+    fn square() -> Result<RigidPolyline, ContactError> {
+        RigidPolyline::new(
             vec![
                 Vector2::new(-1.0, -1.0),
                 Vector2::new(1.0, -1.0),
@@ -738,7 +736,14 @@ mod tests {
                 Vector2::new(-1.0, 1.0),
             ],
             true,
-        )?;
+        )
+    }
+
+    /// A closed square, counter-clockwise: outside positive, inside negative, and the arc
+    /// length wraps with the period of its perimeter.
+    #[test]
+    fn a_closed_polyline_wraps_its_arc_length() -> Result<(), ContactError> {
+        let square = square()?;
         assert_eq!(square.coords_period(), [Some(8.0), None]);
         assert!((project(&square, &Vector3::new(1.5, 0.0, 0.0)).gap - 0.5).abs() < 1e-15);
         assert!((project(&square, &Vector3::new(0.0, 0.8, 0.0)).gap + 0.2).abs() < 1e-15);
@@ -784,15 +789,7 @@ mod tests {
         assert_eq!(step.point_at(-1.0), step.point_at(0.0));
         assert_eq!(step.point_at(length + 1.0), step.point_at(length));
         assert_eq!(step.point_at(f64::NAN), None);
-        let square = RigidPolyline::new(
-            vec![
-                Vector2::new(-1.0, -1.0),
-                Vector2::new(1.0, -1.0),
-                Vector2::new(1.0, 1.0),
-                Vector2::new(-1.0, 1.0),
-            ],
-            true,
-        )?;
+        let square = square()?;
         let (wrapped, tangent) = square.point_at(8.5).expect("finite");
         assert!((wrapped - Vector2::new(-0.5, -1.0)).norm() < 1e-15);
         assert_eq!(tangent, Vector2::new(1.0, 0.0));
