@@ -173,9 +173,11 @@ enum Command {
         #[arg(long, default_value_t = 5)]
         repeats: usize,
         /// Methods to compare (comma-separated): case (the case's own contact solve setting),
-        /// reduced, global (the contact solves), quasi-static
-        /// (the pad without inertia, global solve), quasi-static-adaptive (the same with adaptive
-        /// increments, tolerance 1e-6 scaled by the square of the level's factor).
+        /// reduced, global (the contact solves), adaptive (the case with adaptive increments,
+        /// tolerance 1e-6 scaled by the square of the level's factor), quasi-static (the pad
+        /// without inertia, global solve), quasi-static-adaptive (the same with adaptive
+        /// increments). An adaptive method is measured against the finest level of its fixed
+        /// one (case, quasi-static) where that is listed before it.
         #[arg(long, value_delimiter = ',', default_value = "reduced,global")]
         methods: Vec<String>,
     },

@@ -167,7 +167,7 @@ fn bench_rejects_an_unknown_method_and_a_ladder_without_the_case_time_step() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         stderr.contains(
-            "expected one of case, reduced, global, quasi-static, quasi-static-adaptive, got \"dense\""
+            "expected one of case, reduced, global, adaptive, quasi-static, quasi-static-adaptive, got \"dense\""
         ),
         "{stderr}"
     );

@@ -75,6 +75,10 @@ pub enum BenchMethod {
     Reduced,
     /// The case as it is, global contact solve.
     Global,
+    /// As [`Self::Case`], with adaptive increments in the dynamic steps (see [`adapt`]);
+    /// measured against the finest `case` level where the bench runs it before, since both
+    /// solve the same model.
+    Adaptive,
     /// The pad quasi-static (`pad.quasi_static`), global contact solve.
     QuasiStatic,
     /// As [`Self::QuasiStatic`], with adaptive increments in the dynamic steps (see
@@ -85,10 +89,11 @@ pub enum BenchMethod {
 
 impl BenchMethod {
     /// Every method, in the order of the report.
-    pub const ALL: [Self; 5] = [
+    pub const ALL: [Self; 6] = [
         Self::Case,
         Self::Reduced,
         Self::Global,
+        Self::Adaptive,
         Self::QuasiStatic,
         Self::QuasiStaticAdaptive,
     ];
@@ -99,6 +104,7 @@ impl BenchMethod {
             Self::Case => "case",
             Self::Reduced => "reduced",
             Self::Global => "global",
+            Self::Adaptive => "adaptive",
             Self::QuasiStatic => "quasi-static",
             Self::QuasiStaticAdaptive => "quasi-static-adaptive",
         }
@@ -122,15 +128,21 @@ impl BenchMethod {
     /// reference.
     fn fixed_counterpart(self) -> Option<Self> {
         match self {
+            Self::Adaptive => Some(Self::Case),
             Self::QuasiStaticAdaptive => Some(Self::QuasiStatic),
             _ => None,
         }
     }
 
+    /// Whether the dynamic steps take adaptive increments.
+    fn is_adaptive(self) -> bool {
+        matches!(self, Self::Adaptive | Self::QuasiStaticAdaptive)
+    }
+
     /// Sets the case up to run by this method.
     fn apply(self, case: &mut Case) {
         let (solve, quasi_static) = match self {
-            Self::Case => (case.solver.contact_solve, case.pad.quasi_static),
+            Self::Case | Self::Adaptive => (case.solver.contact_solve, case.pad.quasi_static),
             Self::Reduced => (ContactSolveSpec::Reduced, case.pad.quasi_static),
             Self::Global => (ContactSolveSpec::Global, case.pad.quasi_static),
             Self::QuasiStatic | Self::QuasiStaticAdaptive => (ContactSolveSpec::Global, true),
@@ -236,7 +248,7 @@ pub fn level_case(case: &Case, factor: f64, method: BenchMethod) -> Case {
         } = step
         {
             *dt *= factor;
-            if method == BenchMethod::QuasiStaticAdaptive {
+            if method.is_adaptive() {
                 *adaptive = Some(adapt(*dt, *duration, factor));
             }
         }
@@ -448,12 +460,12 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
     md.push_str(
         "Each case at a ladder of time steps (every dynamic step's dt scaled alike) with each \
          method (`case`: the case as it is, with its own contact solve; `reduced` and \
-         `global`: the contact solves on the case as it is; \
-         `quasi-static`: the pad without inertia, global solve; `quasi-static-adaptive`: the \
-         same with adaptive increments, dt being the first one and the tolerance 1e-6 times \
-         the square of the level's dt ratio to the case's); the finest level of a case and \
-         method is its reference, and the adaptive method is measured against the finest \
-         `quasi-static` level where the bench runs it. Wall time: the \
+         `global`: the contact solves on the case as it is; `adaptive`: the case with adaptive \
+         increments, dt being the first one and the tolerance 1e-6 times the square of the \
+         level's dt ratio to the case's; `quasi-static`: the pad without inertia, global \
+         solve; `quasi-static-adaptive`: the same with adaptive increments); the finest level \
+         of a case and method is its reference, and the adaptive methods are measured against \
+         the finest `case` and `quasi-static` levels where the bench runs them. Wall time: the \
          solver's, median of the timed runs (runs under 2 s: one warm-up, then the repeats). \
          Errors against the reference: the deceleration (relative), e_slide (max |omega - \
          omega_ref| / omega0 over t <= 0.9 t_stop) and t_stop (relative; the pad vibration \
@@ -550,7 +562,7 @@ fn own_time_step(records: &[BenchRecord]) -> String {
 }
 
 /// What the quasi-static pad changes in the answer: for every case with both, the quasi-static
-/// reference against the dynamic one (the `reduced` reference, else the `global` one).
+/// reference against the dynamic one (the `reduced` reference, else the `global` one, else the `case` one).
 fn model_change(records: &[BenchRecord]) -> String {
     use crate::format::percent;
     use std::fmt::Write as _;
@@ -566,8 +578,9 @@ fn model_change(records: &[BenchRecord]) -> String {
         let Some(qs) = reference(case, BenchMethod::QuasiStatic) else {
             continue;
         };
-        let Some(dynamic) =
-            reference(case, BenchMethod::Reduced).or(reference(case, BenchMethod::Global))
+        let Some(dynamic) = reference(case, BenchMethod::Reduced)
+            .or(reference(case, BenchMethod::Global))
+            .or(reference(case, BenchMethod::Case))
         else {
             continue;
         };
@@ -657,6 +670,52 @@ mod tests {
             run_bench(&[], &bad, dir.path(), |_| ()),
             Err(BenchError::Settings(_))
         ));
+    }
+
+    /// The adaptive method runs the case as it is with adaptive increments, and is measured
+    /// against the finest level of the case run as written: none of its levels is a reference.
+    #[test]
+    fn adaptive_levels_are_measured_against_the_case_as_written() {
+        let text = include_str!("../../../cases/drum/2d-analytic.json");
+        let overrides = ["steps[1].duration=0.01".to_string()];
+        let file = PathBuf::from("2d-analytic.json");
+        let case = skid_cases::validate::parse_case(text, &file, &overrides).expect("case");
+        let adaptive = level_case(&case, 2.0, BenchMethod::Adaptive);
+        assert_eq!(adaptive.solver.contact_solve, case.solver.contact_solve);
+        assert_eq!(adaptive.pad.quasi_static, case.pad.quasi_static);
+        let Some(StepSpec::Dynamic {
+            dt,
+            adaptive: Some(spec),
+            ..
+        }) = adaptive.steps.last()
+        else {
+            panic!("an adaptive dynamic step: {:?}", adaptive.steps.last());
+        };
+        assert!((dt / 2e-4 - 1.0).abs() < 1e-12);
+        assert!((spec.tolerance / (4.0 * ADAPTIVE_TOLERANCE) - 1.0).abs() < 1e-12);
+        let dir = tempfile::tempdir().expect("tempdir");
+        let settings = BenchSettings {
+            levels: 2,
+            ratio: 4.0,
+            coarser: 1,
+            repeats: 1,
+            methods: vec![BenchMethod::Case, BenchMethod::Adaptive],
+        };
+        let records = run_bench(&[(case, file)], &settings, dir.path(), |_| ()).expect("bench");
+        let of = |method: BenchMethod| -> Vec<&BenchRecord> {
+            records
+                .iter()
+                .filter(|r| r.method == method.label())
+                .collect()
+        };
+        let (fixed, adaptive) = (of(BenchMethod::Case), of(BenchMethod::Adaptive));
+        assert_eq!((fixed.len(), adaptive.len()), (2, 2));
+        assert!(fixed[1].reference && !fixed[0].reference);
+        assert!(adaptive.iter().all(|r| !r.reference));
+        assert!(adaptive.iter().all(|r| r.status == "completed"));
+        // measured against the case's finest level, so not zero at its own finest
+        assert!(adaptive[1].deceleration_error.is_some_and(|e| e > 0.0));
+        assert_ne!(adaptive[1].increments, fixed[1].increments);
     }
 
     /// One level: each case at its own time step, by the case's own contact solve, with no
