@@ -616,15 +616,21 @@ mod tests {
         assert!(median(&[]).is_nan());
     }
 
+    /// `2d-analytic` with 10 ms of spin-down, and its file name.
+    fn short_2d_case() -> (Case, PathBuf) {
+        let text = include_str!("../../../cases/drum/2d-analytic.json");
+        let overrides = ["steps[1].duration=0.01".to_string()];
+        let file = PathBuf::from("2d-analytic.json");
+        let case = skid_cases::validate::parse_case(text, &file, &overrides).expect("case");
+        (case, file)
+    }
+
     /// A short 2D spin-down on two levels and one solve: the finest level is the reference
     /// with zero errors; the coarser one has a positive deceleration error; every run is
     /// timed `repeats` times; the records are written.
     #[test]
     fn ladder_measures_against_its_finest_level() {
-        let text = include_str!("../../../cases/drum/2d-analytic.json");
-        let overrides = ["steps[1].duration=0.01".to_string()];
-        let file = PathBuf::from("2d-analytic.json");
-        let case = skid_cases::validate::parse_case(text, &file, &overrides).expect("case");
+        let (case, file) = short_2d_case();
         let dir = tempfile::tempdir().expect("tempdir");
         let settings = BenchSettings {
             levels: 2,
@@ -676,10 +682,7 @@ mod tests {
     /// against the finest level of the case run as written: none of its levels is a reference.
     #[test]
     fn adaptive_levels_are_measured_against_the_case_as_written() {
-        let text = include_str!("../../../cases/drum/2d-analytic.json");
-        let overrides = ["steps[1].duration=0.01".to_string()];
-        let file = PathBuf::from("2d-analytic.json");
-        let case = skid_cases::validate::parse_case(text, &file, &overrides).expect("case");
+        let (case, file) = short_2d_case();
         let adaptive = level_case(&case, 2.0, BenchMethod::Adaptive);
         assert_eq!(adaptive.solver.contact_solve, case.solver.contact_solve);
         assert_eq!(adaptive.pad.quasi_static, case.pad.quasi_static);
