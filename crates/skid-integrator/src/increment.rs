@@ -325,19 +325,6 @@ fn solve_increment_with<const D: usize>(
         let f_ext = external_forces(model, &x, kind.loads())?;
         let net = &internal.force - &f_ext;
         let inertia = mass.component_mul(&a);
-        // The inertia of a dynamic increment is `M (x - x_pred) / (beta h^2)` plus terms of the
-        // start: the round-off of `x` reaches the residual amplified by `1 / (beta h^2)`, which
-        // on a very short increment exceeds the force tolerance (2e-5 of the forces on the
-        // spinning drum at h = 5e-8 s), so that Newton could never converge there.
-        let roundoff = match kind {
-            IncrementKind::Static { .. } => DVector::zeros(n),
-            IncrementKind::Dynamic { hht, h, .. } => {
-                let factor = ROUNDOFF_ULPS * f64::EPSILON * hht.mass_factor(h);
-                DVector::from_fn(n, |i, _| {
-                    factor * mass[i] * x[i].abs().max(start.x[i].abs())
-                })
-            }
-        };
         let mut residual = match kind {
             IncrementKind::Static { .. } => net.clone(),
             IncrementKind::Dynamic { hht, .. } => {
@@ -367,6 +354,20 @@ fn solve_increment_with<const D: usize>(
             let r = forces.r();
             let contact_force = rows.transpose_times(r, n);
             let full = &residual - &contact_force;
+            // The inertia of a dynamic increment is `M (x - x_pred) / (beta h^2)` plus terms
+            // of the start: the round-off of `x` reaches the residual amplified by
+            // `1 / (beta h^2)`, which on a very short increment exceeds the force tolerance
+            // (2e-5 of the forces on the spinning drum at h = 5e-8 s), so that Newton could
+            // never converge there.
+            let roundoff = match kind {
+                IncrementKind::Static { .. } => DVector::zeros(n),
+                IncrementKind::Dynamic { hht, h, .. } => {
+                    let factor = ROUNDOFF_ULPS * f64::EPSILON * hht.mass_factor(h);
+                    DVector::from_fn(n, |i, _| {
+                        factor * mass[i] * x[i].abs().max(start.x[i].abs())
+                    })
+                }
+            };
             let (force_residual, force_worst) = scaled_force_residual(
                 model,
                 &full,
