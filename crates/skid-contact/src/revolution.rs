@@ -139,10 +139,10 @@ impl RigidSurface for RigidRevolution {
         let b1 = self.chart.reference_direction();
         let (sin, cos) = (from.x / self.chart.radius()).sin_cos();
         let u = b1 * cos + e.cross(&b1) * sin;
-        let start = u * point.x + e * point.y;
+        let moved = y - (u * point.x + e * point.y);
         let tangents = [e.cross(&u), u * tangent.x + e * tangent.y];
         Slip {
-            value: Vector2::new(tangents[0].dot(&(y - start)), tangents[1].dot(&(y - start))),
+            value: Vector2::new(tangents[0].dot(&moved), tangents[1].dot(&moved)),
             gradient: tangents,
             hessian: [Matrix3::zeros(); 2],
         }

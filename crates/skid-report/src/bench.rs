@@ -134,9 +134,10 @@ impl BenchMethod {
         }
     }
 
-    /// Whether the dynamic steps take adaptive increments.
+    /// Whether the dynamic steps take adaptive increments: the methods measured against a
+    /// fixed-step counterpart.
     fn is_adaptive(self) -> bool {
-        matches!(self, Self::Adaptive | Self::QuasiStaticAdaptive)
+        self.fixed_counterpart().is_some()
     }
 
     /// Sets the case up to run by this method.
