@@ -254,8 +254,9 @@ pub enum RigidSurfaceSpec {
     /// `points`, back to the first point if `closed`. Its outward normal is each piece's
     /// direction turned clockwise (a closed chain counter-clockwise is contacted from outside,
     /// clockwise from inside; a counter-clockwise arc from outside its circle); the surface
-    /// coordinate is the arc length from the first point. Beyond an open chain's ends the gap
-    /// is the signed distance to the end point.
+    /// coordinate is the arc length from the first point. An open chain's ends are the
+    /// surface's edges: beyond them a point is off the surface, its gap the distance to the
+    /// end point (positive on either side), so a node that slides past an end leaves it.
     Polyline {
         /// Points `[x, y]`, m.
         points: Vec<[f64; 2]>,
@@ -272,7 +273,7 @@ pub enum RigidSurfaceSpec {
     /// `axis x reference` (`v`), swept along `axis` without end (back to the first point if
     /// `closed`). Its outside is on the right walking along the profile with `u` to the right
     /// and `v` up; the surface coordinates are the profile's arc length and the position along
-    /// `axis`.
+    /// `axis`. An open profile's ends are the surface's edges, as a polyline's.
     Extrusion {
         /// Sweep direction.
         axis: [f64; 3],
@@ -293,7 +294,9 @@ pub enum RigidSurfaceSpec {
     /// about `axis` through the origin. Its outside is on the right walking along the profile
     /// with `r` to the right and `z` up (the cylinder `r = R` is walked towards `+z`). The
     /// surface coordinates are the angle about the axis times `radius` and the profile's arc
-    /// length, so that slip is a length where `r = radius`.
+    /// length, so that slip is a length where `r = radius`. An open profile's ends off the
+    /// axis are the surface's edges, as a polyline's; an end on the axis is not (the surface
+    /// closes there).
     Revolution {
         /// Axis direction.
         axis: [f64; 3],
@@ -312,8 +315,9 @@ pub enum RigidSurfaceSpec {
         radius: Option<f64>,
     },
     /// Triangles (3D), counter-clockwise seen from outside, with surface coordinates read on
-    /// the `chart` at each closest point. Beyond an open mesh's boundary the gap is the signed
-    /// distance to the boundary.
+    /// the `chart` at each closest point. An open mesh's boundary (edges of one triangle only)
+    /// is the surface's edge: beyond it a point is off the surface, its gap the distance to the
+    /// boundary (positive on either side).
     Triangles {
         /// Vertices, m.
         vertices: Vec<[f64; 3]>,

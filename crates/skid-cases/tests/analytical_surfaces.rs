@@ -7,7 +7,9 @@
 //! lines that is no plane through the reference node, read to them (profiles in the body frame,
 //! listed as a polyline's), which the deck writer writes back; their `CIRCL` pieces are arcs
 //! (the 2D drum as four quarter circles spins down as the circle); inward closed profiles,
-//! arcs whose ends miss their circle and arcs of 180 degrees or more are refused.
+//! arcs whose ends miss their circle and arcs of 180 degrees or more are refused. An open
+//! surface ends at its edge: the pushed block slides off an extruded floor and off a floor of
+//! rigid elements, its nodes leaving the surface as they pass the edge.
 
 use std::path::{Path, PathBuf};
 
@@ -363,6 +365,84 @@ fn the_pushed_block_slides_on_an_extruded_line_as_on_the_plane() {
             );
         }
     }
+}
+
+/// The pushed block on an extruded floor that ends at x = 2 cm, 1 cm ahead of the block: the
+/// block slides past the floor's edge, and each node that has passed it leaves the surface
+/// (beyond an open profile's end a point is off the surface, whichever side of the floor's
+/// level it stands). (Signed by the floor's normal alone, the nodes past the edge count as
+/// penetrating the floor and are caught on it: the run fails.)
+#[test]
+fn the_pushed_block_leaves_an_extruded_floor_past_its_edge() {
+    let (_, floor) = pushed_block_on(
+        RigidSurfaceSpec::Extrusion {
+            axis: [0.0, 0.0, 1.0],
+            reference: [1.0, 0.0, 0.0],
+            // walked towards -x: the outside (on the right) is up
+            profile: vec![[0.02, 0.0], [-2.0, 0.0]],
+            centres: Vec::new(),
+            closed: false,
+        },
+        [0.0, 0.0, 0.0],
+    );
+    leaves_the_floor_past(&floor, 0.02);
+}
+
+/// The pushed block of the facet deck (its flat of R3D4 and R3D3 rigid elements) with the flat
+/// ending at x = 2 cm, for 30 ms: past the mesh's boundary the nodes leave the surface.
+#[test]
+fn the_pushed_block_leaves_a_mesh_floor_past_its_boundary() {
+    let deck = std::fs::read_to_string(repo(
+        "cases/verification/3d-block-pushed-on-facets-deck.inp",
+    ))
+    .expect("deck");
+    let mut cut = deck.replace("0.0005, 0.04", "0.0005, 0.03");
+    for node in ["44", "48", "52"] {
+        let line = |x: &str| {
+            let z = match node {
+                "44" => "-0.05",
+                "48" => "0.001",
+                _ => "0.05",
+            };
+            format!("\n{node}, {x}, 0.0, {z}\n")
+        };
+        assert!(cut.contains(&line("2.0")), "node {node}");
+        cut = cut.replace(&line("2.0"), &line("0.02"));
+    }
+    let model = read_deck_text(&cut).expect("deck");
+    leaves_the_floor_past(&model, 0.02);
+}
+
+/// Checks the run of `model`, the pushed block on a floor that ends at `x = edge` ahead of it:
+/// once the block is pressed, the closed contacts are those of the node columns still over the
+/// floor, three per column, all of them sliding once the block moves; the run sees the block on
+/// the floor, partly past its edge and wholly past it.
+fn leaves_the_floor_past(model: &ModelSpec, edge: f64) {
+    let column = |name: &str| history_column(model, name);
+    let (time, u, active, sliding) = (
+        column("time"),
+        column("plate.u_x"),
+        column("block-ground.active"),
+        column("block-ground.sliding"),
+    );
+    // the columns of bottom nodes, at x0 = -1, -0.5, 0, 0.5 and 1 cm
+    let columns = [-0.01, -0.005, 0.0, 0.005, 0.01];
+    let mut compared = [0; 6];
+    for (((t, u), active), sliding) in time.iter().zip(&u).zip(&active).zip(&sliding) {
+        // once pressed (the press ramps up over 10 ms); the block moves as a whole, and a
+        // column within 1 mm of the edge could go either way
+        if *t < 0.01 || columns.iter().any(|x0| (x0 + u - edge).abs() < 1e-3) {
+            continue;
+        }
+        let over = columns.iter().filter(|x0| *x0 + u < edge).count();
+        assert_eq!(*active, 3.0 * over as f64, "u_x = {u}");
+        if over > 0 && *u > 1e-3 {
+            assert_eq!(sliding, active, "u_x = {u}");
+        }
+        compared[over] += 1;
+    }
+    assert!(compared[5] > 0 && compared[0] > 0, "{compared:?}");
+    assert!(compared[1..5].iter().sum::<usize>() > 0, "{compared:?}");
 }
 
 /// The pushed block on the plane y = 0 given as a disc of revolution about the vertical axis

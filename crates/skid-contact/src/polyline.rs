@@ -193,7 +193,11 @@ impl PointDistance for Located {
 ///   (the pseudo-normal) and `s = sign((q - P_j).N_j)` (`+` on ties), `g = s |q - P_j|`,
 ///   `dg/dy = s (q - P_j)/|q - P_j|` (`N_j/|N_j|` when `|q - P_j| ~ 0`),
 ///   `d^2g/dy^2 = s (I - e_z e_z^T - dg/dy dg/dy^T)/|q - P_j|` (zero when `|q - P_j| ~ 0`),
-///   `xi_0 = s_j`, `d xi_0/dy = 0`.
+///   `xi_0 = s_j`, `d xi_0/dy = 0`. An open polyline's end vertex is the surface's edge: a point
+///   whose closest point it is lies beyond the surface, off it whichever side of the end piece's
+///   line it stands, so there `s = +1` (a node sliding past the end leaves the surface instead of
+///   being caught on it), unless the surface goes on beyond that end (see
+///   [`RigidPolyline::continued_at`]).
 ///
 /// Always `xi_1 = y_z`, `d xi_1/dy = e_z`; a closed polyline's `xi_0` has the period of its
 /// length. The gap is the signed distance, C1 across the pieces' ends on the outside. Equally
@@ -214,6 +218,9 @@ pub struct RigidPolyline {
     length: f64,
     /// Largest vertex norm, the length scale of round-off tolerances.
     scale: f64,
+    /// Whether the first and the last vertex are edges of the surface (an open polyline's
+    /// ends, unless continued).
+    edges: [bool; 2],
 }
 
 impl RigidPolyline {
@@ -353,7 +360,29 @@ impl RigidPolyline {
             tree,
             length: arc,
             scale,
+            edges: [!closed; 2],
         })
+    }
+
+    /// The polyline with its first (`end` 0) or last (`end` 1) vertex no edge: the surface it
+    /// stands for goes on beyond that end (as a profile of revolution does where it meets the
+    /// axis), so a point there is signed by the end's pseudo-normal like any vertex's.
+    pub(crate) fn continued_at(mut self, end: usize) -> Self {
+        if let Some(edge) = self.edges.get_mut(end) {
+            *edge = false;
+        }
+        self
+    }
+
+    /// The first and the last vertex.
+    pub(crate) fn ends(&self) -> [Vector2<f64>; 2] {
+        let last = self.vertices.len() - 1;
+        [self.vertices[0], self.vertices[last]]
+    }
+
+    /// Whether vertex `j` is an edge of the surface (see [`RigidPolyline::continued_at`]).
+    fn is_edge(&self, j: usize) -> bool {
+        (j == 0 && self.edges[0]) || (j + 1 == self.vertices.len() && self.edges[1])
     }
 
     /// The axis-aligned box `(low, high)` holding every piece.
@@ -572,7 +601,7 @@ impl RigidSurface for RigidPolyline {
             Feature::Vertex(j) => {
                 let offset = q - closest.point;
                 let pseudo = self.vertex_normals[j];
-                let sign = if offset.dot(&pseudo) >= 0.0 {
+                let sign = if self.is_edge(j) || offset.dot(&pseudo) >= 0.0 {
                     1.0
                 } else {
                     -1.0
@@ -701,6 +730,34 @@ mod tests {
         ] {
             check_gradients(&floor, &y, 1e-6);
         }
+    }
+
+    /// Beyond an open end the point is off the surface: its gap is its distance to the end
+    /// vertex, positive on either side of the end piece's line (below it, the end piece's
+    /// normal alone would sign it as a penetration and catch a node sliding past the end),
+    /// with the derivatives of that distance; under the surface within its extent the gap is
+    /// still negative. An end the surface continues beyond is signed by its normal.
+    #[test]
+    fn an_open_end_is_the_surface_edge() -> Result<(), ContactError> {
+        let floor = step_floor();
+        for (y, end) in [
+            // beyond the first vertex (2, 0.2), below the level of its piece
+            (Vector3::new(2.3, 0.1, 0.0), Vector2::new(2.0, 0.2)),
+            // beyond the last vertex (-1, 0), below the floor
+            (Vector3::new(-1.2, -0.05, 0.1), Vector2::new(-1.0, 0.0)),
+        ] {
+            let p = project(&floor, &y);
+            let offset = y.xy() - end;
+            assert!((p.gap - offset.norm()).abs() < 1e-15, "{y:?}: {}", p.gap);
+            assert!((p.gap_gradient - lift(&offset.normalize())).norm() < 1e-15);
+            check_gradients(&floor, &y, 1e-6);
+        }
+        let under = project(&floor, &Vector3::new(1.9, 0.1, 0.0));
+        assert!((under.gap + 0.1).abs() < 1e-15);
+        let continued = step_floor().continued_at(0);
+        let caught = project(&continued, &Vector3::new(2.3, 0.1, 0.0));
+        assert!((caught.gap + (0.3_f64.hypot(0.1))).abs() < 1e-15);
+        Ok(())
     }
 
     /// At a convex corner the gap is the distance to the vertex and the arc length stays at

@@ -24,7 +24,9 @@ use crate::surface::{
 /// on the surface where `r = R`, and `r/R` of one elsewhere), and `xi_1 = s`, the profile's arc
 /// length; friction measures slip in lengths in the tangent plane of the increment's start
 /// point instead (see [`RigidSurface::slip`] below). On the axis the point is taken a round-off
-/// distance off it (see [`RigidSurface::project`] below).
+/// distance off it (see [`RigidSurface::project`] below). An open profile's ends off the axis
+/// are the surface's edges (see [`RigidPolyline`]); an end on the axis is not, since the
+/// revolved surface closes there.
 #[derive(Clone, Debug)]
 pub struct RigidRevolution {
     profile: RigidPolyline,
@@ -56,8 +58,16 @@ impl RigidRevolution {
                 low.x
             )));
         }
+        let size = low.abs().sup(&high.abs()).max();
+        // an end on the axis is no edge: the revolved surface closes there
+        let mut profile = profile;
+        for (end, point) in profile.ends().into_iter().enumerate() {
+            if point.x <= ON_AXIS * size {
+                profile = profile.continued_at(end);
+            }
+        }
         Ok(Self {
-            size: low.abs().sup(&high.abs()).max(),
+            size,
             profile,
             chart: AnalyticCylinder::new(radius, axis)?,
         })
@@ -250,6 +260,27 @@ mod tests {
         for k in 0..2 {
             assert!((change[k] - still.gradient[k].dot(&h)).abs() < 1e-15);
         }
+    }
+
+    /// A profile's end on the axis is no edge, its end off the axis is: under the apex of a
+    /// cone whose solid lies below it (the profile walked down to the axis) a point is inside,
+    /// while beyond the cone's rim, below its level, a point is off the surface.
+    #[test]
+    fn only_the_ends_off_the_axis_are_edges() -> Result<(), ContactError> {
+        let cone = RigidRevolution::new(
+            Vector3::z(),
+            RigidPolyline::new(vec![Vector2::new(1.0, 1.0), Vector2::zeros()], false)?,
+            1.0,
+        )?;
+        for y in [Vector3::new(0.0, 0.0, -0.1), Vector3::new(0.05, 0.0, -0.2)] {
+            let p = project(&cone, &y);
+            assert!((p.gap + y.norm()).abs() < 1e-12, "{y:?}: {}", p.gap);
+        }
+        // beyond the rim r = 1, z = 1 along the profile, below the cone's surface
+        let beyond = Vector3::new(0.0, 1.2, 1.1);
+        let p = project(&cone, &beyond);
+        assert!((p.gap - 0.2_f64.hypot(0.1)).abs() < 1e-12, "{}", p.gap);
+        Ok(())
     }
 
     /// The straight profile r = R is the analytical cylinder: the same gap, coordinates (the

@@ -102,6 +102,10 @@ struct Triangle {
     /// Pseudo-normal of corner `i`: `sum_t alpha_t n_t` over incident triangles `t`, `alpha_t` the
     /// triangle's angle at the corner.
     vertex_normals: [Vector3<f64>; 3],
+    /// Whether edge `i` is on the mesh's boundary (no other triangle has it).
+    boundary_edges: [bool; 3],
+    /// Whether corner `i` is on the mesh's boundary (on a boundary edge of any triangle).
+    boundary_corners: [bool; 3],
     /// Centroid, for the tests' orientation checks.
     #[cfg(test)]
     centre: Vector3<f64>,
@@ -208,6 +212,16 @@ impl PointDistance for Located {
 }
 
 impl Triangle {
+    /// Whether `feature` lies on the mesh's boundary: an edge of this triangle only, or a
+    /// corner on such an edge.
+    fn on_boundary(&self, feature: Feature) -> bool {
+        match feature {
+            Feature::Face => false,
+            Feature::Edge(i) => self.boundary_edges[i],
+            Feature::Vertex(i) => self.boundary_corners[i],
+        }
+    }
+
     fn pseudo_normal(&self, feature: Feature) -> Vector3<f64> {
         match feature {
             Feature::Face => self.normal,
@@ -243,8 +257,11 @@ impl Triangle {
 ///   `0` (vertex), and, `p` being affine in `y` within a region,
 ///   `d^2 xi/dy^2 = (dp/dy)^T (d^2 xi/dp^2) dp/dy`.
 ///
-/// The sign is that of a closed, consistently oriented mesh; on an open mesh it is only
-/// meaningful near the surface. Equally distant features (to round-off) resolve to the face,
+/// The sign is that of a closed, consistently oriented mesh. An open mesh's boundary (the edges
+/// of one triangle only and their corners) is the surface's edge: a point whose closest feature
+/// lies on it is beyond the surface, off it whichever side of the boundary triangle's plane it
+/// stands, so there `s = +1` (a node sliding past the edge leaves the surface instead of being
+/// caught on it). Equally distant features (to round-off) resolve to the face,
 /// then the edge, then the lowest triangle index. The projection is undefined (`None`) if `p`
 /// lies on a cylinder chart's axis.
 ///
@@ -302,15 +319,22 @@ impl TriangulatedSurface {
             }
             normals.push(cross.normalize());
         }
-        let mut edge_sums: BTreeMap<(usize, usize), Vector3<f64>> = BTreeMap::new();
+        // each edge's pseudo-normal and the number of triangles that have it
+        let mut edge_sums: BTreeMap<(usize, usize), (Vector3<f64>, usize)> = BTreeMap::new();
         let mut vertex_sums = vec![Vector3::zeros(); vertices.len()];
         for (tri, normal) in triangles.iter().zip(&normals) {
             for i in 0..3 {
                 let (a, b, c) = (tri[i], tri[(i + 1) % 3], tri[(i + 2) % 3]);
-                *edge_sums.entry((a.min(b), a.max(b))).or_default() += normal;
+                let sum = edge_sums.entry((a.min(b), a.max(b))).or_default();
+                *sum = (sum.0 + normal, sum.1 + 1);
                 let angle = (vertices[b] - vertices[a]).angle(&(vertices[c] - vertices[a]));
                 vertex_sums[a] += normal * angle;
             }
+        }
+        let mut boundary_vertices = vec![false; vertices.len()];
+        for (&(a, b), _) in edge_sums.iter().filter(|(_, (_, count))| *count == 1) {
+            boundary_vertices[a] = true;
+            boundary_vertices[b] = true;
         }
         let built = triangles
             .iter()
@@ -322,13 +346,16 @@ impl TriangulatedSurface {
                     edge_sums
                         .get(&(a.min(b), a.max(b)))
                         .copied()
-                        .unwrap_or(*normal)
+                        .unwrap_or((*normal, 1))
                 };
+                let edges = [edge(0), edge(1), edge(2)];
                 Triangle {
                     corners,
                     normal: *normal,
-                    edge_normals: [edge(0), edge(1), edge(2)],
+                    edge_normals: edges.map(|(sum, _)| sum),
                     vertex_normals: tri.map(|i| vertex_sums[i]),
+                    boundary_edges: edges.map(|(_, count)| count == 1),
+                    boundary_corners: tri.map(|i| boundary_vertices[i]),
                     #[cfg(test)]
                     centre: (corners[0] + corners[1] + corners[2]) / 3.0,
                 }
@@ -447,7 +474,7 @@ impl RigidSurface for TriangulatedSurface {
         } else {
             let offset = y - closest.point;
             let pseudo = triangle.pseudo_normal(closest.feature);
-            let sign = if offset.dot(&pseudo) >= 0.0 {
+            let sign = if triangle.on_boundary(closest.feature) || offset.dot(&pseudo) >= 0.0 {
                 1.0
             } else {
                 -1.0
@@ -530,6 +557,40 @@ mod tests {
 
     fn drum_72() -> FacetedCylinder {
         FacetedCylinder::new(R, Vector3::z(), 72, PI / 72.0).expect("drum")
+    }
+
+    /// An open mesh's boundary is the surface's edge: a point beyond a boundary edge or corner
+    /// is off the surface, its gap the distance to that edge or corner, positive below the
+    /// floor's plane as above it (the boundary triangle's normal alone would sign it as a
+    /// penetration); within the floor's extent a point below it penetrates.
+    #[test]
+    fn an_open_mesh_boundary_is_the_surface_edge() -> Result<(), ContactError> {
+        let vertices = vec![
+            Vector3::new(-1.0, -1.0, 0.0),
+            Vector3::new(1.0, -1.0, 0.0),
+            Vector3::new(1.0, 1.0, 0.0),
+            Vector3::new(-1.0, 1.0, 0.0),
+        ];
+        let floor = TriangulatedSurface::new(vertices, vec![[0, 1, 2], [0, 2, 3]], z_chart(1.0))?;
+        for (y, nearest) in [
+            // beyond the edge x = 1, below the plane
+            (Vector3::new(1.5, 0.2, -0.2), Vector3::new(1.0, 0.2, 0.0)),
+            // beyond the corner (1, 1)
+            (Vector3::new(1.5, 1.5, -0.1), Vector3::new(1.0, 1.0, 0.0)),
+            // beyond the edge y = -1, above the plane
+            (Vector3::new(0.3, -1.4, 0.3), Vector3::new(0.3, -1.0, 0.0)),
+        ] {
+            let p = project(&floor, &y);
+            assert_relative_eq!(p.gap, (y - nearest).norm(), epsilon = 1e-15);
+            assert_relative_eq!(p.gap_gradient, (y - nearest).normalize(), epsilon = 1e-15);
+            check_gradients(&floor, &y, 1e-6);
+        }
+        assert_relative_eq!(
+            project(&floor, &Vector3::new(0.5, 0.2, -0.1)).gap,
+            -0.1,
+            epsilon = 1e-15
+        );
+        Ok(())
     }
 
     /// A tilted floor of two triangles, `z = 0.1 x` over `[-1, 1]^2`, with the plane chart of
@@ -654,15 +715,17 @@ mod tests {
             z_chart(0.5),
         )
         .expect("triangle");
-        // (point relative to o, closest point relative to o, signed distance)
+        // (point relative to o, closest point relative to o, signed distance); the edges and
+        // corners of a lone triangle are all its boundary, so beyond them the gap is the
+        // distance, below the plane as above it
         let cases = [
             ((0.2, 0.3, 0.5), (0.2, 0.3, 0.0), 0.5),   // face, above
             ((0.2, 0.3, -0.5), (0.2, 0.3, 0.0), -0.5), // face, below
             ((0.5, -0.3, 0.4), (0.5, 0.0, 0.0), 0.5),  // edge ab
             ((0.8, 0.8, 0.1), (0.5, 0.5, 0.0), 0.19f64.sqrt()), // edge bc
-            ((-0.3, 0.5, -0.4), (0.0, 0.5, 0.0), -0.5), // edge ca
+            ((-0.3, 0.5, -0.4), (0.0, 0.5, 0.0), 0.5), // edge ca, below
             ((-0.2, -0.1, 0.2), (0.0, 0.0, 0.0), 0.3), // vertex a
-            ((1.3, -0.4, -1.2), (1.0, 0.0, 0.0), -1.3), // vertex b
+            ((1.3, -0.4, -1.2), (1.0, 0.0, 0.0), 1.3), // vertex b, below
             ((-0.3, 1.4, 1.2), (0.0, 1.0, 0.0), 1.3),  // vertex c
         ];
         for ((yx, yy, yz), (px, py, pz), gap) in cases {
