@@ -397,15 +397,9 @@ fn the_pushed_block_leaves_a_mesh_floor_past_its_boundary() {
     ))
     .expect("deck");
     let mut cut = deck.replace("0.0005, 0.04", "0.0005, 0.03");
-    for node in ["44", "48", "52"] {
-        let line = |x: &str| {
-            let z = match node {
-                "44" => "-0.05",
-                "48" => "0.001",
-                _ => "0.05",
-            };
-            format!("\n{node}, {x}, 0.0, {z}\n")
-        };
+    // the flat's vertices at x = 2 m: node number and z
+    for (node, z) in [(44, "-0.05"), (48, "0.001"), (52, "0.05")] {
+        let line = |x: &str| format!("\n{node}, {x}, 0.0, {z}\n");
         assert!(cut.contains(&line("2.0")), "node {node}");
         cut = cut.replace(&line("2.0"), &line("0.02"));
     }

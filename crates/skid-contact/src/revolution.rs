@@ -48,7 +48,7 @@ impl RigidRevolution {
     /// or radius.
     pub fn new(
         axis: Vector3<f64>,
-        profile: RigidPolyline,
+        mut profile: RigidPolyline,
         radius: f64,
     ) -> Result<Self, ContactError> {
         let (low, high) = profile.bounds();
@@ -60,7 +60,6 @@ impl RigidRevolution {
         }
         let size = low.abs().sup(&high.abs()).max();
         // an end on the axis is no edge: the revolved surface closes there
-        let mut profile = profile;
         for (end, point) in profile.ends().into_iter().enumerate() {
             if point.x <= ON_AXIS * size {
                 profile = profile.continued_at(end);
