@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 
 use nalgebra::{Matrix3, Vector3};
-use rstar::{AABB, PointDistance, RTree, RTreeObject};
+use rstar::{AABB, ParentNode, RTree, RTreeNode, RTreeObject};
 
 use crate::error::ContactError;
 use crate::facets::FacetedCylinder;
@@ -195,19 +195,6 @@ impl RTreeObject for Located {
     fn envelope(&self) -> Self::Envelope {
         let [a, b, c] = self.corners;
         AABB::from_corners(a.inf(&b).inf(&c).into(), a.sup(&b).sup(&c).into())
-    }
-}
-
-impl PointDistance for Located {
-    /// Square of the exact distance of [`closest`]; a NaN (only from overflowing coordinates)
-    /// counts as infinitely far, as the tree needs an order.
-    fn distance_2(&self, point: &[f64; 3]) -> f64 {
-        let distance = self.closest(&Vector3::from(*point)).distance;
-        if distance.is_nan() {
-            f64::INFINITY
-        } else {
-            distance * distance
-        }
     }
 }
 
@@ -428,21 +415,45 @@ impl TriangulatedSurface {
     /// one replaces it if nearer by more than `tolerance`, or no more than `tolerance` farther
     /// with a higher-ranked feature (face, then edge, then vertex).
     ///
-    /// Only the candidates are scanned: the triangles the tree yields nearest first, up to the
-    /// first one more than `2 tolerance` farther than all before it. Each triangle left out is
-    /// then more than `2 tolerance` farther than every candidate, so it never replaces one, while
-    /// every candidate replaces it; leaving it out does not change the result. This holds for a
-    /// `tolerance` above the round-off of the distances, as in [`RigidSurface::project`].
+    /// Only the candidates are scanned: the chain of ties from the nearest triangle (with the
+    /// triangles' distances sorted, those up to the first gap wider than `2 tolerance`). Each
+    /// triangle left out is then more than `2 tolerance` farther than every candidate, so it
+    /// never replaces one, while every candidate replaces it; leaving it out does not change
+    /// the result. This holds for a `tolerance` above the round-off of the distances, as in
+    /// [`RigidSurface::project`].
+    ///
+    /// The chain is found in the tree without ordering it: a greedy descent to the leaf of the
+    /// nearest boxes bounds the nearest distance from above, the triangles within that bound
+    /// (and `2 tolerance`) are collected by boxes, and the bound widens while the chain reaches
+    /// it.
     fn nearest(&self, y: &Vector3<f64>, tolerance: f64) -> Option<(usize, Closest)> {
+        let point = [y.x, y.y, y.z];
+        let box_distance = |node: &RTreeNode<Located>| node.envelope().distance_2(&point);
+        let mut node = self.tree.root();
+        let bound = loop {
+            let nearest = (node.children().iter())
+                .min_by(|a, b| box_distance(a).total_cmp(&box_distance(b)))?;
+            match nearest {
+                RTreeNode::Parent(parent) => node = parent,
+                RTreeNode::Leaf(located) => break located.closest(y).distance,
+            }
+        };
+        let mut reach = bound + 2.0 * tolerance;
         let mut candidates: Vec<(usize, Closest)> = Vec::new();
-        let mut farthest = f64::NEG_INFINITY;
-        for located in self.tree.nearest_neighbor_iter(&[y.x, y.y, y.z]) {
-            let closest = located.closest(y);
-            if !candidates.is_empty() && closest.distance > farthest + 2.0 * tolerance {
+        loop {
+            candidates.clear();
+            collect_within(self.tree.root(), y, reach, &mut candidates);
+            candidates.sort_unstable_by(|a, b| a.1.distance.total_cmp(&b.1.distance));
+            let chain = 1
+                + (candidates.windows(2))
+                    .take_while(|pair| pair[1].1.distance <= pair[0].1.distance + 2.0 * tolerance)
+                    .count();
+            let last = candidates.get(chain - 1)?.1.distance;
+            if chain < candidates.len() || last + 2.0 * tolerance <= reach {
+                candidates.truncate(chain);
                 break;
             }
-            farthest = farthest.max(closest.distance);
-            candidates.push((located.index, closest));
+            reach = last + 2.0 * tolerance;
         }
         candidates.sort_unstable_by_key(|(index, _)| *index);
         candidates.into_iter().reduce(|best, candidate| {
@@ -452,6 +463,32 @@ impl TriangulatedSurface {
                 best
             }
         })
+    }
+}
+
+/// Every triangle under `node` within `reach` of `y` (its box first, then its closest point),
+/// with its closest point, into `out`.
+fn collect_within(
+    node: &ParentNode<Located>,
+    y: &Vector3<f64>,
+    reach: f64,
+    out: &mut Vec<(usize, Closest)>,
+) {
+    let point = [y.x, y.y, y.z];
+    let squared = reach * reach;
+    for child in node.children() {
+        if child.envelope().distance_2(&point) > squared {
+            continue;
+        }
+        match child {
+            RTreeNode::Parent(parent) => collect_within(parent, y, reach, out),
+            RTreeNode::Leaf(located) => {
+                let closest = located.closest(y);
+                if closest.distance <= reach {
+                    out.push((located.index, closest));
+                }
+            }
+        }
     }
 }
 
