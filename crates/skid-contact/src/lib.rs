@@ -9,6 +9,7 @@
 //! * [`extrusion`]: a profile of straight segments swept along an axis (3D).
 //! * [`facets`]: the faceted cylinder (rigid line, quad, membrane or shell facets of a drum).
 //! * [`triangles`]: triangulated surfaces (exterior faces of a tetrahedral drum).
+//! * `search`: the closest-piece search of the polyline's and the triangles' R*-trees.
 //! * [`kinematics`]: gap, convected coordinates and their exact first derivatives for a slave node
 //!   against a surface carried by a body rotating about a fixed axis; slip increments unwrapped
 //!   across periodic coordinates.
@@ -25,6 +26,7 @@ pub mod kinematics;
 pub mod plane;
 pub mod polyline;
 pub mod revolution;
+mod search;
 pub mod surface;
 pub mod triangles;
 

@@ -5,9 +5,10 @@
 use std::f64::consts::PI;
 
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
-use rstar::{AABB, PointDistance, RTree, RTreeObject};
+use rstar::{AABB, RTree, RTreeObject};
 
 use crate::error::ContactError;
+use crate::search::nearest_chain;
 use crate::surface::{Projection, RigidSurface, SurfaceShape};
 
 /// The circle an arc piece follows.
@@ -158,17 +159,6 @@ impl RTreeObject for Located {
     fn envelope(&self) -> Self::Envelope {
         let (low, high) = self.segment.bounds();
         AABB::from_corners([low.x, low.y], [high.x, high.y])
-    }
-}
-
-impl PointDistance for Located {
-    /// Square of the exact distance to the piece (a NaN counts as infinitely far).
-    fn distance_2(&self, point: &[f64; 2]) -> f64 {
-        let (_, _, d) = self
-            .segment
-            .closest(&Vector2::new(point[0], point[1]), 0.0, [false; 2]);
-        let d = d * d;
-        if d.is_nan() { f64::INFINITY } else { d }
     }
 }
 
@@ -450,20 +440,14 @@ impl RigidPolyline {
 
     /// The closest feature over all segments, as a scan in segment order finds it: a later
     /// segment replaces the best so far if nearer by more than `tolerance`, or no more than
-    /// `tolerance` farther with its interior against a vertex. Only the segments the tree
-    /// yields nearest first are scanned, up to the first one more than `2 tolerance` farther
-    /// than all before it (one left out could never replace a candidate).
+    /// `tolerance` farther with its interior against a vertex. Only the segments in the chain of
+    /// ties from the nearest are scanned ([`crate::search::nearest_chain`]; one left out could
+    /// never replace a candidate).
     fn nearest(&self, q: &Vector2<f64>, tolerance: f64) -> Option<Closest> {
-        let mut candidates: Vec<Closest> = Vec::new();
-        let mut farthest = f64::NEG_INFINITY;
-        for located in self.tree.nearest_neighbor_iter(&[q.x, q.y]) {
+        let mut candidates = nearest_chain(&self.tree, [q.x, q.y], tolerance, |located| {
             let closest = self.closest_on(located.index, q, tolerance);
-            if !candidates.is_empty() && closest.distance > farthest + 2.0 * tolerance {
-                break;
-            }
-            farthest = farthest.max(closest.distance);
-            candidates.push(closest);
-        }
+            (closest, closest.distance)
+        });
         candidates.sort_unstable_by_key(|c| c.segment);
         let interior = |c: &Closest| matches!(c.feature, Feature::Interior(_));
         candidates.into_iter().reduce(|best, c| {

@@ -4,11 +4,12 @@
 use std::collections::BTreeMap;
 
 use nalgebra::{Matrix3, Vector3};
-use rstar::{AABB, ParentNode, RTree, RTreeNode, RTreeObject};
+use rstar::{AABB, RTree, RTreeObject};
 
 use crate::error::ContactError;
 use crate::facets::FacetedCylinder;
 use crate::plane::RigidPlane;
+use crate::search::nearest_chain;
 use crate::surface::{AnalyticCylinder, Projection, RigidSurface, SurfaceShape};
 
 /// Cylinder whose coordinates label points of a triangulated drum: `xi_0 = R atan2(p.b2, p.b1)`,
@@ -415,46 +416,17 @@ impl TriangulatedSurface {
     /// one replaces it if nearer by more than `tolerance`, or no more than `tolerance` farther
     /// with a higher-ranked feature (face, then edge, then vertex).
     ///
-    /// Only the candidates are scanned: the chain of ties from the nearest triangle (with the
-    /// triangles' distances sorted, those up to the first gap wider than `2 tolerance`). Each
-    /// triangle left out is then more than `2 tolerance` farther than every candidate, so it
-    /// never replaces one, while every candidate replaces it; leaving it out does not change
-    /// the result. This holds for a `tolerance` above the round-off of the distances, as in
-    /// [`RigidSurface::project`].
-    ///
-    /// The chain is found in the tree without ordering it: a greedy descent to the leaf of the
-    /// nearest boxes bounds the nearest distance from above, the triangles within that bound
-    /// (and `2 tolerance`) are collected by boxes, and the bound widens while the chain reaches
-    /// it.
+    /// Only the candidates are scanned: the chain of ties from the nearest triangle
+    /// ([`crate::search::nearest_chain`]). Each triangle left out is then more than
+    /// `2 tolerance` farther than every candidate, so it never replaces one, while every
+    /// candidate replaces it; leaving it out does not change the result. This holds for a
+    /// `tolerance` above the round-off of the distances, as in [`RigidSurface::project`].
     fn nearest(&self, y: &Vector3<f64>, tolerance: f64) -> Option<(usize, Closest)> {
-        let point = [y.x, y.y, y.z];
-        let box_distance = |node: &RTreeNode<Located>| node.envelope().distance_2(&point);
-        let mut node = self.tree.root();
-        let bound = loop {
-            let nearest = (node.children().iter())
-                .min_by(|a, b| box_distance(a).total_cmp(&box_distance(b)))?;
-            match nearest {
-                RTreeNode::Parent(parent) => node = parent,
-                RTreeNode::Leaf(located) => break located.closest(y).distance,
-            }
-        };
-        let mut reach = bound + 2.0 * tolerance;
-        let mut candidates: Vec<(usize, Closest)> = Vec::new();
-        loop {
-            candidates.clear();
-            collect_within(self.tree.root(), y, reach, &mut candidates);
-            candidates.sort_unstable_by(|a, b| a.1.distance.total_cmp(&b.1.distance));
-            let chain = 1
-                + (candidates.windows(2))
-                    .take_while(|pair| pair[1].1.distance <= pair[0].1.distance + 2.0 * tolerance)
-                    .count();
-            let last = candidates.get(chain - 1)?.1.distance;
-            if chain < candidates.len() || last + 2.0 * tolerance <= reach {
-                candidates.truncate(chain);
-                break;
-            }
-            reach = last + 2.0 * tolerance;
-        }
+        let mut candidates = nearest_chain(&self.tree, [y.x, y.y, y.z], tolerance, |located| {
+            let closest = located.closest(y);
+            let distance = closest.distance;
+            ((located.index, closest), distance)
+        });
         candidates.sort_unstable_by_key(|(index, _)| *index);
         candidates.into_iter().reduce(|best, candidate| {
             if candidate.1.replaces(&best.1, tolerance) {
@@ -463,32 +435,6 @@ impl TriangulatedSurface {
                 best
             }
         })
-    }
-}
-
-/// Every triangle under `node` within `reach` of `y` (its box first, then its closest point),
-/// with its closest point, into `out`.
-fn collect_within(
-    node: &ParentNode<Located>,
-    y: &Vector3<f64>,
-    reach: f64,
-    out: &mut Vec<(usize, Closest)>,
-) {
-    let point = [y.x, y.y, y.z];
-    let squared = reach * reach;
-    for child in node.children() {
-        if child.envelope().distance_2(&point) > squared {
-            continue;
-        }
-        match child {
-            RTreeNode::Parent(parent) => collect_within(parent, y, reach, out),
-            RTreeNode::Leaf(located) => {
-                let closest = located.closest(y);
-                if closest.distance <= reach {
-                    out.push((located.index, closest));
-                }
-            }
-        }
     }
 }
 
