@@ -329,10 +329,12 @@ pub enum RigidSurfaceSpec {
 }
 
 /// The surface coordinates of a triangle mesh: those of its closest point read on a cylinder or a
-/// plane through the body origin. Friction measures slip in these coordinates, so they are
-/// lengths on the mesh only where the mesh lies on the chart: a flat mesh on its plane chart
-/// exactly, a faceted drum on its cylinder up to the facets' chord (`1 - cos(pi / n)`, 1e-3
-/// for 72 facets).
+/// plane through the body origin. On a cylinder chart friction measures slip in these
+/// coordinates, which are lengths on the mesh only where it lies on the cylinder (a faceted drum
+/// up to the facets' chord, `1 - cos(pi / n)`, 1e-3 for 72 facets). On a plane chart the
+/// coordinates only label points, and slip is measured in lengths in the tangent plane at the
+/// contact point where each increment starts, whatever the mesh's shape (any curved mesh, or a
+/// chart plane sloped against the mesh).
 #[derive(Clone, Debug, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ChartSpec {

@@ -36,7 +36,7 @@ pub const RESTART_JSON: &str = "restart.json";
 /// Converged increments between restart files when the command line does not say.
 pub const DEFAULT_RESTART_EVERY: usize = 100;
 /// Version of the restart file's layout.
-pub const RESTART_FORMAT: u32 = 5;
+pub const RESTART_FORMAT: u32 = 6;
 
 /// The input a run was started with: the file in its output directory and its hash.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]

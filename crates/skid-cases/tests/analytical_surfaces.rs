@@ -28,7 +28,7 @@ use skid_cases::deck::write::write_deck;
 use skid_cases::drum::model_spec;
 use skid_cases::load_case;
 use skid_cases::model_file::parse_model;
-use skid_cases::model_spec::{ModelSpec, RigidSurfaceSpec};
+use skid_cases::model_spec::{ChartSpec, ModelSpec, RigidSurfaceSpec};
 use skid_cases::runner::run_model;
 
 fn repo(path: &str) -> PathBuf {
@@ -363,6 +363,42 @@ fn the_pushed_block_slides_on_an_extruded_line_as_on_the_plane() {
                 (x.abs() - y.abs()).abs() <= 1e-9 * scale,
                 "{name}: {x} against {y}"
             );
+        }
+    }
+}
+
+/// The pushed block on the plane y = 0 given as two triangles whose plane chart is tilted by
+/// atan(1/2) about z against them: its first coordinate's increments are `cos a = 0.894` times
+/// the lengths slid along x. Slip is measured in lengths in the tangent plane of each
+/// increment's start point, so the block slides as on the plane (weighed by the chart's
+/// coordinates, friction would be 0.894 mu N and the block would move further).
+#[test]
+fn the_pushed_block_slides_on_a_mesh_with_a_tilted_chart_as_on_the_plane() {
+    let (plane, mesh) = pushed_block_on(
+        RigidSurfaceSpec::Triangles {
+            vertices: vec![
+                [-2.0, 0.0, -0.05],
+                [-2.0, 0.0, 0.05],
+                [2.0, 0.0, 0.05],
+                [2.0, 0.0, -0.05],
+            ],
+            // counter-clockwise seen from +y
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            chart: ChartSpec::Plane {
+                normal: [0.5, 1.0, 0.0],
+                tangent: [1.0, 0.0, 0.0],
+            },
+        },
+        [0.0, 0.0, 0.0],
+    );
+    let column = history_column;
+    for name in ["plate.u_x", "block-ground.tangential_force_1"] {
+        let (a, b) = (column(&plane, name), column(&mesh, name));
+        assert_eq!(a.len(), b.len());
+        let scale = a.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        assert!(scale > 0.0, "{name} moves");
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() <= 1e-9 * scale, "{name}: {x} against {y}");
         }
     }
 }

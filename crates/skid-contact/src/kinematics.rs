@@ -14,7 +14,7 @@
 
 use nalgebra::{Matrix3, Rotation3, Unit, Vector2, Vector3};
 
-use crate::surface::{DiscreteGradient, RigidSurface};
+use crate::surface::{DiscreteGradient, RigidSurface, SurfacePoint};
 
 /// Placement of a rigid body rotating about a fixed axis.
 #[derive(Clone, Copy, Debug)]
@@ -60,14 +60,14 @@ impl RotatingFrame {
     }
 }
 
-/// Gap, slip and their exact first and second derivatives for one slave node, with the
-/// convected coordinates of its closest point.
+/// Gap, slip and their exact first and second derivatives for one slave node, with its closest
+/// point.
 #[derive(Clone, Debug)]
 pub struct ContactKinematics {
     /// Signed gap `g` (`> 0` open).
     pub gap: f64,
-    /// Convected surface coordinates `xi` of the closest point (body frame).
-    pub coords: Vector2<f64>,
+    /// The closest point on the surface (body frame): where the next increment's slip starts.
+    pub closest: SurfacePoint,
     /// The slip `s` since the contact point the kinematics were evaluated from (see
     /// [`RigidSurface::slip`]): two lengths along the surface.
     pub slip: Vector2<f64>,
@@ -87,9 +87,10 @@ pub struct ContactKinematics {
     pub d2_dangle2: [f64; 3],
 }
 
-/// Evaluate gap, slip since the contact point of convected coordinates `from` (see
-/// [`RigidSurface::slip`]) and their exact first and second derivatives for a node at world
-/// position `x` (2D problems pass `z = 0` and a `z` axis).
+/// Evaluate gap, slip since the contact point `from` (see [`RigidSurface::slip`]; `None`: since
+/// the node's own closest point, a zero slip with its derivatives) and their exact first and
+/// second derivatives for a node at world position `x` (2D problems pass `z = 0` and a `z`
+/// axis).
 ///
 /// Returns `None` if the frame is degenerate (zero or non-finite axis, non-finite centre or angle)
 /// or the surface projection is undefined at `y = Q^T (x - c)`.
@@ -97,12 +98,13 @@ pub fn evaluate(
     surface: &dyn RigidSurface,
     frame: &RotatingFrame,
     x: &Vector3<f64>,
-    from: &Vector2<f64>,
+    from: Option<&SurfacePoint>,
 ) -> Option<ContactKinematics> {
     let (axis, rotation) = frame.orientation()?;
     let y = rotation.inverse_transform_vector(&(x - frame.center));
     let projection = surface.project(&y)?;
-    let slip = surface.slip(from, &y, &projection);
+    let closest = projection.closest(&y);
+    let slip = surface.slip(from.unwrap_or(&closest), &y, &projection);
     let body_velocity = axis.cross(&y);
     let gradients = [projection.gap_gradient, slip.gradient[0], slip.gradient[1]];
     let hessians = [projection.gap_hessian, slip.hessian[0], slip.hessian[1]];
@@ -123,7 +125,7 @@ pub fn evaluate(
     };
     Some(ContactKinematics {
         gap: projection.gap,
-        coords: projection.coords,
+        closest,
         slip: slip.value,
         normal,
         d_dx: gradients.map(|g| rotation * g),
@@ -217,7 +219,8 @@ pub fn rotation_column(
     }
     let axis = frame.unit_axis()?;
     let start_rotation = Rotation3::from_axis_angle(&axis, start.angle);
-    let before = surface.project(&start_rotation.inverse_transform_vector(&start.offset))?;
+    let y_before = start_rotation.inverse_transform_vector(&start.offset);
+    let before = surface.project(&y_before)?;
     let moved = end_offset - start.offset;
     let whole = [end.gap - before.gap, end.slip[0], end.slip[1]];
     let column: [f64; 3] = std::array::from_fn(|k| (whole[k] - end.d_dx[k].dot(&moved)) / turn);
@@ -228,7 +231,9 @@ pub fn rotation_column(
     let rotation = Rotation3::from_axis_angle(&axis, frame.angle);
     let y_turned = rotation.inverse_transform_vector(&start.offset);
     let turned = surface.project(&y_turned)?;
-    let slip = surface.slip(&before.coords, &y_turned, &turned).value;
+    let slip = surface
+        .slip(&before.closest(&y_before), &y_turned, &turned)
+        .value;
     let secant = [turned.gap - before.gap, slip[0], slip[1]].map(|d| d / turn);
     secant.iter().all(|c| c.is_finite()).then_some(secant)
 }
@@ -247,17 +252,23 @@ mod tests {
         frame: &RotatingFrame,
         x: &Vector3<f64>,
     ) -> Result<ContactKinematics, ContactError> {
-        eval_from(surface, frame, x, &Vector2::zeros())
+        eval_from(
+            surface,
+            frame,
+            x,
+            &SurfacePoint::of_coords(Vector2::zeros()),
+        )
     }
 
-    /// The kinematics at `x`, the slip measured from the contact point of coordinates `from`.
+    /// The kinematics at `x`, the slip measured from the contact point `from`.
     fn eval_from(
         surface: &dyn RigidSurface,
         frame: &RotatingFrame,
         x: &Vector3<f64>,
-        from: &Vector2<f64>,
+        from: &SurfacePoint,
     ) -> Result<ContactKinematics, ContactError> {
-        evaluate(surface, frame, x, from).ok_or(ContactError::InvalidSurface("undefined".into()))
+        evaluate(surface, frame, x, Some(from))
+            .ok_or(ContactError::InvalidSurface("undefined".into()))
     }
 
     /// Differences of `[g, xi_0, xi_1]` between two states, with `xi` unwrapped.
@@ -266,7 +277,10 @@ mod tests {
         plus: &ContactKinematics,
         minus: &ContactKinematics,
     ) -> [f64; 3] {
-        let slip = unwrapped_increment(surface.coords_period(), plus.coords - minus.coords);
+        let slip = unwrapped_increment(
+            surface.coords_period(),
+            plus.closest.coords - minus.closest.coords,
+        );
         [plus.gap - minus.gap, slip[0], slip[1]]
     }
 
@@ -423,7 +437,7 @@ mod tests {
                 angle: theta1,
             };
             let k0 = eval(&drum, &start, &(c0 + r0))?;
-            let k1 = eval_from(&drum, &end, &(c1 + r1), &k0.coords)?;
+            let k1 = eval_from(&drum, &end, &(c1 + r1), &k0.closest)?;
             let change = difference(&drum, &k1, &k0);
             let begin = IncrementStart {
                 angle: theta0,
@@ -456,7 +470,7 @@ mod tests {
             angle: theta0 + 1e-6,
             ..start
         };
-        let still = eval_from(&drum, &close, &(c0 + r0), &k0.coords)?;
+        let still = eval_from(&drum, &close, &(c0 + r0), &k0.closest)?;
         let limit = rotation_column(&drum, &close, &begin, &r0, &still).ok_or_else(none)?;
         for (secant, derivative) in limit.iter().zip(k0.d_dangle).take(2) {
             assert_relative_eq!(*secant, derivative, epsilon = 1e-6);
@@ -491,7 +505,7 @@ mod tests {
             angle: 0.0,
             ..frame
         };
-        let end = eval_from(&drum, &frame, &r1, &eval(&drum, &unturned, &r0)?.coords)?;
+        let end = eval_from(&drum, &frame, &r1, &eval(&drum, &unturned, &r0)?.closest)?;
         let column = rotation_column(&drum, &frame, &begin, &r1, &end)
             .ok_or_else(|| ContactError::InvalidSurface("no rotation column".into()))?;
         for c in column {
@@ -531,9 +545,9 @@ mod tests {
         // body-frame angle pi: atan2 jumps from +pi to -pi within the finite-difference stencil
         let x = Vector3::new(-0.2005, 1e-8, 0.0);
         let k = eval(&drum, &frame, &x)?;
-        assert!(k.coords[0] > 0.0);
+        assert!(k.closest.coords[0] > 0.0);
         let xm = Vector3::new(-0.2005, -1e-7, 0.0);
-        assert!(eval(&drum, &frame, &xm)?.coords[0] < 0.0);
+        assert!(eval(&drum, &frame, &xm)?.closest.coords[0] < 0.0);
         check_derivatives(&drum, &frame, &x)?;
         // a body rotated by pi/2 brings the cut to world angle 3 pi / 2 (below the centre)
         let rotated = RotatingFrame {
@@ -560,7 +574,7 @@ mod tests {
             assert_relative_eq!(k.d_dangle[1], -radius, epsilon = 1e-14);
             assert_relative_eq!(k.d_dangle[2], 0.0, epsilon = 1e-15);
             // 2D point in the z = 0 plane with a z axis has axial coordinate 0
-            assert_eq!(k.coords[1], 0.0);
+            assert_eq!(k.closest.coords[1], 0.0);
             // the world normal is radial from the centre, independent of the angle
             let radial = (x - frame.center).normalize();
             assert_relative_eq!(k.normal, radial, epsilon = 1e-14);
@@ -584,9 +598,9 @@ mod tests {
         };
         // a full turn in 0.1 rad steps: the unwrapped slip sums to -2 pi R
         let mut total = 0.0;
-        let mut previous = at(0.0)?.coords;
+        let mut previous = at(0.0)?.closest.coords;
         for step in 1..=63 {
-            let current = at(step as f64 * 0.1)?.coords;
+            let current = at(step as f64 * 0.1)?.closest.coords;
             total += unwrapped_increment(drum.coords_period(), current - previous)[0];
             previous = current;
         }

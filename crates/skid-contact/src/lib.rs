@@ -45,7 +45,7 @@ pub use plane::RigidPlane;
 pub use polyline::RigidPolyline;
 pub use revolution::RigidRevolution;
 pub use surface::{
-    AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, Slip, SurfaceShape,
+    AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, Slip, SurfacePoint, SurfaceShape,
     unwrapped_increment,
 };
 pub use triangles::{CylinderChart, SurfaceChart, TriangulatedSurface};

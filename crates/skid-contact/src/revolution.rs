@@ -7,7 +7,7 @@ use nalgebra::{Matrix2x3, Matrix3, Vector2, Vector3};
 use crate::error::ContactError;
 use crate::polyline::{RigidPolyline, lift_from_plane};
 use crate::surface::{
-    AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, Slip, SurfaceShape,
+    AnalyticCylinder, DiscreteGradient, Projection, RigidSurface, Slip, SurfacePoint, SurfaceShape,
 };
 
 /// The surface swept by the [`RigidPolyline`] `profile` of the `r-z` half-plane (`r >= 0` the
@@ -140,7 +140,8 @@ impl RigidSurface for RigidRevolution {
     /// give `s_k = t_k . (y - p_0)`, gradients `t_k` and no curvature. The angle's increments
     /// are no lengths (`R dtheta` is one only where `r = R`: friction would be weighed by
     /// `R / r`); these are, at every radius, and orthonormal, as a plane's coordinates are.
-    fn slip(&self, from: &Vector2<f64>, y: &Vector3<f64>, to: &Projection) -> Slip {
+    fn slip(&self, from: &SurfacePoint, y: &Vector3<f64>, to: &Projection) -> Slip {
+        let from = &from.coords;
         let Some((point, tangent)) = self.profile.point_at(from.y) else {
             return Slip::of_coordinates(self.coords_period(), from, to);
         };
@@ -229,7 +230,8 @@ mod tests {
         let start = point(0.3, 0.225, 0.025);
         let from = project(&surface, &start);
         assert!(from.gap.abs() < 1e-15);
-        let slip = |y: Vector3<f64>| surface.slip(&from.coords, &y, &project(&surface, &y));
+        let slip =
+            |y: Vector3<f64>| surface.slip(&from.closest(&start), &y, &project(&surface, &y));
         let still = slip(start);
         assert!(still.value.norm() < 1e-15, "{}", still.value);
         let [round, along] = still.gradient;

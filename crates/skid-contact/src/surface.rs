@@ -119,14 +119,54 @@ pub trait RigidSurface: Send + Sync + std::fmt::Debug {
     ) -> Option<DiscreteGradient> {
         None
     }
-    /// The slip from the surface point of convected coordinates `from` (the contact point at
-    /// the start of an increment) to the body-frame point `y` of projection `to`: two lengths
-    /// along the surface, the friction law's tangential displacements, with their gradients and
-    /// Hessians in `y`. The default, right where the coordinates are lengths on the surface
-    /// (arc lengths, plane coordinates): the coordinates' increments `to.coords - from`, each
-    /// periodic one unwrapped into `(-p/2, p/2]`, with the coordinates' own derivatives.
-    fn slip(&self, from: &Vector2<f64>, _y: &Vector3<f64>, to: &Projection) -> Slip {
-        Slip::of_coordinates(self.coords_period(), from, to)
+    /// The slip from the surface point `from` (the contact point at the start of an increment)
+    /// to the body-frame point `y` of projection `to`: two lengths along the surface, the
+    /// friction law's tangential displacements, with their gradients and Hessians in `y`. The
+    /// default, right where the coordinates are lengths on the surface (arc lengths, plane
+    /// coordinates): the coordinates' increments `to.coords - from.coords`, each periodic one
+    /// unwrapped into `(-p/2, p/2]`, with the coordinates' own derivatives.
+    fn slip(&self, from: &SurfacePoint, _y: &Vector3<f64>, to: &Projection) -> Slip {
+        Slip::of_coordinates(self.coords_period(), &from.coords, to)
+    }
+}
+
+/// A point of a rigid surface where a node's contact was (at the start of an increment): its
+/// convected coordinates, its body-frame position and the surface's outward unit normal there,
+/// from which [`RigidSurface::slip`] measures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    /// Convected coordinates `xi`.
+    pub coords: Vector2<f64>,
+    /// Position `p` (body frame).
+    pub position: Vector3<f64>,
+    /// Outward unit normal `n` (body frame): the gap gradient at the projected point.
+    pub normal: Vector3<f64>,
+}
+
+#[cfg(test)]
+impl SurfacePoint {
+    /// A point known by its coordinates alone, for surfaces whose slip reads only those (its
+    /// position and normal are NaN, so that any other use shows).
+    pub(crate) fn of_coords(coords: Vector2<f64>) -> Self {
+        let unknown = Vector3::repeat(f64::NAN);
+        Self {
+            coords,
+            position: unknown,
+            normal: unknown,
+        }
+    }
+}
+
+impl Projection {
+    /// The closest point of the body-frame point `y` this is the projection of: `p = y - g
+    /// dg/dy`, `n = dg/dy` (the gap is a signed distance, so that `dg/dy` is the unit vector
+    /// from the closest point towards `y`, or the outward normal where `y` is on the surface).
+    pub fn closest(&self, y: &Vector3<f64>) -> SurfacePoint {
+        SurfacePoint {
+            coords: self.coords,
+            position: y - self.gap_gradient * self.gap,
+            normal: self.gap_gradient,
+        }
     }
 }
 

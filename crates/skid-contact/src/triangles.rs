@@ -3,14 +3,16 @@
 
 use std::collections::BTreeMap;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Vector2, Vector3};
 use rstar::{AABB, RTree, RTreeObject};
 
 use crate::error::ContactError;
 use crate::facets::FacetedCylinder;
 use crate::plane::RigidPlane;
 use crate::search::nearest_chain;
-use crate::surface::{AnalyticCylinder, Projection, RigidSurface, SurfaceShape};
+use crate::surface::{
+    AnalyticCylinder, Projection, RigidSurface, Slip, SurfacePoint, SurfaceShape,
+};
 
 /// Cylinder whose coordinates label points of a triangulated drum: `xi_0 = R atan2(p.b2, p.b1)`,
 /// `xi_1 = e.p` for a surface point `p`, with `b1`, `b2` as in [`AnalyticCylinder`].
@@ -29,8 +31,9 @@ pub enum SurfaceChart {
     /// A drum's chart (see [`CylinderChart`]); `xi_0` has period `2 pi R`.
     Cylinder(CylinderChart),
     /// `xi = (t1.p, t2.p)` for a surface point `p`, as on the [`RigidPlane`] of outward `normal`
-    /// and first in-plane direction `tangent = t1`, for a mesh that is nowhere steep against
-    /// that plane (a floor, a ramp, a punch face).
+    /// and first in-plane direction `tangent = t1`: labels of any mesh's points (unique where
+    /// the mesh is a graph over the plane), while its slip is measured in lengths in the
+    /// tangent plane (see [`TriangulatedSurface`]'s `slip`).
     Plane {
         /// Normal `n` of the chart plane (normalised on use).
         normal: Vector3<f64>,
@@ -486,6 +489,31 @@ impl RigidSurface for TriangulatedSurface {
     fn coords_period(&self) -> [Option<f64>; 2] {
         self.chart.surface().coords_period()
     }
+
+    /// With a cylinder chart, the increments of its coordinates (the default, see
+    /// [`RigidSurface::slip`]). With a plane chart, lengths in the tangent plane at the start
+    /// point `p_0` of normal `n_0`: `s_k = t_k . (y - p_0)`, gradients `t_k` and no curvature,
+    /// with the chart's directions turned into that plane (`t_1` the chart's first direction's
+    /// part in it, made unit, or its second's where the first is steep, `t_2 = n_0 x t_1`). On
+    /// a flat mesh on its own plane chart these are the increments of the chart's coordinates;
+    /// they stay lengths on a curved mesh or a mesh sloped against the chart, where a chart
+    /// coordinate's increment would be the slip's projection (`cos a` times its length on a
+    /// face at angle `a` to the chart).
+    fn slip(&self, from: &SurfacePoint, y: &Vector3<f64>, to: &Projection) -> Slip {
+        let tangents = match &self.chart {
+            Chart::Plane(plane) => plane.tangents_across(&from.normal),
+            Chart::Cylinder(_) => None,
+        };
+        let Some(tangents) = tangents else {
+            return Slip::of_coordinates(self.coords_period(), &from.coords, to);
+        };
+        let moved = y - from.position;
+        Slip {
+            value: Vector2::new(tangents[0].dot(&moved), tangents[1].dot(&moved)),
+            gradient: tangents,
+            hessian: [Matrix3::zeros(); 2],
+        }
+    }
 }
 
 #[cfg(test)]
@@ -579,6 +607,84 @@ mod tests {
     /// A tilted floor of two triangles, `z = 0.1 x` over `[-1, 1]^2`, with the plane chart of
     /// normal `+z`, `t1 = +x`: on a face the gap is the distance to the tilted plane and the
     /// coordinates those of the closest point, read on the chart.
+    #[test]
+    fn a_plane_charted_mesh_slips_in_lengths_in_the_start_tangent_plane() -> Result<(), ContactError>
+    {
+        // a roof: two faces of slope 0.5 meeting at a ridge along y, read on the chart z = 0
+        let roof = |x: f64, y: f64| Vector3::new(x, y, 0.5 * (1.0 - x.abs()));
+        let vertices = vec![
+            roof(-1.0, -1.0),
+            roof(0.0, -1.0),
+            roof(1.0, -1.0),
+            roof(-1.0, 1.0),
+            roof(0.0, 1.0),
+            roof(1.0, 1.0),
+        ];
+        let triangles = vec![[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]];
+        let chart = SurfaceChart::Plane {
+            normal: Vector3::z(),
+            tangent: Vector3::x(),
+        };
+        let mesh = TriangulatedSurface::new(vertices, triangles, chart)?;
+        let start = roof(0.4, 0.1);
+        let from = project(&mesh, &start).closest(&start);
+        let normal = Vector3::new(0.5, 0.0, 1.0).normalize();
+        assert_relative_eq!(from.normal, normal, epsilon = 1e-15);
+        assert_relative_eq!(from.position, start, epsilon = 1e-15);
+        let slip = |y: Vector3<f64>| mesh.slip(&from, &y, &project(&mesh, &y));
+        let still = slip(start);
+        assert!(still.value.norm() < 1e-15, "{}", still.value);
+        // orthonormal tangents of the sloped face, the first down the slope (the chart's x)
+        let [down, along] = still.gradient;
+        assert_relative_eq!(
+            down,
+            Vector3::new(1.0, 0.0, -0.5).normalize(),
+            epsilon = 1e-15
+        );
+        assert_relative_eq!(along, Vector3::y(), epsilon = 1e-15);
+        assert_eq!(still.hessian, [Matrix3::zeros(); 2]);
+        // sliding 0.3 down the face and 0.2 along the ridge, and lifted off by 0.01: lengths,
+        // where the chart's coordinates change by 0.3 cos a in x
+        let moved = start + down * 0.3 + along * 0.2 + normal * 0.01;
+        let p = project(&mesh, &moved);
+        let s = slip(moved).value;
+        assert_relative_eq!(s, Vector2::new(0.3, 0.2), epsilon = 1e-15);
+        let chart_dx = p.coords[0] - from.coords[0];
+        assert_relative_eq!(chart_dx, 0.3 * normal.z, epsilon = 1e-15);
+        // a flat mesh on its own chart slips by the chart's coordinates
+        let left = roof(-0.5, 0.0);
+        let flat = TriangulatedSurface::new(
+            vec![roof(-1.0, -1.0), roof(0.0, -1.0), roof(0.0, 1.0)],
+            vec![[0, 1, 2]],
+            SurfaceChart::Plane {
+                normal: Vector3::new(-0.5, 0.0, 1.0),
+                tangent: Vector3::x(),
+            },
+        )?;
+        let from = project(&flat, &left).closest(&left);
+        let to = left + Vector3::new(0.2, -0.1, 0.1);
+        let p = project(&flat, &to);
+        assert_relative_eq!(
+            flat.slip(&from, &to, &p).value,
+            p.coords - from.coords,
+            epsilon = 1e-15
+        );
+        // a wall across the chart (normal x against the chart's first direction x): the
+        // chart's second direction y leads
+        let wall = TriangulatedSurface::new(
+            vec![Vector3::zeros(), Vector3::y(), Vector3::z()],
+            vec![[0, 1, 2]],
+            chart,
+        )?;
+        let on = Vector3::new(0.0, 0.2, 0.2);
+        let from = project(&wall, &on).closest(&on);
+        let to = on + Vector3::new(0.05, 0.1, -0.3);
+        let slip = wall.slip(&from, &to, &project(&wall, &to));
+        assert_eq!(slip.gradient, [Vector3::y(), Vector3::z()]);
+        assert_relative_eq!(slip.value, Vector2::new(0.1, -0.3), epsilon = 1e-15);
+        Ok(())
+    }
+
     #[test]
     fn a_plane_chart_labels_a_floor() -> Result<(), ContactError> {
         let floor = |x: f64, y: f64| Vector3::new(x, y, 0.1 * x);

@@ -8,7 +8,8 @@
 //! to the node's components and the carrying body's translation and rotation, and each row's
 //! second derivatives give the stiffness of the contact forces on a curved, turning surface.
 
-use nalgebra::{DMatrix, DVector, Vector2, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3};
+use skid_contact::SurfacePoint;
 use skid_contact::kinematics::{
     ContactKinematics, IncrementStart, evaluate, gap_discrete_gradient, rotation_column,
 };
@@ -27,8 +28,8 @@ pub struct ContactRows {
     pub rows: Vec<Vec<(usize, f64)>>,
     /// Current local quantities u (gap, slip increment per tangent), per row.
     pub u: DVector<f64>,
-    /// Current convected coordinates per contact.
-    pub coords: Vec<Vector2<f64>>,
+    /// Current closest point per contact (body frame), where the next increment's slip starts.
+    pub closest: Vec<SurfacePoint>,
     /// Friction coefficient per contact.
     pub mu: Vec<f64>,
     /// Per row, the second derivatives of its `u` in the candidate's local coordinates
@@ -41,12 +42,12 @@ pub struct ContactRows {
 impl ContactRows {
     /// Number of contact candidates.
     pub fn len(&self) -> usize {
-        self.coords.len()
+        self.closest.len()
     }
 
     /// True if there are no candidates.
     pub fn is_empty(&self) -> bool {
-        self.coords.is_empty()
+        self.closest.is_empty()
     }
 
     /// `H^T r`: the generalized contact forces on the equations.
@@ -196,8 +197,9 @@ impl ContactRows {
     }
 }
 
-/// Evaluates the contact rows of all pairs at displacement `x`. `previous` holds the convected
-/// coordinates at the start of the increment (one per candidate, pair by pair); `held` marks
+/// Evaluates the contact rows of all pairs at displacement `x`. `previous` holds the closest
+/// points at the start of the increment, where the slips start (one per candidate, pair by
+/// pair; `None`: each node's own closest point, zero slips); `held` marks
 /// equations whose increment is zero in this step (their columns are dropped).
 ///
 /// `start` is the displacement at the start of a dynamic increment (`None` for rows at the
@@ -220,7 +222,7 @@ pub fn contact_rows<const D: usize>(
     model: &Model<D>,
     x: &DVector<f64>,
     start: Option<&DVector<f64>>,
-    previous: &[Vector2<f64>],
+    previous: Option<&[SurfacePoint]>,
     held: &[bool],
 ) -> Result<ContactRows, IncrementFailure> {
     let components = D;
@@ -231,7 +233,7 @@ pub fn contact_rows<const D: usize>(
         components,
         rows: Vec::with_capacity(candidates * D),
         u: DVector::zeros(0),
-        coords: Vec::with_capacity(candidates),
+        closest: Vec::with_capacity(candidates),
         mu: Vec::with_capacity(candidates),
         curvature: Vec::with_capacity(candidates * D * size * size),
     };
@@ -244,7 +246,8 @@ pub fn contact_rows<const D: usize>(
             start.map(|x0| embed(&(body.reference_point + dofs.body_displacement(x0, pair.body))));
         for &node in &pair.nodes {
             let pos = model.node_position(x, node);
-            let mut kin = evaluate(pair.surface.as_ref(), &frame, &pos, &previous[k])
+            let from = previous.map(|points| &points[k]);
+            let mut kin = evaluate(pair.surface.as_ref(), &frame, &pos, from)
                 .ok_or(IncrementFailure::NoProjection { pair: p, node })?;
             if let (Some(x0), Some(c0)) = (start, start_center) {
                 let offset = model.node_position(x0, node) - c0;
@@ -297,7 +300,7 @@ pub fn contact_rows<const D: usize>(
                     kin.slip[comp - 1]
                 });
             }
-            out.coords.push(kin.coords);
+            out.closest.push(kin.closest);
             out.mu.push(pair.mu);
             k += 1;
         }
@@ -353,7 +356,7 @@ fn push_local_curvature<const D: usize>(kin: &ContactKinematics, comp: usize, ou
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_support::block_on_drum;
+    use crate::test_support::{block_on_drum, coordinate_origins};
 
     /// `H dx` predicts the change of gaps and slips for a small motion of nodes and drum.
     fn rows_are_the_derivative_of_the_kinematics<const D: usize>() {
@@ -361,12 +364,11 @@ mod tests {
         let n = model.dofs().len();
         let held = vec![false; n];
         let x = DVector::from_fn(n, |i, _| 1e-3 * (i as f64 * 0.9).sin());
-        let start: Vec<Vector2<f64>> = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
-        let previous = rows.coords.clone();
+        let rows = contact_rows(&model, &x, None, None, &held).expect("rows");
+        let previous = Some(rows.closest.as_slice());
         let dx = DVector::from_fn(n, |i, _| 1e-7 * (i as f64 * 2.3).cos());
-        let plus = contact_rows(&model, &(&x + &dx), None, &previous, &held).expect("rows");
-        let minus = contact_rows(&model, &(&x - &dx), None, &previous, &held).expect("rows");
+        let plus = contact_rows(&model, &(&x + &dx), None, previous, &held).expect("rows");
+        let minus = contact_rows(&model, &(&x - &dx), None, previous, &held).expect("rows");
         let predicted = rows.times(&dx);
         let measured = (&plus.u - &minus.u) / 2.0;
         assert!(
@@ -385,7 +387,7 @@ mod tests {
         for &eq in &drum_eqs {
             held[eq] = true;
         }
-        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
+        let rows = contact_rows(&model, &x, None, None, &held).expect("rows");
         assert!(
             rows.rows
                 .iter()
@@ -399,8 +401,8 @@ mod tests {
         let model = block_on_drum::<D>();
         let n = model.dofs().len();
         let x = DVector::from_fn(n, |i, _| 1e-3 * ((i as f64 * 1.3).sin() - 0.5));
-        let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, None, &start, &vec![false; n]).expect("rows");
+        let start = coordinate_origins(&model);
+        let rows = contact_rows(&model, &x, None, Some(&start), &vec![false; n]).expect("rows");
         let m = 2 * D + 1;
         assert_eq!(rows.curvature.len(), rows.rows.len() * m * m);
         let block =

@@ -297,13 +297,13 @@ pub fn solve_contact_forces(
 
 #[cfg(test)]
 mod tests {
-    use nalgebra::{DMatrix, Vector2};
+    use nalgebra::DMatrix;
 
     use super::*;
     use crate::contact_rows::contact_rows;
     use crate::error::LinearFailure;
     use crate::model::Model;
-    use crate::test_support::block_on_drum;
+    use crate::test_support::{block_on_drum, coordinate_origins};
 
     /// Screening open candidates out of the conic solve gives the full problem's solution,
     /// including for a candidate that only closes because a neighbour's force pulls it in.
@@ -361,8 +361,8 @@ mod tests {
         let x = DVector::from_fn(n, |i, _| 1e-4 * (i as f64 * 1.3).sin());
         let (model, mut assembler) = assembled::<D>(&x);
         let held = vec![false; n];
-        let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
+        let start = coordinate_origins(&model);
+        let rows = contact_rows(&model, &x, None, Some(&start), &held).expect("rows");
         let subset: Vec<usize> = (0..rows.len()).step_by(2).collect();
         assembler
             .eliminate_last(&rows.equations(&subset))
@@ -399,8 +399,8 @@ mod tests {
         let x = DVector::zeros(n);
         let (model, mut assembler) = assembled::<D>(&x);
         let held = vec![false; n];
-        let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
+        let start = coordinate_origins(&model);
+        let rows = contact_rows(&model, &x, None, Some(&start), &held).expect("rows");
         // the drum is held by its mass term; every pad node is pushed down by 1 cm
         let mut residual = DVector::zeros(n);
         for node in 0..model.part().mesh.nodes.len() {
@@ -458,8 +458,8 @@ mod tests {
         let increment_start = secant.then_some(&x0);
         let (model, mut assembler) = assembled::<D>(&x);
         let held = vec![false; n];
-        let start = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let rows = contact_rows(&model, &x, increment_start, &start, &held).expect("rows");
+        let start = coordinate_origins(&model);
+        let rows = contact_rows(&model, &x, increment_start, Some(&start), &held).expect("rows");
         let r = DVector::from_fn(rows.rows.len(), |k, _| {
             if k % D == 0 {
                 700.0 + 10.0 * k as f64
@@ -472,7 +472,7 @@ mod tests {
         assembler.add_contact_curvature(&rows, &r);
         let k = assembler.dense(n);
         let residual = |assembler: &mut Assembler, x: &DVector<f64>| {
-            let rows = contact_rows(&model, x, increment_start, &start, &held).expect("rows");
+            let rows = contact_rows(&model, x, increment_start, Some(&start), &held).expect("rows");
             assembler.internal(&model, x, None).expect("internal").force
                 - rows.transpose_times(&r, n)
         };

@@ -876,7 +876,7 @@ mod tests {
     use crate::quasi_definite::CONSTRAINT_REGULARIZATION;
     use crate::sparse::symmetric_times;
     use crate::test_support::block_on_drum;
-    use nalgebra::{DMatrix, Vector2};
+    use nalgebra::DMatrix;
     use skid_contact::coulomb::CoulombSettings;
 
     /// `K v` from the lower triangle of a symmetric `K`.
@@ -904,11 +904,7 @@ mod tests {
         }
         assembler.hold(&held);
         // slips counted from the nodes' current positions on the drum
-        let origin = vec![Vector2::zeros(); model.contacts()[0].nodes.len()];
-        let start = contact_rows(&model, &x, None, &origin, &held)
-            .expect("rows")
-            .coords;
-        let rows = contact_rows(&model, &x, None, &start, &held).expect("rows");
+        let rows = contact_rows(&model, &x, None, None, &held).expect("rows");
         let mut residual = DVector::zeros(n);
         for (node, p) in model.part().mesh.nodes.iter().enumerate() {
             let [Some(ex), Some(ey)] = [model.dofs().node(node)[0], model.dofs().node(node)[1]]

@@ -36,6 +36,7 @@
 use std::time::Instant;
 
 use nalgebra::{DVector, Vector2};
+use skid_contact::SurfacePoint;
 
 use crate::assembly::{Assembler, InternalState, external_forces};
 use crate::contact_rows::{ContactRows, contact_rows};
@@ -215,7 +216,7 @@ fn solve_increment_with<const D: usize>(
     let shift_mass = model.regularization_mass();
     let quasi_static = model.quasi_static();
     let length = model.length_scale();
-    let previous_coords: Vec<Vector2<f64>> = start.contacts.iter().map(|c| c.coords).collect();
+    let previous: Vec<SurfacePoint> = start.contacts.iter().map(|c| c.closest()).collect();
     // Dynamic increments take the normal rows between the start and the end positions, so
     // that the contact impulse does the work `p_N dg` (see `contact_rows`); a static
     // equilibrium takes the normal at the solution itself.
@@ -335,7 +336,7 @@ fn solve_increment_with<const D: usize>(
                 r
             }
         };
-        let rows = contact_rows(model, &x, row_start, &previous_coords, held)?;
+        let rows = contact_rows(model, &x, row_start, Some(&previous), held)?;
         // what the constraints must balance, before their rows become identities
         let held_residual: Vec<(usize, f64)> = held
             .iter()
@@ -413,8 +414,7 @@ fn solve_increment_with<const D: usize>(
                 let held_contact = if held_residual.is_empty() {
                     None
                 } else {
-                    let all =
-                        contact_rows(model, &x, row_start, &previous_coords, &vec![false; n])?;
+                    let all = contact_rows(model, &x, row_start, Some(&previous), &vec![false; n])?;
                     Some(all.transpose_times(r, n))
                 };
                 let (mut constrained, mut reaction) = (DVector::zeros(n), DVector::zeros(n));
@@ -828,7 +828,9 @@ fn finish<const D: usize>(
         contacts.push(ContactPointState {
             pair: old.pair,
             node: old.node,
-            coords: rows.coords[k],
+            coords: rows.closest[k].coords,
+            position: rows.closest[k].position,
+            normal: rows.closest[k].normal,
             gap,
             slip,
             normal_force: force(0),

@@ -576,13 +576,7 @@ pub fn initial_state<const D: usize>(
     let x = DVector::zeros(n);
     let v = model.initial_velocity();
     let held = vec![false; n];
-    let coords0: Vec<_> = model
-        .contacts()
-        .iter()
-        .flat_map(|p| p.nodes.iter())
-        .map(|_| nalgebra::Vector2::zeros())
-        .collect();
-    let rows = contact_rows(model, &x, None, &coords0, &held)?;
+    let rows = contact_rows(model, &x, None, None, &held)?;
     let d = rows.components;
     let contacts = model
         .contacts()
@@ -593,7 +587,9 @@ pub fn initial_state<const D: usize>(
         .map(|(k, (pair, node))| ContactPointState {
             pair,
             node,
-            coords: rows.coords[k],
+            coords: rows.closest[k].coords,
+            position: rows.closest[k].position,
+            normal: rows.closest[k].normal,
             gap: rows.u[k * d],
             slip: nalgebra::Vector2::zeros(),
             normal_force: 0.0,

@@ -1,11 +1,12 @@
 //! Small scenes shared by the unit tests.
 
 use crate::model::Section;
-use nalgebra::{SVector, Vector3};
+use nalgebra::{SVector, Vector2, Vector3};
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::RigidBody;
 
+use skid_contact::SurfacePoint;
 use skid_contact::surface::AnalyticCylinder;
 
 use crate::loads::Loads;
@@ -73,4 +74,18 @@ pub(crate) fn block_on_drum<const D: usize>() -> Model<D> {
         mu: 0.15,
     };
     Model::new(part, vec![drum], vec![], Loads::default(), vec![pair]).expect("model")
+}
+
+/// One slip origin per contact candidate at the surface coordinates' origin, for drums whose
+/// slip reads their coordinates only (the position and normal are NaN, so that any other use
+/// shows).
+pub(crate) fn coordinate_origins<const D: usize>(model: &Model<D>) -> Vec<SurfacePoint> {
+    let unknown = Vector3::repeat(f64::NAN);
+    let origin = SurfacePoint {
+        coords: Vector2::zeros(),
+        position: unknown,
+        normal: unknown,
+    };
+    let candidates = model.contacts().iter().map(|p| p.nodes.len()).sum();
+    vec![origin; candidates]
 }

@@ -99,8 +99,8 @@ fn contact_tractions<const D: usize>(
         let position = current
             .get(c.node)
             .ok_or_else(|| invalid_data(format!("contact node {} does not exist", c.node)))?;
-        let kinematics =
-            evaluate(pair.surface.as_ref(), &frame, position, &c.coords).ok_or_else(|| {
+        let kinematics = evaluate(pair.surface.as_ref(), &frame, position, Some(&c.closest()))
+            .ok_or_else(|| {
                 invalid_data(format!(
                     "contact pair '{}': node {} has no projection",
                     pair.name, c.node
@@ -110,7 +110,7 @@ fn contact_tractions<const D: usize>(
         // The tangential forces are conjugate to the slip: their force on the node is
         // r_T,k d s_k / dx, here with the slip's rows at the converged contact point (those of
         // the increment, which start at its contact point, differ by the increment's turn of
-        // the surface's tangents on a surface of revolution).
+        // the surface's tangents on a surface of revolution or a plane-charted mesh).
         for k in 0..D - 1 {
             shear[c.node] += kinematics.d_dx[k + 1] * c.tangential_force[k];
         }
