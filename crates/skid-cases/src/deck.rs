@@ -51,8 +51,10 @@
 //!   is treated as axially unbounded, and the slave nodes are checked to lie within its ends;
 //!   other lines must form one chain (a polyline; closed, it must face outwards), other
 //!   quadrilaterals (split along their 1-3 diagonal: exact when flat) and triangles a triangle
-//!   mesh whose surface coordinates are read on its plane if it is flat, else on a cylinder
-//!   about its body's one free rotation (see [`rigid`]); an analytical profile of lines that
+//!   mesh whose surface coordinates are read on its plane if it is flat, on a cylinder about
+//!   its body's one free rotation if it is curved and the body has one, else on the plane of
+//!   its mean normal, its slip measured in the tangent plane (see [`rigid`]); an analytical
+//!   profile of lines that
 //!   runs straight through the reference node is the unbounded line or plane through it, any
 //!   other a polyline (`SEGMENTS`) or its extrusion along the generator (`CYLINDER`); a
 //!   revolved profile of lines at one radius is a cylinder, any other a surface of revolution

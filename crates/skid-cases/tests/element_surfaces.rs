@@ -1,6 +1,7 @@
 //! Rigid surfaces of rigid elements other than a drum's regular prism: 2D lines chained into a
 //! polyline (and bent `SEGMENTS` profiles, the same polyline), 3D quadrilaterals and triangles
-//! as a triangle mesh with a plane chart when flat; what cannot be read is refused with the
+//! as a triangle mesh with a plane chart unless they are curved on a turning body; what cannot
+//! be read is refused with the
 //! reason; the deck writer writes them back as elements that read to the same surfaces.
 
 use std::path::Path;
@@ -164,8 +165,11 @@ ground-lines, SPOS
 }
 
 /// The 3D verification scene's floor of `R3D4` quadrilaterals and `R3D3` triangles is one flat
-/// triangle mesh with the plane chart of its normal (+y, first direction +x); the same
-/// quadrilaterals bent into a roof, on a body that cannot turn, have no chart and are refused.
+/// triangle mesh with the plane chart of its normal (+y, first direction +x). The same floor
+/// with one vertex under the block dipped by 0.2 mm, on a body that cannot turn, is a curved
+/// mesh on the plane chart of its mean normal (its slip measured in the tangent plane): the
+/// block, pushed for 30 ms, slides over the dip with every pressed node sliding, and the energy
+/// balance closes.
 #[test]
 fn flat_rigid_elements_are_a_triangle_mesh_on_a_plane_chart() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -196,9 +200,35 @@ fn flat_rigid_elements_are_a_triangle_mesh_on_a_plane_chart() {
         }
         other => panic!("{other:?}"),
     }
-    let roof = deck.replace("47, 0.0055, 0.0, 0.001", "47, 0.0055, 0.001, 0.001");
-    assert_ne!(roof, deck);
-    assert_refused_at(&roof, "*SURFACE, NAME=ground, TYPE=ELEMENT", "curved");
+    let dip = deck
+        .replace("47, 0.0055, 0.0, 0.001", "47, 0.0055, -0.0002, 0.001")
+        .replace("0.0005, 0.04", "0.0005, 0.03");
+    assert_ne!(dip, deck);
+    let model = read_deck_text(&dip).expect("dipped floor");
+    let ground = model
+        .rigid_bodies
+        .iter()
+        .find(|b| b.name == "ground")
+        .expect("ground");
+    let Some(RigidSurfaceSpec::Triangles {
+        chart: ChartSpec::Plane { normal, tangent },
+        ..
+    }) = &ground.surface
+    else {
+        panic!("{:?}", ground.surface);
+    };
+    // the area vectors of a mesh add up to those of its boundary's loop, flat here: +y
+    assert!((normal[1] - 1.0).abs() < 1e-15, "{normal:?}");
+    assert!((tangent[0] - 1.0).abs() < 1e-15, "{tangent:?}");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let summary = run_model(&model, Path::new("dip.inp"), dir.path()).expect("runs");
+    assert!(summary.error.is_none(), "{:?}", summary.error);
+    assert_eq!(summary.final_time, 0.03);
+    let pair = &summary.pairs[0];
+    assert_eq!((pair.active, pair.sliding), (15, 15));
+    assert!(summary.bodies[1].displacement[0] > 0.01);
+    let error = summary.energy_balance_error.expect("energy balance");
+    assert!(error.abs() < 1e-4, "{error}");
 }
 
 /// Model files with a polyline or a triangle mesh of their own are written as decks of `R2D2`

@@ -607,8 +607,11 @@ fn aligned_phase(phase: f64, n: usize) -> f64 {
 /// body frame, with its chart: a flat mesh (every triangle's normal within 1e-9 of their
 /// area-weighted mean `n`) the plane chart of `n`, whose first direction is the coordinate axis
 /// least along `n` made perpendicular to it, so that its coordinates are lengths on the mesh;
-/// any other mesh the cylinder about `axis` (the body's one free rotation, through the origin)
-/// whose radius reaches the farthest vertex.
+/// a curved mesh on a body with one free rotation `axis` (through the origin) the cylinder about
+/// it whose radius reaches the farthest vertex (a drum's chart: its slip is counted in the
+/// cylinder's coordinates); any other curved mesh the plane chart of its mean normal (`z` where
+/// that vanishes, on a closed mesh), whose coordinates label its points while its slip is
+/// measured in lengths in the tangent plane.
 pub fn triangles(
     vertices: Vec<[f64; 3]>,
     triangles: Vec<[usize; 3]>,
@@ -629,15 +632,7 @@ pub fn triangles(
             .all(|a| unit(*a).is_some_and(|m| (m - n).norm() <= 1e-9))
     });
     let chart = match (flat, axis) {
-        (Some(normal), _) => {
-            let least = normal.iamin();
-            let tangent = unit(Vector3::ith(least, 1.0) - normal * normal[least])
-                .ok_or("the mesh's normal has no perpendicular")?;
-            ChartSpec::Plane {
-                normal: normal.into(),
-                tangent: tangent.into(),
-            }
-        }
+        (Some(normal), _) => plane_chart(normal)?,
         (None, Some(axis)) => {
             let radius = vertices
                 .iter()
@@ -652,17 +647,29 @@ pub fn triangles(
             }
         }
         (None, None) => {
-            return Err(
-                "a curved (not flat) rigid element surface takes its surface coordinates on a \
-                 cylinder about its body's one free rotation, and this body has none or several"
-                    .into(),
-            );
+            let total: f64 = areas.iter().map(|a| a.norm()).sum();
+            let normal = unit(mean)
+                .filter(|_| mean.norm() > 1e-6 * total)
+                .unwrap_or_else(Vector3::z);
+            plane_chart(normal)?
         }
     };
     Ok(RigidSurfaceSpec::Triangles {
         vertices,
         triangles,
         chart,
+    })
+}
+
+/// The plane chart of unit `normal` whose first direction is the coordinate axis least along it,
+/// made perpendicular to it.
+fn plane_chart(normal: Vector3<f64>) -> Result<ChartSpec, String> {
+    let least = normal.iamin();
+    let tangent = unit(Vector3::ith(least, 1.0) - normal * normal[least])
+        .ok_or("the mesh's normal has no perpendicular")?;
+    Ok(ChartSpec::Plane {
+        normal: normal.into(),
+        tangent: tangent.into(),
     })
 }
 
