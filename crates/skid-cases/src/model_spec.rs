@@ -331,7 +331,9 @@ pub enum RigidSurfaceSpec {
 /// The surface coordinates of a triangle mesh: those of its closest point read on a cylinder or a
 /// plane through the body origin. On a cylinder chart friction measures slip in these
 /// coordinates, which are lengths on the mesh only where it lies on the cylinder (a faceted drum
-/// up to the facets' chord, `1 - cos(pi / n)`, 1e-3 for 72 facets). On a plane chart the
+/// up to the facets' chord, `1 - cos(pi / n)`, 1e-3 for 72 facets): each triangle must lie on a
+/// cylinder about the chart's axis or across the axis (a drum's end), or the model is refused.
+/// On a plane chart the
 /// coordinates only label points, and slip is measured in lengths in the tangent plane at the
 /// contact point where each increment starts, whatever the mesh's shape (any curved mesh, or a
 /// chart plane sloped against the mesh).

@@ -261,3 +261,50 @@ ground-lines, SPOS
     let read = read_deck_text(&written).expect("read back");
     assert_eq!(read.rigid_bodies, model.rigid_bodies);
 }
+
+/// Rigid elements on a body turning about z: a ring of quadrilaterals at one radius is a drum,
+/// read on the cylinder about the axis (slip in its arc length); the same ring with every other
+/// vertex pulled in, a cam, is read on a plane chart, whose slip is in lengths on any mesh (the
+/// cylinder's arc length would weigh slip `R / r` times where the cam is at radius `r`).
+#[test]
+fn a_curved_mesh_on_a_turning_body_is_on_the_cylinder_only_if_it_is_a_drum() {
+    let ring = |inner: f64| -> Vec<[f64; 3]> {
+        (0..16)
+            .map(|k| {
+                let a = (k / 2) as f64 * std::f64::consts::TAU / 8.0;
+                let r = if (k / 2) % 2 == 0 { 1.0 } else { inner };
+                [r * a.cos(), r * a.sin(), (k % 2) as f64]
+            })
+            .collect()
+    };
+    // vertex 2k at z = 0, 2k + 1 at z = 1; two outward triangles per quadrilateral
+    let triangles: Vec<[usize; 3]> = (0..8)
+        .flat_map(|k| {
+            let (a, b) = (2 * k, 2 * ((k + 1) % 8));
+            [[a, b, b + 1], [a, b + 1, a + 1]]
+        })
+        .collect();
+    let axis = Some(nalgebra::Vector3::z());
+    let drum = skid_cases::deck::rigid::triangles(ring(1.0), triangles.clone(), axis);
+    assert!(
+        matches!(
+            drum,
+            Ok(RigidSurfaceSpec::Triangles {
+                chart: ChartSpec::Cylinder { radius, axis: [0.0, 0.0, 1.0] },
+                ..
+            }) if radius == 1.0
+        ),
+        "{drum:?}"
+    );
+    let cam = skid_cases::deck::rigid::triangles(ring(0.8), triangles, axis);
+    assert!(
+        matches!(
+            cam,
+            Ok(RigidSurfaceSpec::Triangles {
+                chart: ChartSpec::Plane { .. },
+                ..
+            })
+        ),
+        "{cam:?}"
+    );
+}

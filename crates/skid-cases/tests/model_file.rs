@@ -379,7 +379,7 @@ fn every_model_error_names_its_field() {
     )
     .expect("json");
     type Edit = fn(&mut Value);
-    let cases: [(&Value, Edit, &str, &str); 17] = [
+    let cases: [(&Value, Edit, &str, &str); 18] = [
         (
             &base,
             |v| v["skid_model"] = json!(2),
@@ -494,6 +494,18 @@ fn every_model_error_names_its_field() {
             },
             "rigid_bodies[0].surface",
             "not parallel",
+        ),
+        (
+            &base3,
+            |v| {
+                // a face on the cylinder r = 1 about z, and one leaning across it
+                v["rigid_bodies"][0]["surface"] = json!({"type": "triangles",
+                    "vertices": [[1, 0, 0], [0, 1, 0], [0, 1, 1], [0.5, 0, 2]],
+                    "triangles": [[0, 1, 2], [0, 2, 3]],
+                    "chart": {"type": "cylinder", "radius": 1, "axis": [0, 0, 1]}})
+            },
+            "rigid_bodies[0].surface.triangles[1]",
+            "neither on a cylinder about its axis nor across it",
         ),
         (
             &base3,

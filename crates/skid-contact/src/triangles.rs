@@ -42,6 +42,47 @@ pub enum SurfaceChart {
     },
 }
 
+/// Relative tolerance of [`CylinderChart::first_triangle_off`]: on the radii of a triangle's
+/// corners (over the largest) and on a normal's part across the axis.
+pub const ON_CYLINDER_TOLERANCE: f64 = 1e-6;
+
+impl CylinderChart {
+    /// The first of `triangles` (indices into `vertices`) that lies neither on a cylinder about
+    /// the chart's axis (its corners at one radius within [`ON_CYLINDER_TOLERANCE`] of it) nor
+    /// across the axis (a drum's end face: unit normal along the axis within that tolerance), or
+    /// that names a vertex that does not exist; `None` if every triangle does one or the other.
+    /// Slip is counted in the chart's arc length `R dtheta`, which at radius `r` weighs a slip
+    /// `R / r` times, and friction with it: exact on the chart's own cylinder, wrong on faces
+    /// that are not about its axis. (A coaxial face at another radius, a hollow drum's bore,
+    /// passes: it is told from the drum's outside by nothing but where contact happens.)
+    pub fn first_triangle_off(
+        &self,
+        vertices: &[Vector3<f64>],
+        triangles: &[[usize; 3]],
+    ) -> Option<usize> {
+        let e = self.axis.try_normalize(0.0)?;
+        let radius = |v: &Vector3<f64>| (v - e * e.dot(v)).norm();
+        triangles.iter().position(|t| {
+            let Some(corners) = t
+                .iter()
+                .map(|&i| vertices.get(i))
+                .collect::<Option<Vec<_>>>()
+            else {
+                return true;
+            };
+            let radii = corners.iter().map(|v| radius(v));
+            let (least, most) =
+                radii.fold((f64::INFINITY, 0.0_f64), |(a, b), r| (a.min(r), b.max(r)));
+            let round = most - least <= ON_CYLINDER_TOLERANCE * most;
+            let normal = (corners[1] - corners[0]).cross(&(corners[2] - corners[0]));
+            let across = normal
+                .try_normalize(0.0)
+                .is_some_and(|n| (n - e * e.dot(&n)).norm() <= ON_CYLINDER_TOLERANCE);
+            !(round || across)
+        })
+    }
+}
+
 impl From<CylinderChart> for SurfaceChart {
     fn from(chart: CylinderChart) -> Self {
         Self::Cylinder(chart)
@@ -607,6 +648,47 @@ mod tests {
     /// A tilted floor of two triangles, `z = 0.1 x` over `[-1, 1]^2`, with the plane chart of
     /// normal `+z`, `t1 = +x`: on a face the gap is the distance to the tilted plane and the
     /// coordinates those of the closest point, read on the chart.
+    /// A hollow drum's faces (outside, bore and ends) are about the chart's axis or across it;
+    /// a cam's, whose ring alternates radii, are not, and neither is a triangle with a missing
+    /// vertex.
+    #[test]
+    fn a_cylinder_chart_knows_the_faces_it_measures_slip_on() {
+        let chart = z_chart(1.0);
+        let ring = |radii: [f64; 2], z: f64| -> Vec<Vector3<f64>> {
+            (0..8)
+                .map(|k| {
+                    let a = k as f64 * TAU / 8.0;
+                    Vector3::new(a.cos(), a.sin(), 0.0) * radii[k % 2] + Vector3::z() * z
+                })
+                .collect()
+        };
+        // outside at r = 1 and bore at r = 0.5, at z = 0 and 1: rings 0, 1 outside, 2, 3 bore
+        let vertices: Vec<Vector3<f64>> = [([1.0; 2], 0.0), ([1.0; 2], 1.0)]
+            .into_iter()
+            .chain([([0.5; 2], 0.0), ([0.5; 2], 1.0)])
+            .flat_map(|(r, z)| ring(r, z))
+            .collect();
+        let band = |low: usize, high: usize| -> Vec<[usize; 3]> {
+            (0..8)
+                .flat_map(|k| {
+                    let next = (k + 1) % 8;
+                    [
+                        [low + k, low + next, high + next],
+                        [low + k, high + next, high + k],
+                    ]
+                })
+                .collect()
+        };
+        let hollow: Vec<[usize; 3]> = [band(0, 8), band(16, 24), band(0, 16), band(8, 24)].concat();
+        assert_eq!(chart.first_triangle_off(&vertices, &hollow), None);
+        let cam: Vec<Vector3<f64>> = ring([1.0, 0.8], 0.0)
+            .into_iter()
+            .chain(ring([1.0, 0.8], 1.0))
+            .collect();
+        assert_eq!(chart.first_triangle_off(&cam, &band(0, 8)), Some(0));
+        assert_eq!(chart.first_triangle_off(&vertices, &[[0, 1, 99]]), Some(0));
+    }
+
     #[test]
     fn a_plane_charted_mesh_slips_in_lengths_in_the_start_tangent_plane() -> Result<(), ContactError>
     {

@@ -13,6 +13,7 @@
 use nalgebra::{Vector2, Vector3};
 use skid_contact::RigidPolyline;
 use skid_contact::surface::AnalyticCylinder;
+use skid_contact::triangles::CylinderChart;
 use std::f64::consts::TAU;
 
 use super::fields::{allow_parameters, at_most, field, line_error, real, real_parameter};
@@ -607,11 +608,13 @@ fn aligned_phase(phase: f64, n: usize) -> f64 {
 /// body frame, with its chart: a flat mesh (every triangle's normal within 1e-9 of their
 /// area-weighted mean `n`) the plane chart of `n`, whose first direction is the coordinate axis
 /// least along `n` made perpendicular to it, so that its coordinates are lengths on the mesh;
-/// a curved mesh on a body with one free rotation `axis` (through the origin) the cylinder about
-/// it whose radius reaches the farthest vertex (a drum's chart: its slip is counted in the
-/// cylinder's coordinates); any other curved mesh the plane chart of its mean normal (`z` where
-/// that vanishes, on a closed mesh), whose coordinates label its points while its slip is
-/// measured in lengths in the tangent plane.
+/// a drum, a curved mesh on a body with one free rotation `axis` (through the origin) whose
+/// faces lie on cylinders about it or across it (its ends, see
+/// [`CylinderChart::first_triangle_off`]), the cylinder about the axis whose radius reaches the
+/// farthest vertex (its slip is counted in that cylinder's arc length); any other curved mesh
+/// the plane chart of its mean
+/// normal (`z` where that vanishes, on a closed mesh), whose coordinates label its points while
+/// its slip is measured in lengths in the tangent plane.
 pub fn triangles(
     vertices: Vec<[f64; 3]>,
     triangles: Vec<[usize; 3]>,
@@ -631,21 +634,30 @@ pub fn triangles(
             .iter()
             .all(|a| unit(*a).is_some_and(|m| (m - n).norm() <= 1e-9))
     });
-    let chart = match (flat, axis) {
+    let drum = axis.and_then(|axis| {
+        let radius = vertices
+            .iter()
+            .map(|v| {
+                let v = Vector3::from(*v);
+                (v - axis * axis.dot(&v)).norm()
+            })
+            .fold(0.0, f64::max);
+        let cylinder = CylinderChart {
+            radius: shortest_decimal(radius),
+            axis,
+        };
+        let points: Vec<Vector3<f64>> = vertices.iter().map(|v| Vector3::from(*v)).collect();
+        cylinder
+            .first_triangle_off(&points, &triangles)
+            .is_none()
+            .then_some(cylinder)
+    });
+    let chart = match (flat, drum) {
         (Some(normal), _) => plane_chart(normal)?,
-        (None, Some(axis)) => {
-            let radius = vertices
-                .iter()
-                .map(|v| {
-                    let v = Vector3::from(*v);
-                    (v - axis * axis.dot(&v)).norm()
-                })
-                .fold(0.0, f64::max);
-            ChartSpec::Cylinder {
-                radius: shortest_decimal(radius),
-                axis: axis.into(),
-            }
-        }
+        (None, Some(drum)) => ChartSpec::Cylinder {
+            radius: drum.radius,
+            axis: drum.axis.into(),
+        },
         (None, None) => {
             let total: f64 = areas.iter().map(|a| a.norm()).sum();
             let normal = unit(mean)

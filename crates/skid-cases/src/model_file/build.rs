@@ -748,14 +748,24 @@ fn rigid_surface<const D: usize>(
             if D != 3 {
                 return fail(field, "triangles are a 3D surface");
             }
-            let vertices = vertices.iter().map(|v| Vector3::from(*v)).collect();
+            let vertices: Vec<Vector3<f64>> = vertices.iter().map(|v| Vector3::from(*v)).collect();
             let chart = match chart {
                 ChartSpec::Cylinder { radius, axis } => {
                     positive(&format!("{field}.chart.radius"), *radius)?;
-                    SurfaceChart::Cylinder(CylinderChart {
+                    let cylinder = CylinderChart {
                         radius: *radius,
                         axis: vector3(&format!("{field}.chart.axis"), *axis)?,
-                    })
+                    };
+                    if let Some(t) = cylinder.first_triangle_off(&vertices, triangles) {
+                        return fail(
+                            format!("{field}.triangles[{t}]"),
+                            "a cylinder chart counts slip in its arc length, a length only on \
+                             the cylinder; this triangle lies neither on a cylinder about its \
+                             axis nor across it (an end face): give the mesh a plane chart, \
+                             which measures slip in lengths on any mesh",
+                        );
+                    }
+                    SurfaceChart::Cylinder(cylinder)
                 }
                 ChartSpec::Plane { normal, tangent } => SurfaceChart::Plane {
                     normal: vector3(&format!("{field}.chart.normal"), *normal)?,
