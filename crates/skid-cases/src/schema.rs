@@ -292,7 +292,9 @@ pub struct SolverSpec {
     pub max_newton_iterations: usize,
     /// Relative force residual tolerance.
     pub force_tolerance: f64,
-    /// Contact kinematic tolerance relative to the model size.
+    /// Contact kinematic tolerance relative to the model size: a converged increment's gaps
+    /// and slips are within this times the model size of those for which the Coulomb law
+    /// holds exactly.
     pub contact_tolerance: f64,
     /// Natural-map tolerance of the Coulomb solve.
     pub coulomb_tolerance: f64,

@@ -497,7 +497,8 @@ fn a_node_on_the_axis_of_a_revolved_disc_slides_as_on_the_plane() {
 
 /// The pushed block on the plane and on the disc of revolution of the profile from r = 1 in
 /// to `inner` about the vertical axis through `reference` (the ground's reference point): the
-/// same motion to 1e-9 of its travel, and the same contacts sliding.
+/// same motion to 1e-8 of its travel (each run converges its contacts to 1e-8 of the model
+/// size), and the same contacts sliding.
 fn slides_on_a_disc_as_on_the_plane(inner: f64, reference: [f64; 3]) {
     let (plane, disc) = pushed_block_on(
         RigidSurfaceSpec::Revolution {
@@ -519,7 +520,7 @@ fn slides_on_a_disc_as_on_the_plane(inner: f64, reference: [f64; 3]) {
     assert!(travel > 0.05, "the block slides: {travel} m");
     for (x, y) in a.iter().zip(&b) {
         assert!(
-            (x - y).abs() <= 1e-9 * travel,
+            (x - y).abs() <= 1e-8 * travel,
             "u_x {x} on the plane, {y} on the disc"
         );
     }

@@ -13,7 +13,12 @@ pub struct NewtonSettings {
     pub max_iterations: usize,
     /// Relative force residual tolerance.
     pub force_tolerance: f64,
-    /// Contact kinematic tolerance, relative to the model size.
+    /// Contact kinematic tolerance, relative to the model size: a converged increment's gaps
+    /// and slips differ from those for which the Coulomb law holds exactly by less than this
+    /// times the model size. The default, 1e-8, is under 3 nm on the braking drum (model size
+    /// about 0.28 m), nanometres against a pad compressed by millimetres. 1e-9 took 11 % more
+    /// Newton iterations on `3d-refined` (3738 against 3374) and 14 % more time (145.7 s
+    /// against 127.9 s), for the same stop time to 4e-8 and deceleration to 2e-8.
     pub contact_tolerance: f64,
 }
 
@@ -22,7 +27,7 @@ impl Default for NewtonSettings {
         Self {
             max_iterations: 25,
             force_tolerance: 1e-6,
-            contact_tolerance: 1e-9,
+            contact_tolerance: 1e-8,
         }
     }
 }
