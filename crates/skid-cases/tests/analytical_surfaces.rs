@@ -351,16 +351,21 @@ fn the_pushed_block_slides_on_an_extruded_line_as_on_the_plane() {
         },
         [0.0, 0.0, 0.0],
     );
-    let column = history_column;
+    // the extrusion's first coordinate runs along -x, the plane's along +x
+    follows_the_plane(&plane, &extruded, |x| x.abs());
+}
+
+/// Checks that the run of `other` follows that of `plane` in the plate's travel and the
+/// friction force, read through `seen`, to 1e-9 of each one's largest magnitude.
+fn follows_the_plane(plane: &ModelSpec, other: &ModelSpec, seen: fn(f64) -> f64) {
     for name in ["plate.u_x", "block-ground.tangential_force_1"] {
-        let (a, b) = (column(&plane, name), column(&extruded, name));
+        let (a, b) = (history_column(plane, name), history_column(other, name));
         assert_eq!(a.len(), b.len());
         let scale = a.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         assert!(scale > 0.0, "{name} moves");
-        // the extrusion's first coordinate runs along -x, the plane's along +x
         for (x, y) in a.iter().zip(&b) {
             assert!(
-                (x.abs() - y.abs()).abs() <= 1e-9 * scale,
+                (seen(*x) - seen(*y)).abs() <= 1e-9 * scale,
                 "{name}: {x} against {y}"
             );
         }
@@ -391,16 +396,7 @@ fn the_pushed_block_slides_on_a_mesh_with_a_tilted_chart_as_on_the_plane() {
         },
         [0.0, 0.0, 0.0],
     );
-    let column = history_column;
-    for name in ["plate.u_x", "block-ground.tangential_force_1"] {
-        let (a, b) = (column(&plane, name), column(&mesh, name));
-        assert_eq!(a.len(), b.len());
-        let scale = a.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        assert!(scale > 0.0, "{name} moves");
-        for (x, y) in a.iter().zip(&b) {
-            assert!((x - y).abs() <= 1e-9 * scale, "{name}: {x} against {y}");
-        }
-    }
+    follows_the_plane(&plane, &mesh, |x| x);
 }
 
 /// The pushed block on an extruded floor that ends at x = 2 cm, 1 cm ahead of the block: the

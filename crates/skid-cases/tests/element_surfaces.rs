@@ -61,7 +61,8 @@ block, P3, 1.e4
 }
 
 fn ground(model: &ModelSpec) -> &RigidSurfaceSpec {
-    model.rigid_bodies[0].surface.as_ref().expect("a surface")
+    let body = model.rigid_bodies.iter().find(|b| b.name == "ground");
+    body.expect("ground").surface.as_ref().expect("a surface")
 }
 
 /// A floor that runs flat then ramps up: as a bent `SEGMENTS` profile and as a chain of `R2D2`
@@ -176,17 +177,12 @@ fn flat_rigid_elements_are_a_triangle_mesh_on_a_plane_chart() {
         .join("../../cases/verification/3d-block-pushed-on-facets-deck.inp");
     let deck = std::fs::read_to_string(&path).expect("deck");
     let model = read_deck_text(&deck).expect("facets deck");
-    let ground = model
-        .rigid_bodies
-        .iter()
-        .find(|b| b.name == "ground")
-        .expect("ground");
-    match &ground.surface {
-        Some(RigidSurfaceSpec::Triangles {
+    match ground(&model) {
+        RigidSurfaceSpec::Triangles {
             vertices,
             triangles,
             chart,
-        }) => {
+        } => {
             // five quadrilaterals of two triangles and two triangles
             assert_eq!((vertices.len(), triangles.len()), (12, 12));
             assert!(vertices.iter().all(|v| v[1] == 0.0));
@@ -205,17 +201,12 @@ fn flat_rigid_elements_are_a_triangle_mesh_on_a_plane_chart() {
         .replace("0.0005, 0.04", "0.0005, 0.03");
     assert_ne!(dip, deck);
     let model = read_deck_text(&dip).expect("dipped floor");
-    let ground = model
-        .rigid_bodies
-        .iter()
-        .find(|b| b.name == "ground")
-        .expect("ground");
-    let Some(RigidSurfaceSpec::Triangles {
+    let RigidSurfaceSpec::Triangles {
         chart: ChartSpec::Plane { normal, tangent },
         ..
-    }) = &ground.surface
+    } = ground(&model)
     else {
-        panic!("{:?}", ground.surface);
+        panic!("{:?}", ground(&model));
     };
     // the area vectors of a mesh add up to those of its boundary's loop, flat here: +y
     assert!((normal[1] - 1.0).abs() < 1e-15, "{normal:?}");

@@ -42,15 +42,12 @@ impl RigidPlane {
             t2: n.cross(&t1),
         })
     }
-}
 
-impl RigidPlane {
     /// The plane's directions turned into the tangent plane of a surface of unit normal `n`:
     /// `t_1` is the part of `t1` perpendicular to `n` made unit, or that of `t2` where the part of
     /// `t1` is shorter than `1/sqrt 2` (then that of `t2` is longer: their squares add up to at
     /// least 1), and `t_2 = n x t_1`; on a surface parallel to the plane, `t1` and `t2`
-    /// themselves.
-    /// `None` if `n` is not a finite unit vector.
+    /// themselves. `None` if `n` is not a finite unit vector.
     pub(crate) fn tangents_across(&self, n: &Vector3<f64>) -> Option<[Vector3<f64>; 2]> {
         let off_unit = (n.norm() - 1.0).abs();
         if off_unit.is_nan() || off_unit > 1e-9 {

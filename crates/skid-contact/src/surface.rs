@@ -2,6 +2,7 @@
 //! static in that frame), with closest-point projections.
 
 use nalgebra::{Matrix3, Vector2, Vector3};
+use serde::{Deserialize, Serialize};
 
 use crate::error::ContactError;
 
@@ -133,7 +134,7 @@ pub trait RigidSurface: Send + Sync + std::fmt::Debug {
 /// A point of a rigid surface where a node's contact was (at the start of an increment): its
 /// convected coordinates, its body-frame position and the surface's outward unit normal there,
 /// from which [`RigidSurface::slip`] measures.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SurfacePoint {
     /// Convected coordinates `xi`.
     pub coords: Vector2<f64>,

@@ -216,7 +216,7 @@ fn solve_increment_with<const D: usize>(
     let shift_mass = model.regularization_mass();
     let quasi_static = model.quasi_static();
     let length = model.length_scale();
-    let previous: Vec<SurfacePoint> = start.contacts.iter().map(|c| c.closest()).collect();
+    let previous: Vec<SurfacePoint> = start.contacts.iter().map(|c| c.closest).collect();
     // Dynamic increments take the normal rows between the start and the end positions, so
     // that the contact impulse does the work `p_N dg` (see `contact_rows`); a static
     // equilibrium takes the normal at the solution itself.
@@ -828,9 +828,7 @@ fn finish<const D: usize>(
         contacts.push(ContactPointState {
             pair: old.pair,
             node: old.node,
-            coords: rows.closest[k].coords,
-            position: rows.closest[k].position,
-            normal: rows.closest[k].normal,
+            closest: rows.closest[k],
             gap,
             slip,
             normal_force: force(0),

@@ -1,6 +1,6 @@
 //! The solution state at the end of a converged increment.
 
-use nalgebra::{DVector, Vector2, Vector3};
+use nalgebra::{DVector, Vector2};
 use serde::{Deserialize, Serialize};
 use skid_contact::SurfacePoint;
 
@@ -11,12 +11,10 @@ pub struct ContactPointState {
     pub pair: usize,
     /// Slave node.
     pub node: usize,
-    /// Convected coordinates of the node's projection on the master surface (m).
-    pub coords: Vector2<f64>,
-    /// The projection itself, in the body frame of the surface's rigid body (m).
-    pub position: Vector3<f64>,
-    /// The surface's outward unit normal there (body frame).
-    pub normal: Vector3<f64>,
+    /// The node's projection on the master surface (its convected coordinates, and its
+    /// position and the normal there in the body frame of the surface's rigid body), where
+    /// the next increment's slip starts.
+    pub closest: SurfacePoint,
     /// Normal gap (m, > 0 open).
     pub gap: f64,
     /// Slip increment of the last increment in the surface coordinates (m).
@@ -28,15 +26,6 @@ pub struct ContactPointState {
 }
 
 impl ContactPointState {
-    /// The node's closest point on the master surface, where the next increment's slip starts.
-    pub fn closest(&self) -> SurfacePoint {
-        SurfacePoint {
-            coords: self.coords,
-            position: self.position,
-            normal: self.normal,
-        }
-    }
-
     /// True if the contact carries a normal force.
     pub fn is_closed(&self) -> bool {
         self.normal_force > 0.0

@@ -587,9 +587,7 @@ pub fn initial_state<const D: usize>(
         .map(|(k, (pair, node))| ContactPointState {
             pair,
             node,
-            coords: rows.closest[k].coords,
-            position: rows.closest[k].position,
-            normal: rows.closest[k].normal,
+            closest: rows.closest[k],
             gap: rows.u[k * d],
             slip: nalgebra::Vector2::zeros(),
             normal_force: 0.0,

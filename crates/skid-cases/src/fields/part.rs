@@ -99,7 +99,7 @@ fn contact_tractions<const D: usize>(
         let position = current
             .get(c.node)
             .ok_or_else(|| invalid_data(format!("contact node {} does not exist", c.node)))?;
-        let kinematics = evaluate(pair.surface.as_ref(), &frame, position, Some(&c.closest()))
+        let kinematics = evaluate(pair.surface.as_ref(), &frame, position, Some(&c.closest))
             .ok_or_else(|| {
                 invalid_data(format!(
                     "contact pair '{}': node {} has no projection",
