@@ -44,10 +44,11 @@ impl RigidPlane {
     }
 
     /// The plane's directions turned into the tangent plane of a surface of unit normal `n`:
-    /// `t_1` is the part of `t1` perpendicular to `n` made unit, or that of `t2` where the part of
-    /// `t1` is shorter than `1/sqrt 2` (then that of `t2` is longer: their squares add up to at
-    /// least 1), and `t_2 = n x t_1`; on a surface parallel to the plane, `t1` and `t2`
-    /// themselves. `None` if `n` is not a finite unit vector.
+    /// `t_1` is the part of `t1` perpendicular to `n` made unit, and `t_2 = n x t_1`; on a
+    /// surface parallel to the plane, `t1` and `t2` themselves. They turn continuously with `n`
+    /// but where `t1` is within 1e-3 of `n` (a face across the plane's first direction), which
+    /// takes the part of `t2` instead (then nearly all of it). `None` if `n` is not a finite
+    /// unit vector.
     pub(crate) fn tangents_across(&self, n: &Vector3<f64>) -> Option<[Vector3<f64>; 2]> {
         let off_unit = (n.norm() - 1.0).abs();
         if off_unit.is_nan() || off_unit > 1e-9 {
@@ -55,12 +56,7 @@ impl RigidPlane {
         }
         let along = |t: &Vector3<f64>| t - n * n.dot(t);
         let (first, second) = (along(&self.t1), along(&self.t2));
-        let t1 = if first.norm_squared() >= 0.5 {
-            first
-        } else {
-            second
-        }
-        .try_normalize(0.0)?;
+        let t1 = if first.norm() >= 1e-3 { first } else { second }.try_normalize(0.0)?;
         Some([t1, n.cross(&t1)])
     }
 }

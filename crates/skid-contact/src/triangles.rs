@@ -535,7 +535,8 @@ impl RigidSurface for TriangulatedSurface {
     /// [`RigidSurface::slip`]). With a plane chart, lengths in the tangent plane at the start
     /// point `p_0` of normal `n_0`: `s_k = t_k . (y - p_0)`, gradients `t_k` and no curvature,
     /// with the chart's directions turned into that plane (`t_1` the chart's first direction's
-    /// part in it, made unit, or its second's where the first is steep, `t_2 = n_0 x t_1`). On
+    /// part in it, made unit, or its second's where the first is along `n_0`, `t_2 = n_0 x
+    /// t_1`). On
     /// a flat mesh on its own plane chart these are the increments of the chart's coordinates;
     /// they stay lengths on a curved mesh or a mesh sloped against the chart, where a chart
     /// coordinate's increment would be the slip's projection (`cos a` times its length on a
@@ -751,6 +752,18 @@ mod tests {
             p.coords - from.coords,
             epsilon = 1e-15
         );
+        // a steeper face (slope 2, its part of x shorter than 1/sqrt 2) still slips down the
+        // slope first, as the tangents turn continuously with the normal
+        let steep = TriangulatedSurface::new(
+            vec![Vector3::zeros(), Vector3::y(), Vector3::new(-0.5, 0.0, 1.0)],
+            vec![[0, 1, 2]],
+            chart,
+        )?;
+        let on = Vector3::new(-0.1, 0.3, 0.2);
+        let from = project(&steep, &on).closest(&on);
+        let slip = steep.slip(&from, &on, &project(&steep, &on));
+        let down = Vector3::new(1.0, 0.0, -2.0) / 5.0_f64.sqrt();
+        assert_relative_eq!(slip.gradient[0], down, epsilon = 1e-15);
         // a wall across the chart (normal x against the chart's first direction x): the
         // chart's second direction y leads
         let wall = TriangulatedSurface::new(
