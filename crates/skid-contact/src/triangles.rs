@@ -49,8 +49,9 @@ pub const ON_CYLINDER_TOLERANCE: f64 = 1e-6;
 impl CylinderChart {
     /// The first of `triangles` (indices into `vertices`) that lies neither on a cylinder about
     /// the chart's axis (its corners at one radius within [`ON_CYLINDER_TOLERANCE`] of it) nor
-    /// across the axis (a drum's end face: unit normal along the axis within that tolerance), or
-    /// that names a vertex that does not exist; `None` if every triangle does one or the other.
+    /// across the axis (a drum's end face: unit normal along the axis within that tolerance);
+    /// `None` if every triangle does one or the other. A triangle that names a vertex that does
+    /// not exist is left to [`TriangulatedSurface::new`] to report.
     /// Slip is counted in the chart's arc length `R dtheta`, which at radius `r` weighs a slip
     /// `R / r` times, and friction with it: exact on the chart's own cylinder, wrong on faces
     /// that are not about its axis. (A coaxial face at another radius, a hollow drum's bore,
@@ -68,7 +69,7 @@ impl CylinderChart {
                 .map(|&i| vertices.get(i))
                 .collect::<Option<Vec<_>>>()
             else {
-                return true;
+                return false;
             };
             let radii = corners.iter().map(|v| radius(v));
             let (least, most) =
@@ -650,8 +651,8 @@ mod tests {
     /// normal `+z`, `t1 = +x`: on a face the gap is the distance to the tilted plane and the
     /// coordinates those of the closest point, read on the chart.
     /// A hollow drum's faces (outside, bore and ends) are about the chart's axis or across it;
-    /// a cam's, whose ring alternates radii, are not, and neither is a triangle with a missing
-    /// vertex.
+    /// a cam's, whose ring alternates radii, are not; a triangle with a missing vertex is left
+    /// to the mesh's own checks.
     #[test]
     fn a_cylinder_chart_knows_the_faces_it_measures_slip_on() {
         let chart = z_chart(1.0);
@@ -687,7 +688,7 @@ mod tests {
             .chain(ring([1.0, 0.8], 1.0))
             .collect();
         assert_eq!(chart.first_triangle_off(&cam, &band(0, 8)), Some(0));
-        assert_eq!(chart.first_triangle_off(&vertices, &[[0, 1, 99]]), Some(0));
+        assert_eq!(chart.first_triangle_off(&vertices, &[[0, 1, 99]]), None);
     }
 
     #[test]
