@@ -52,6 +52,7 @@ impl CylinderChart {
     /// across the axis (a drum's end face: unit normal along the axis within that tolerance);
     /// `None` if every triangle does one or the other. A triangle that names a vertex that does
     /// not exist is left to [`TriangulatedSurface::new`] to report.
+    ///
     /// Slip is counted in the chart's arc length `R dtheta`, which at radius `r` weighs a slip
     /// `R / r` times, and friction with it: exact on the chart's own cylinder, wrong on faces
     /// that are not about its axis. (A coaxial face at another radius, a hollow drum's bore,
@@ -537,11 +538,10 @@ impl RigidSurface for TriangulatedSurface {
     /// point `p_0` of normal `n_0`: `s_k = t_k . (y - p_0)`, gradients `t_k` and no curvature,
     /// with the chart's directions turned into that plane (`t_1` the chart's first direction's
     /// part in it, made unit, or its second's where the first is along `n_0`, `t_2 = n_0 x
-    /// t_1`). On
-    /// a flat mesh on its own plane chart these are the increments of the chart's coordinates;
-    /// they stay lengths on a curved mesh or a mesh sloped against the chart, where a chart
-    /// coordinate's increment would be the slip's projection (`cos a` times its length on a
-    /// face at angle `a` to the chart).
+    /// t_1`). On a flat mesh on its own plane chart these are the increments of the chart's
+    /// coordinates; they stay lengths on a curved mesh or a mesh sloped against the chart,
+    /// where a chart coordinate's increment would be the slip's projection (`cos a` times its
+    /// length on a face at angle `a` to the chart).
     fn slip(&self, from: &SurfacePoint, y: &Vector3<f64>, to: &Projection) -> Slip {
         let tangents = match &self.chart {
             Chart::Plane(plane) => plane.tangents_across(&from.normal),
