@@ -202,9 +202,15 @@ pub struct RigidBodySpec {
     /// Point mass, kg.
     #[serde(default)]
     pub mass: f64,
-    /// Rotary inertia about the free rotation axis, kg m^2.
+    /// Rotary inertia about the free rotation axis of a body turning about one axis, kg m^2.
     #[serde(default)]
     pub rotary_inertia: f64,
+    /// Principal moments of inertia `[Jx, Jy, Jz]` about the global axes through the reference
+    /// node, which are the body's principal axes at the start, kg m^2. A body free to turn about
+    /// all three axes needs them; a body turning about one axis may take its moment from here
+    /// instead of `rotary_inertia` (give one or the other).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub principal_inertia: Option<[f64; 3]>,
     /// Contact surface, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub surface: Option<RigidSurfaceSpec>,
@@ -212,7 +218,7 @@ pub struct RigidBodySpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial_velocity: Option<Vec<f64>>,
     /// Initial angular velocity vector `[wx, wy, wz]`, rad/s (absent: 0); it must lie along the
-    /// body's free rotation axis.
+    /// body's free rotation axis, or be any vector for a body free to turn about all three.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial_angular_velocity: Option<[f64; 3]>,
 }

@@ -871,3 +871,41 @@ fn automatic_static_incrementation_reads_with_the_keyword_defaults() {
     let read = read_text(&written).expect("reads back").model;
     assert_eq!(read.steps, model.steps);
 }
+
+/// A rigid body with no boundary condition on its rotations turns freely about all three axes,
+/// with the principal moments of its `*ROTARY INERTIA`; products of inertia are refused there.
+#[test]
+fn a_body_without_rotation_boundaries_turns_freely() {
+    let deck = std::fs::read_to_string(repo("cases/inp/3d-analytic.inp")).expect("deck");
+    let free = deck.replacen("drum, 4, 4\ndrum, 5, 5\n", "", 1).replacen(
+        "0.175, 0.175, 0.175",
+        "0.1, 0.1, 0.175",
+        1,
+    );
+    let read = read_text(&free).expect("deck reads");
+    let drum = &read.model.rigid_bodies[0];
+    assert_eq!(drum.principal_inertia, Some([0.1, 0.1, 0.175]));
+    assert_eq!(drum.rotary_inertia, 0.0);
+    let scene = skid_cases::model_file::build::<3>(&read.model).expect("model builds");
+    let body = &scene.model.bodies()[0];
+    assert_eq!(
+        body.rotation,
+        skid_fem::rigid::Rotation::Free {
+            principal_inertia: nalgebra::Vector3::new(0.1, 0.1, 0.175),
+            initial_angular_velocity: nalgebra::Vector3::new(0.0, 0.0, 60.0),
+        }
+    );
+    assert_eq!(scene.model.dofs().body_rotations(0).len(), 3);
+    let tilted = free.replacen("0.1, 0.1, 0.175", "0.1, 0.1, 0.175, 0.01", 1);
+    let error = read_text(&tilted).expect_err("products of inertia");
+    // at the *RIGID BODY line
+    let line = tilted
+        .lines()
+        .position(|l| l.starts_with("*RIGID BODY"))
+        .expect("a rigid body")
+        + 1;
+    assert!(
+        error.contains("products of inertia") && error.contains(&format!("scene.inp:{line}:")),
+        "{error}"
+    );
+}

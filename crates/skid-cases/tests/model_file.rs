@@ -381,7 +381,7 @@ fn every_model_error_names_its_field() {
     )
     .expect("json");
     type Edit = fn(&mut Value);
-    let cases: [(&Value, Edit, &str, &str); 18] = [
+    let cases: [(&Value, Edit, &str, &str); 21] = [
         (
             &base,
             |v| v["skid_model"] = json!(2),
@@ -452,7 +452,31 @@ fn every_model_error_names_its_field() {
             &base3,
             |v| v["boundary"][1]["dofs"] = json!(["x", "z", "rz"]),
             "rigid_bodies[1]",
-            "at most one axis",
+            "about no axis, one, or all three",
+        ),
+        (
+            &base3,
+            |v| v["boundary"][1]["dofs"] = json!(["x", "z"]),
+            "rigid_bodies[1].principal_inertia",
+            "expected its principal moments of inertia",
+        ),
+        (
+            &base3,
+            |v| {
+                v["boundary"][1]["dofs"] = json!(["x", "z"]);
+                v["rigid_bodies"][1]["principal_inertia"] = json!([0.1, 0.1, -0.2]);
+            },
+            "rigid_bodies[1].principal_inertia",
+            "expected moments >= 0",
+        ),
+        (
+            &base3,
+            |v| {
+                v["rigid_bodies"][1]["rotary_inertia"] = json!(0.1);
+                v["rigid_bodies"][1]["principal_inertia"] = json!([0.1, 0.1, 0.1]);
+            },
+            "rigid_bodies[1].principal_inertia",
+            "not both",
         ),
         (
             &base,

@@ -1,67 +1,115 @@
-//! Gap and slip kinematics of a slave node against a surface carried by a rigid body rotating
-//! about a fixed axis.
+//! Gap and slip kinematics of a slave node against a surface carried by a rigid body, turning
+//! about a fixed axis or freely.
 //!
-//! With body reference point `c`, unit world axis `e` and angle `theta`, `Q(theta)` is the rotation
-//! by `theta` about `e` and the body frame is `y = Q^T (x - c)`. Since `dQ/dtheta = [e]x Q` and
-//! `Q^T e = e`, `dy = Q^T dx - (e x y) dtheta`. For any surface function `f(y)` with gradient
-//! `G = df/dy` and Hessian `F = d^2f/dy^2` this gives, with `w = e x y`,
-//! - `df/dx = Q G` and `df/dtheta = -G . w`;
-//! - `d^2f/dx^2 = Q F Q^T`, `d^2f/dx dtheta = e x (Q G) - Q F w` and
-//!   `d^2f/dtheta^2 = w . F w + G . (e x w)` (from `dw/dtheta = -e x w`).
+//! With body reference point `c` and orientation `Q`, the body frame is `y = Q^T (x - c)`. The
+//! body's rotation unknowns are material increments `delta_i` about unit body-frame axes `a_i`,
+//! `Q <- Q exp(sum_i delta_i [a_i]x)`: one about the axis `e` of a body turning about a fixed
+//! axis (there `Q^T e = e` and `delta` is the increment of its angle), or three about the body's
+//! own axes for a body free to turn. Then `dy = Q^T dx - sum_i w_i delta_i` with `w_i = a_i x y`,
+//! and to second order `y` gains `1/2 sum_ij delta_i delta_j a_i x w_j`. For any surface
+//! function `f(y)` with gradient `G = df/dy` and Hessian `F = d^2f/dy^2` this gives
+//! - `df/dx = Q G` and `df/ddelta_i = -G . w_i`;
+//! - `d^2f/dx^2 = Q F Q^T` and `d^2f/dx ddelta_i = Q (a_i x G - F w_i)`;
+//! - `d^2f/ddelta_i ddelta_j = w_i . F w_j + 1/2 G . (a_i x w_j + a_j x w_i)`.
 //!
 //! The second derivatives give the stiffness of the contact forces `r` on a curved or rotating
 //! surface, `sum_k r_k d^2 u_k` (see `skid_integrator::coupling`).
 
-use nalgebra::{Matrix3, Rotation3, Unit, Vector2, Vector3};
+use nalgebra::{Matrix3, Rotation3, Unit, UnitQuaternion, Vector2, Vector3};
 
 use crate::surface::{DiscreteGradient, RigidSurface, SurfacePoint};
 
-/// Placement of a rigid body rotating about a fixed axis.
+/// How a rigid body may turn: which rotation unknowns its kinematics are differentiated in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Turning {
+    /// About one fixed unit axis `e` (world frame, which is also its body frame direction):
+    /// one unknown, the angle.
+    About(Unit<Vector3<f64>>),
+    /// Freely: three unknowns, the material increments about the body's own x, y and z axes.
+    Free,
+}
+
+/// Placement of a rigid body: reference point, orientation and rotation unknowns.
 #[derive(Clone, Copy, Debug)]
 pub struct RotatingFrame {
-    /// Reference point `c` of the body on the rotation axis (world frame).
+    /// Reference point `c` of the body (world frame): on the rotation axis, or the centre of mass
+    /// of a body free to turn.
     pub center: Vector3<f64>,
-    /// Unit rotation axis `e` (world frame); it is normalised again on use.
-    pub axis: Vector3<f64>,
-    /// Rotation angle `theta` (radians, counter-clockwise about `axis`); the body frame coincides
-    /// with the world orientation at `theta = 0`.
-    pub angle: f64,
+    /// Orientation `Q`: a body-frame point `y` is at `c + Q y`.
+    pub orientation: Rotation3<f64>,
+    /// The rotation unknowns.
+    pub turning: Turning,
 }
 
 impl RotatingFrame {
-    /// The unit axis `e` and the rotation `Q(theta)`; `None` if the frame is degenerate (zero or
-    /// non-finite axis, non-finite centre or angle).
-    fn orientation(&self) -> Option<(Unit<Vector3<f64>>, Rotation3<f64>)> {
-        let axis = self.unit_axis()?;
-        Some((axis, Rotation3::from_axis_angle(&axis, self.angle)))
-    }
-
-    /// The unit axis `e` alone, without the rotation (whose sine and cosine cost more than the
-    /// rest); `None` where [`Self::orientation`] is.
-    fn unit_axis(&self) -> Option<Unit<Vector3<f64>>> {
-        if !(self.angle.is_finite() && self.center.iter().all(|c| c.is_finite())) {
-            return None;
+    /// The frame of a body turned by `angle` (rad, counter-clockwise) about the fixed `axis`
+    /// through `center`, from the world orientation; a zero or non-finite axis or a non-finite
+    /// angle gives a frame that [`Self::is_finite`] rejects.
+    pub fn about(center: Vector3<f64>, axis: Vector3<f64>, angle: f64) -> Self {
+        let axis = Unit::new_unchecked(axis / axis.norm());
+        Self {
+            center,
+            orientation: Rotation3::from_axis_angle(&axis, angle),
+            turning: Turning::About(axis),
         }
-        Unit::try_new(self.axis, 0.0).filter(|a| a.iter().all(|c| c.is_finite()))
     }
 
-    /// The world position `x = c + Q(theta) y` of the body-frame point `y`; `None` if the frame
-    /// is degenerate.
+    /// The frame of a body free to turn, at `orientation` with its reference point at `center`.
+    pub fn free(center: Vector3<f64>, orientation: &UnitQuaternion<f64>) -> Self {
+        Self {
+            center,
+            orientation: orientation.to_rotation_matrix(),
+            turning: Turning::Free,
+        }
+    }
+
+    /// Number of rotation unknowns (1 or 3).
+    pub fn rotations(&self) -> usize {
+        match self.turning {
+            Turning::About(_) => 1,
+            Turning::Free => 3,
+        }
+    }
+
+    /// Body-frame unit axis `a_i` of rotation unknown `i`.
+    pub fn rotation_axis(&self, i: usize) -> Vector3<f64> {
+        match self.turning {
+            Turning::About(axis) => axis.into_inner(),
+            Turning::Free => Vector3::ith(i, 1.0),
+        }
+    }
+
+    /// True if the centre, the orientation and the axis are finite (a frame made from a zero
+    /// axis or a non-finite angle is not).
+    pub fn is_finite(&self) -> bool {
+        let axis_finite = match self.turning {
+            Turning::About(axis) => axis.iter().all(|c| c.is_finite()),
+            Turning::Free => true,
+        };
+        axis_finite
+            && self.center.iter().all(|c| c.is_finite())
+            && self.orientation.matrix().iter().all(|c| c.is_finite())
+    }
+
+    /// The world position `x = c + Q y` of the body-frame point `y`; `None` if the frame is not
+    /// finite.
     pub fn to_world(&self, y: &Vector3<f64>) -> Option<Vector3<f64>> {
-        let (_, rotation) = self.orientation()?;
-        Some(self.center + rotation * y)
+        self.is_finite().then(|| self.center + self.orientation * y)
     }
 
-    /// The body-frame point `y = Q(theta)^T (x - c)` at the world position `x`; `None` if the
-    /// frame is degenerate.
+    /// The body-frame point `y = Q^T (x - c)` at the world position `x`; `None` if the frame is
+    /// not finite.
     pub fn to_body(&self, x: &Vector3<f64>) -> Option<Vector3<f64>> {
-        let (_, rotation) = self.orientation()?;
-        Some(rotation.inverse_transform_vector(&(x - self.center)))
+        self.is_finite().then(|| {
+            self.orientation
+                .inverse_transform_vector(&(x - self.center))
+        })
     }
 }
 
 /// Gap, slip and their exact first and second derivatives for one slave node, with its closest
-/// point.
+/// point. Rotation derivatives are per rotation unknown of the frame ([`RotatingFrame::rotations`]
+/// of them; the others are zero).
 #[derive(Clone, Debug)]
 pub struct ContactKinematics {
     /// Signed gap `g` (`> 0` open).
@@ -76,15 +124,17 @@ pub struct ContactKinematics {
     /// Derivatives of `[g, s_0, s_1]` with respect to the slave node's world position `x`:
     /// `Q df/dy`.
     pub d_dx: [Vector3<f64>; 3],
-    /// Derivatives of `[g, s_0, s_1]` with respect to the body's rotation angle `theta`:
-    /// `-(df/dy) . (e x y)`.
-    pub d_dangle: [f64; 3],
+    /// Derivatives of `[g, s_0, s_1]` with respect to the rotation unknowns, entry `i` for
+    /// `delta_i`: `-G . w_i`.
+    pub d_drotation: [Vector3<f64>; 3],
     /// Second derivatives of `[g, s_0, s_1]` with respect to `x`: `Q F Q^T`.
     pub d2_dx2: [Matrix3<f64>; 3],
-    /// Mixed second derivatives with respect to `x` and `theta`: `e x (Q G) - Q F w`.
-    pub d2_dx_dangle: [Vector3<f64>; 3],
-    /// Second derivatives with respect to `theta`: `w . F w + G . (e x w)`.
-    pub d2_dangle2: [f64; 3],
+    /// Mixed second derivatives, column `i` with respect to `x` and `delta_i`:
+    /// `Q (a_i x G - F w_i)`.
+    pub d2_dx_drotation: [Matrix3<f64>; 3],
+    /// Second derivatives with respect to the rotation unknowns (symmetric):
+    /// `w_i . F w_j + 1/2 G . (a_i x w_j + a_j x w_i)`.
+    pub d2_drotation2: [Matrix3<f64>; 3],
 }
 
 /// Evaluate gap, slip since the contact point `from` (see [`RigidSurface::slip`]; `None`: since
@@ -92,29 +142,40 @@ pub struct ContactKinematics {
 /// second derivatives for a node at world position `x` (2D problems pass `z = 0` and a `z`
 /// axis).
 ///
-/// Returns `None` if the frame is degenerate (zero or non-finite axis, non-finite centre or angle)
-/// or the surface projection is undefined at `y = Q^T (x - c)`.
+/// Returns `None` if the frame is not finite or the surface projection is undefined at
+/// `y = Q^T (x - c)`.
 pub fn evaluate(
     surface: &dyn RigidSurface,
     frame: &RotatingFrame,
     x: &Vector3<f64>,
     from: Option<&SurfacePoint>,
 ) -> Option<ContactKinematics> {
-    let (axis, rotation) = frame.orientation()?;
-    let y = rotation.inverse_transform_vector(&(x - frame.center));
+    let y = frame.to_body(x)?;
+    let rotation = &frame.orientation;
     let projection = surface.project(&y)?;
     let closest = projection.closest(&y);
     let slip = surface.slip(from.unwrap_or(&closest), &y, &projection);
-    let body_velocity = axis.cross(&y);
+    let rotations = frame.rotations();
+    let axes: [Vector3<f64>; 3] = std::array::from_fn(|i| frame.rotation_axis(i));
+    let w: [Vector3<f64>; 3] = std::array::from_fn(|i| axes[i].cross(&y));
     let gradients = [projection.gap_gradient, slip.gradient[0], slip.gradient[1]];
     let hessians = [projection.gap_hessian, slip.hessian[0], slip.hessian[1]];
     let world = rotation.matrix();
-    let mut d2_dx_dangle = [Vector3::zeros(); 3];
-    let mut d2_dangle2 = [0.0; 3];
+    let mut d_drotation = [Vector3::zeros(); 3];
+    let mut d2_dx_drotation = [Matrix3::zeros(); 3];
+    let mut d2_drotation2 = [Matrix3::zeros(); 3];
     for (k, (g, f)) in gradients.iter().zip(&hessians).enumerate() {
-        let f_w = f * body_velocity;
-        d2_dx_dangle[k] = axis.cross(&(rotation * g)) - rotation * f_w;
-        d2_dangle2[k] = body_velocity.dot(&f_w) + g.dot(&axis.cross(&body_velocity));
+        let f_w: [Vector3<f64>; 3] = std::array::from_fn(|i| f * w[i]);
+        for i in 0..rotations {
+            d_drotation[k][i] = -g.dot(&w[i]);
+            d2_dx_drotation[k].set_column(i, &(world * (axes[i].cross(g) - f_w[i])));
+            for j in 0..=i {
+                let value =
+                    w[i].dot(&f_w[j]) + 0.5 * g.dot(&(axes[i].cross(&w[j]) + axes[j].cross(&w[i])));
+                d2_drotation2[k][(i, j)] = value;
+                d2_drotation2[k][(j, i)] = value;
+            }
+        }
     }
     let normal_world = rotation * projection.gap_gradient;
     let normal_norm = normal_world.norm();
@@ -129,31 +190,36 @@ pub fn evaluate(
         slip: slip.value,
         normal,
         d_dx: gradients.map(|g| rotation * g),
-        d_dangle: gradients.map(|g| -g.dot(&body_velocity)),
+        d_drotation,
         d2_dx2: hessians.map(|f| world * f * world.transpose()),
-        d2_dx_dangle,
-        d2_dangle2,
+        d2_dx_drotation,
+        d2_drotation2,
     })
 }
 
 /// World-frame discrete gradient of the gap over an increment (see
 /// [`RigidSurface::gap_discrete_gradient`]) for a node now at world position `x` that started
 /// the increment at `start_offset = x_start - c_start` from the body reference point: the start
-/// point is taken into the current body frame, which the surface's rotation invariance allows.
-/// Then `G . ((x - c) - start_offset)` is exactly the change of the gap over the increment.
+/// point is taken into the current body frame, which the surface's invariance under the body's
+/// rotation about its fixed axis allows. Then `G . ((x - c) - start_offset)` is exactly the
+/// change of the gap over the increment.
 ///
 /// Its Jacobian (in `x`, rotated to the world frame alike) is independent of the body's angle
 /// for the same reason.
 ///
-/// `None` if the frame is degenerate or the surface offers no discrete gradient.
+/// `None` if the frame is not finite, the body is free to turn (no axis of invariance), or the
+/// surface offers no discrete gradient.
 pub fn gap_discrete_gradient(
     surface: &dyn RigidSurface,
     frame: &RotatingFrame,
     start_offset: &Vector3<f64>,
     x: &Vector3<f64>,
 ) -> Option<DiscreteGradient> {
-    let (axis, rotation) = frame.orientation()?;
-    let y_end = rotation.inverse_transform_vector(&(x - frame.center));
+    let Turning::About(axis) = frame.turning else {
+        return None;
+    };
+    let y_end = frame.to_body(x)?;
+    let rotation = &frame.orientation;
     let y_start = rotation.inverse_transform_vector(start_offset);
     let world = rotation.matrix();
     surface
@@ -175,21 +241,24 @@ pub const MIN_SECANT_TURN: f64 = 1e-8;
 /// the node's motion.
 pub const MAX_COLUMN_LEVER: f64 = 2.0;
 
-/// The start of an increment for [`rotation_column`]: the body's angle `theta_0` and the node's
-/// offset `r_0 = x_0 - c_0` from the body's reference point.
+/// The start of an increment for [`rotation_column`]: the body's orientation `Q_0`, its turn
+/// over the increment `theta_1 - theta_0` about its fixed axis, and the node's offset
+/// `r_0 = x_0 - c_0` from the body's reference point.
 #[derive(Clone, Copy, Debug)]
 pub struct IncrementStart {
-    /// `theta_0`, rad.
-    pub angle: f64,
+    /// `Q_0`.
+    pub orientation: Rotation3<f64>,
+    /// `theta_1 - theta_0`, rad.
+    pub turn: f64,
     /// `r_0` (world frame).
     pub offset: Vector3<f64>,
 }
 
 /// Rotation column of a node's rows `f = [g, s_0, s_1]` over an increment that makes them a
-/// discrete gradient. With the end-point `df/dx` (`end.d_dx`, the kinematics evaluated from the
-/// contact point at the start `y_0`, so that `end.slip` is the slip over the increment) in the
-/// node and translation columns, the body now at `theta_1 = frame.angle` and the node at offset
-/// `r_1 = x_1 - c_1`:
+/// discrete gradient, for a body turning about a fixed axis. With the end-point `df/dx`
+/// (`end.d_dx`, the kinematics evaluated from the contact point at the start `y_0`, so that
+/// `end.slip` is the slip over the increment) in the node and translation columns, the body now
+/// at `frame` and the node at offset `r_1 = x_1 - c_1`:
 ///
 /// `col = (f(y_1) - f(y_0) - df/dx . (r_1 - r_0)) / (theta_1 - theta_0)`,
 ///
@@ -204,8 +273,9 @@ pub struct IncrementStart {
 /// if that makes a component exceed [`MAX_COLUMN_LEVER`] `|r_0|`, the secant in the rotation
 /// alone is returned instead.
 ///
-/// `None` if the turn is below [`MIN_SECANT_TURN`] or not finite, the frame is degenerate, or a
-/// projection is undefined: then the end-point derivative stands.
+/// `None` if the turn is below [`MIN_SECANT_TURN`] or not finite, the body is free to turn (its
+/// end-point derivatives stand), the frame is not finite, or a projection is undefined: then the
+/// end-point derivative stands.
 pub fn rotation_column(
     surface: &dyn RigidSurface,
     frame: &RotatingFrame,
@@ -213,13 +283,14 @@ pub fn rotation_column(
     end_offset: &Vector3<f64>,
     end: &ContactKinematics,
 ) -> Option<[f64; 3]> {
-    let turn = frame.angle - start.angle;
-    if !(turn.abs() >= MIN_SECANT_TURN && turn.is_finite()) {
+    let turn = start.turn;
+    if !(turn.abs() >= MIN_SECANT_TURN && turn.is_finite())
+        || frame.turning == Turning::Free
+        || !frame.is_finite()
+    {
         return None;
     }
-    let axis = frame.unit_axis()?;
-    let start_rotation = Rotation3::from_axis_angle(&axis, start.angle);
-    let y_before = start_rotation.inverse_transform_vector(&start.offset);
+    let y_before = start.orientation.inverse_transform_vector(&start.offset);
     let before = surface.project(&y_before)?;
     let moved = end_offset - start.offset;
     let whole = [end.gap - before.gap, end.slip[0], end.slip[1]];
@@ -228,8 +299,7 @@ pub fn rotation_column(
     if column.iter().all(|c| c.abs() <= bound) {
         return Some(column);
     }
-    let rotation = Rotation3::from_axis_angle(&axis, frame.angle);
-    let y_turned = rotation.inverse_transform_vector(&start.offset);
+    let y_turned = frame.orientation.inverse_transform_vector(&start.offset);
     let turned = surface.project(&y_turned)?;
     let slip = surface
         .slip(&before.closest(&y_before), &y_turned, &turned)
@@ -284,6 +354,16 @@ mod tests {
         [plus.gap - minus.gap, slip[0], slip[1]]
     }
 
+    /// The frame after the material increment `by` of rotation unknown `i`:
+    /// `Q exp(by [a_i]x)`.
+    fn turned(frame: &RotatingFrame, i: usize, by: f64) -> RotatingFrame {
+        let axis = Unit::new_normalize(frame.rotation_axis(i));
+        RotatingFrame {
+            orientation: frame.orientation * Rotation3::from_axis_angle(&axis, by),
+            ..*frame
+        }
+    }
+
     fn check_derivatives(
         surface: &dyn RigidSurface,
         frame: &RotatingFrame,
@@ -305,26 +385,23 @@ mod tests {
                 assert_relative_eq!(difference / (2.0 * h), derivative[j], epsilon = 1e-7);
             }
         }
-        let plus = RotatingFrame {
-            angle: frame.angle + h,
-            ..*frame
-        };
-        let minus = RotatingFrame {
-            angle: frame.angle - h,
-            ..*frame
-        };
-        let d = difference(
-            surface,
-            &eval(surface, &plus, x)?,
-            &eval(surface, &minus, x)?,
-        );
-        for (difference, derivative) in d.iter().zip(k.d_dangle) {
-            assert_relative_eq!(difference / (2.0 * h), derivative, epsilon = 1e-7);
+        for i in 0..frame.rotations() {
+            let d = difference(
+                surface,
+                &eval(surface, &turned(frame, i, h), x)?,
+                &eval(surface, &turned(frame, i, -h), x)?,
+            );
+            for (difference, derivative) in d.iter().zip(&k.d_drotation) {
+                assert_relative_eq!(difference / (2.0 * h), derivative[i], epsilon = 1e-7);
+            }
         }
         check_second_derivatives(surface, frame, x)
     }
 
-    /// Central differences of the first derivatives against the second ones.
+    /// Central differences of the first derivatives against the second ones. Turning by
+    /// `delta_j` first and then differentiating in `delta_i` gives `d^2f/ddelta_i ddelta_j`
+    /// plus half the first derivative about `a_j x a_i` (the increments do not commute):
+    /// `G . (a_i x w_j) - 1/2 G . (a_i x w_j + a_j x w_i) = 1/2 G . ((a_i x a_j) x y)`.
     fn check_second_derivatives(
         surface: &dyn RigidSurface,
         frame: &RotatingFrame,
@@ -349,32 +426,45 @@ mod tests {
                         column[i]
                     );
                 }
-                let mixed = (plus.d_dangle[c] - minus.d_dangle[c]) / (2.0 * h);
-                let exact = k.d2_dx_dangle[c][j];
-                assert!(
-                    (mixed - exact).abs() <= tolerance(exact),
-                    "d2/dx dtheta {c} {j}: {mixed} vs {exact}"
-                );
+                for i in 0..frame.rotations() {
+                    let mixed = (plus.d_drotation[c][i] - minus.d_drotation[c][i]) / (2.0 * h);
+                    let exact = k.d2_dx_drotation[c][(j, i)];
+                    assert!(
+                        (mixed - exact).abs() <= tolerance(exact),
+                        "d2/dx ddelta {c} x{j} delta{i}: {mixed} vs {exact}"
+                    );
+                }
             }
         }
-        let turned = |angle: f64| eval(surface, &RotatingFrame { angle, ..*frame }, x);
-        let (plus, minus) = (turned(frame.angle + h)?, turned(frame.angle - h)?);
-        for c in 0..3 {
-            let mixed = (plus.d_dx[c] - minus.d_dx[c]) / (2.0 * h);
-            for i in 0..3 {
-                let exact = k.d2_dx_dangle[c][i];
-                assert!(
-                    (mixed[i] - exact).abs() <= tolerance(exact),
-                    "d2/dtheta dx {c} {i}: {} vs {exact}",
-                    mixed[i]
-                );
-            }
-            let second = (plus.d_dangle[c] - minus.d_dangle[c]) / (2.0 * h);
-            let exact = k.d2_dangle2[c];
-            assert!(
-                (second - exact).abs() <= tolerance(exact),
-                "d2/dtheta2 {c}: {second} vs {exact}"
+        let y = frame
+            .orientation
+            .inverse_transform_vector(&(x - frame.center));
+        for j in 0..frame.rotations() {
+            let (plus, minus) = (
+                eval(surface, &turned(frame, j, h), x)?,
+                eval(surface, &turned(frame, j, -h), x)?,
             );
+            for c in 0..3 {
+                let mixed = (plus.d_dx[c] - minus.d_dx[c]) / (2.0 * h);
+                for i in 0..3 {
+                    let exact = k.d2_dx_drotation[c][(i, j)];
+                    assert!(
+                        (mixed[i] - exact).abs() <= tolerance(exact),
+                        "d2/ddelta dx {c} delta{j} x{i}: {} vs {exact}",
+                        mixed[i]
+                    );
+                }
+                let gradient = frame.orientation.inverse_transform_vector(&k.d_dx[c]);
+                for i in 0..frame.rotations() {
+                    let second = (plus.d_drotation[c][i] - minus.d_drotation[c][i]) / (2.0 * h);
+                    let across = frame.rotation_axis(i).cross(&frame.rotation_axis(j));
+                    let exact = k.d2_drotation2[c][(i, j)] + 0.5 * gradient.dot(&across.cross(&y));
+                    assert!(
+                        (second - exact).abs() <= tolerance(exact),
+                        "d2/ddelta2 {c} ({i},{j}): {second} vs {exact}"
+                    );
+                }
+            }
         }
         Ok(())
     }
@@ -390,14 +480,56 @@ mod tests {
             Vector3::new(1.1, 0.7, 0.4),
         ];
         for angle in [0.0, 0.7, -2.5, 3.1, 11.0] {
-            let frame = RotatingFrame {
-                center: Vector3::new(0.9, 0.5, 0.3),
-                axis,
-                angle,
-            };
+            let frame = RotatingFrame::about(Vector3::new(0.9, 0.5, 0.3), axis, angle);
             for x in &points {
                 check_derivatives(&drum, &frame, x)?;
             }
+        }
+        Ok(())
+    }
+
+    /// A body free to turn: the three material increments' first and second derivatives
+    /// against differences, on a tilted cylinder and on the faceted drum, at several
+    /// orientations.
+    #[test]
+    fn free_body_derivatives_match_finite_differences() -> Result<(), ContactError> {
+        let axis = Vector3::new(0.2, -0.4, 0.9).normalize();
+        let cylinder = AnalyticCylinder::new(0.2, axis)?;
+        let facets = crate::facets::FacetedCylinder::new(0.2, axis, 72, 0.0)?;
+        let points = [
+            Vector3::new(0.3, 0.1, 0.5),
+            Vector3::new(-0.21, 0.05, -0.1),
+            Vector3::new(1.1, 0.7, 0.4),
+        ];
+        let center = Vector3::new(0.9, 0.5, 0.3);
+        for turn in [
+            Vector3::zeros(),
+            Vector3::new(0.3, -1.2, 0.4),
+            Vector3::new(-2.0, 0.1, 1.5),
+        ] {
+            let frame = RotatingFrame::free(center, &UnitQuaternion::from_scaled_axis(turn));
+            assert_eq!(frame.rotations(), 3);
+            for x in &points {
+                check_derivatives(&cylinder, &frame, x)?;
+                check_derivatives(&facets, &frame, &(center + (x - center) * 0.21 / 0.2))?;
+            }
+        }
+        // about a fixed axis the free body's derivative along that axis is the angle's
+        let fixed = RotatingFrame::about(center, axis, 0.7);
+        let free = RotatingFrame::free(
+            center,
+            &UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), 0.7),
+        );
+        let (a, b) = (
+            eval(&cylinder, &fixed, &points[0])?,
+            eval(&cylinder, &free, &points[0])?,
+        );
+        for c in 0..3 {
+            assert_relative_eq!(
+                a.d_drotation[c][0],
+                b.d_drotation[c].dot(&axis),
+                epsilon = 1e-14
+            );
         }
         Ok(())
     }
@@ -426,21 +558,14 @@ mod tests {
             let theta1 = theta0 + f64::to_radians(turn_deg);
             let r0 = at(theta0, 2.0_f64.to_radians(), 0.1995);
             let r1 = at(theta1, f64::to_radians(end_deg), 0.1993);
-            let start = RotatingFrame {
-                center: c0,
-                axis,
-                angle: theta0,
-            };
-            let end = RotatingFrame {
-                center: c1,
-                axis,
-                angle: theta1,
-            };
+            let start = RotatingFrame::about(c0, axis, theta0);
+            let end = RotatingFrame::about(c1, axis, theta1);
             let k0 = eval(&drum, &start, &(c0 + r0))?;
             let k1 = eval_from(&drum, &end, &(c1 + r1), &k0.closest)?;
             let change = difference(&drum, &k1, &k0);
             let begin = IncrementStart {
-                angle: theta0,
+                orientation: start.orientation,
+                turn: theta1 - theta0,
                 offset: r0,
             };
             let column = rotation_column(&drum, &end, &begin, &r1, &k1).ok_or_else(none)?;
@@ -448,7 +573,7 @@ mod tests {
             for c in 0..2 {
                 let predicted = k1.d_dx[c].dot(&(r1 - r0)) + column[c] * turn;
                 assert_relative_eq!(predicted, change[c], epsilon = 1e-14);
-                let tangent = k1.d_dx[c].dot(&(r1 - r0)) + k1.d_dangle[c] * turn;
+                let tangent = k1.d_dx[c].dot(&(r1 - r0)) + k1.d_drotation[c][0] * turn;
                 assert!(
                     (tangent - change[c]).abs() > 1e-8,
                     "{c}: the end-point row is exact"
@@ -456,30 +581,31 @@ mod tests {
             }
         }
         let r0 = at(theta0, 2.0_f64.to_radians(), 0.1995);
+        let start = RotatingFrame::about(c0, axis, theta0);
         let begin = IncrementStart {
-            angle: theta0,
+            orientation: start.orientation,
+            turn: 1e-6,
             offset: r0,
         };
-        let start = RotatingFrame {
-            center: c0,
-            axis,
-            angle: theta0,
-        };
         let k0 = eval(&drum, &start, &(c0 + r0))?;
-        let close = RotatingFrame {
-            angle: theta0 + 1e-6,
-            ..start
-        };
+        let close = RotatingFrame::about(c0, axis, theta0 + 1e-6);
         let still = eval_from(&drum, &close, &(c0 + r0), &k0.closest)?;
         let limit = rotation_column(&drum, &close, &begin, &r0, &still).ok_or_else(none)?;
-        for (secant, derivative) in limit.iter().zip(k0.d_dangle).take(2) {
-            assert_relative_eq!(*secant, derivative, epsilon = 1e-6);
+        for (secant, derivative) in limit.iter().zip(k0.d_drotation).take(2) {
+            assert_relative_eq!(*secant, derivative[0], epsilon = 1e-6);
         }
-        let stopped = RotatingFrame {
-            angle: theta0 + 0.1 * MIN_SECANT_TURN,
-            ..start
+        let stopped = RotatingFrame::about(c0, axis, theta0 + 0.1 * MIN_SECANT_TURN);
+        let barely = IncrementStart {
+            turn: 0.1 * MIN_SECANT_TURN,
+            ..begin
         };
-        assert!(rotation_column(&drum, &stopped, &begin, &r0, &still).is_none());
+        assert!(rotation_column(&drum, &stopped, &barely, &r0, &still).is_none());
+        // a body free to turn keeps its end-point derivatives
+        let free = RotatingFrame::free(
+            c0,
+            &UnitQuaternion::from_axis_angle(&Vector3::z_axis(), theta0 + 1e-6),
+        );
+        assert!(rotation_column(&drum, &free, &begin, &r0, &still).is_none());
         Ok(())
     }
 
@@ -489,21 +615,15 @@ mod tests {
     #[test]
     fn rotation_column_stays_of_the_lever_arm_size() -> Result<(), ContactError> {
         let drum = crate::facets::FacetedCylinder::new(0.2, Vector3::z(), 72, 0.0)?;
-        let frame = RotatingFrame {
-            center: Vector3::zeros(),
-            axis: Vector3::z(),
-            angle: 1e-6,
-        };
+        let frame = RotatingFrame::about(Vector3::zeros(), Vector3::z(), 1e-6);
         let at = |body: f64| Vector3::new(body.cos(), body.sin(), 0.0) * 0.1995;
         // from one facet over the vertex at 5 degrees onto the next one
         let (r0, r1) = (at(4.0_f64.to_radians()), at(6.0_f64.to_radians()));
+        let unturned = RotatingFrame::about(Vector3::zeros(), Vector3::z(), 0.0);
         let begin = IncrementStart {
-            angle: 0.0,
+            orientation: unturned.orientation,
+            turn: 1e-6,
             offset: r0,
-        };
-        let unturned = RotatingFrame {
-            angle: 0.0,
-            ..frame
         };
         let end = eval_from(&drum, &frame, &r1, &eval(&drum, &unturned, &r0)?.closest)?;
         let column = rotation_column(&drum, &frame, &begin, &r1, &end)
@@ -511,7 +631,7 @@ mod tests {
         for c in column {
             assert!(c.abs() <= MAX_COLUMN_LEVER * r0.norm(), "{c}");
         }
-        assert_relative_eq!(column[1], end.d_dangle[1], epsilon = 1e-4);
+        assert_relative_eq!(column[1], end.d_drotation[1][0], epsilon = 1e-4);
         Ok(())
     }
 
@@ -520,16 +640,11 @@ mod tests {
     #[test]
     fn faceted_drum_derivatives_match_finite_differences() -> Result<(), ContactError> {
         let drum = crate::facets::FacetedCylinder::new(0.2, Vector3::z(), 72, 0.0)?;
-        let frame = RotatingFrame {
-            center: Vector3::new(0.05, -0.1, 0.0),
-            axis: Vector3::z(),
-            angle: 0.4,
-        };
+        let frame = RotatingFrame::about(Vector3::new(0.05, -0.1, 0.0), Vector3::z(), 0.4);
         // in front of a facet (body angle 2.5 degrees, mid-facet) and off a vertex (0 degrees)
         for body_angle in [2.5_f64.to_radians(), 0.0] {
             let offset = Vector3::new(body_angle.cos(), body_angle.sin(), 0.0) * 0.203;
-            let rotation = Rotation3::from_axis_angle(&Vector3::z_axis(), frame.angle);
-            check_derivatives(&drum, &frame, &(frame.center + rotation * offset))?;
+            check_derivatives(&drum, &frame, &(frame.center + frame.orientation * offset))?;
         }
         Ok(())
     }
@@ -537,11 +652,7 @@ mod tests {
     #[test]
     fn derivatives_across_branch_cut() -> Result<(), ContactError> {
         let drum = AnalyticCylinder::new(0.2, Vector3::z())?;
-        let frame = RotatingFrame {
-            center: Vector3::zeros(),
-            axis: Vector3::z(),
-            angle: 0.0,
-        };
+        let frame = RotatingFrame::about(Vector3::zeros(), Vector3::z(), 0.0);
         // body-frame angle pi: atan2 jumps from +pi to -pi within the finite-difference stencil
         let x = Vector3::new(-0.2005, 1e-8, 0.0);
         let k = eval(&drum, &frame, &x)?;
@@ -550,10 +661,7 @@ mod tests {
         assert!(eval(&drum, &frame, &xm)?.closest.coords[0] < 0.0);
         check_derivatives(&drum, &frame, &x)?;
         // a body rotated by pi/2 brings the cut to world angle 3 pi / 2 (below the centre)
-        let rotated = RotatingFrame {
-            angle: PI / 2.0,
-            ..frame
-        };
+        let rotated = RotatingFrame::about(Vector3::zeros(), Vector3::z(), PI / 2.0);
         check_derivatives(&drum, &rotated, &Vector3::new(1e-9, -0.21, 0.0))?;
         Ok(())
     }
@@ -563,16 +671,12 @@ mod tests {
         let radius = 0.2;
         let drum = AnalyticCylinder::new(radius, Vector3::z())?;
         for angle in [0.0, 1.0, -4.0] {
-            let frame = RotatingFrame {
-                center: Vector3::new(0.1, -0.3, 0.0),
-                axis: Vector3::z(),
-                angle,
-            };
+            let frame = RotatingFrame::about(Vector3::new(0.1, -0.3, 0.0), Vector3::z(), angle);
             let x = Vector3::new(0.17, -0.05, 0.0);
             let k = eval(&drum, &frame, &x)?;
-            assert_relative_eq!(k.d_dangle[0], 0.0, epsilon = 1e-15);
-            assert_relative_eq!(k.d_dangle[1], -radius, epsilon = 1e-14);
-            assert_relative_eq!(k.d_dangle[2], 0.0, epsilon = 1e-15);
+            assert_relative_eq!(k.d_drotation[0][0], 0.0, epsilon = 1e-15);
+            assert_relative_eq!(k.d_drotation[1][0], -radius, epsilon = 1e-14);
+            assert_relative_eq!(k.d_drotation[2][0], 0.0, epsilon = 1e-15);
             // 2D point in the z = 0 plane with a z axis has axial coordinate 0
             assert_eq!(k.closest.coords[1], 0.0);
             // the world normal is radial from the centre, independent of the angle
@@ -589,11 +693,7 @@ mod tests {
         let drum = AnalyticCylinder::new(radius, Vector3::z())?;
         let x = Vector3::new(0.0, 0.2, 0.0);
         let at = |angle: f64| -> Result<ContactKinematics, ContactError> {
-            let frame = RotatingFrame {
-                center: Vector3::zeros(),
-                axis: Vector3::z(),
-                angle,
-            };
+            let frame = RotatingFrame::about(Vector3::zeros(), Vector3::z(), angle);
             eval(&drum, &frame, &x)
         };
         // a full turn in 0.1 rad steps: the unwrapped slip sums to -2 pi R
@@ -628,21 +728,12 @@ mod tests {
     #[test]
     fn degenerate_frame_or_axis_point_gives_none() -> Result<(), ContactError> {
         let drum = AnalyticCylinder::new(0.2, Vector3::z())?;
-        let frame = RotatingFrame {
-            center: Vector3::new(1.0, 2.0, 0.0),
-            axis: Vector3::z(),
-            angle: 0.3,
-        };
+        let center = Vector3::new(1.0, 2.0, 0.0);
+        let frame = RotatingFrame::about(center, Vector3::z(), 0.3);
         assert!(eval(&drum, &frame, &Vector3::new(1.0, 2.0, 0.5)).is_err());
-        let no_axis = RotatingFrame {
-            axis: Vector3::zeros(),
-            ..frame
-        };
+        let no_axis = RotatingFrame::about(center, Vector3::zeros(), 0.3);
         assert!(eval(&drum, &no_axis, &Vector3::new(0.0, 0.0, 0.0)).is_err());
-        let nan_angle = RotatingFrame {
-            angle: f64::NAN,
-            ..frame
-        };
+        let nan_angle = RotatingFrame::about(center, Vector3::z(), f64::NAN);
         assert!(eval(&drum, &nan_angle, &Vector3::new(0.0, 0.0, 0.0)).is_err());
         Ok(())
     }

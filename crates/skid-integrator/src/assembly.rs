@@ -529,6 +529,7 @@ mod tests {
     use crate::model::Tie;
     use crate::test_support::{body, pad_block};
     use nalgebra::DMatrix;
+    use skid_fem::rigid::Rotation;
     use skid_fem::solid::Tangent;
 
     impl Assembler {
@@ -551,7 +552,7 @@ mod tests {
         let top = part.mesh.node_sets["ymax"].clone();
         let mut free = [false; D];
         free[1] = true;
-        let plate = body::<D>("plate", free, None, 0.0, 0.0);
+        let plate = body::<D>("plate", free, Rotation::None, 0.0, 0.0);
         let tie = Tie {
             body: 0,
             nodes: top,

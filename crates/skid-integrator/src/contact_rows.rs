@@ -8,15 +8,15 @@
 //! to the node's components and the carrying body's translation and rotation, and each row's
 //! second derivatives give the stiffness of the contact forces on a curved, turning surface.
 
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use skid_contact::SurfacePoint;
 use skid_contact::kinematics::{
     ContactKinematics, IncrementStart, evaluate, gap_discrete_gradient, rotation_column,
 };
-use skid_fem::cell::embed;
 
 use crate::error::{IncrementFailure, LinearFailure};
 use crate::model::Model;
+use crate::orientation::Orientation;
 use crate::sparse::Factorization;
 
 /// Linearised contact kinematics at one configuration.
@@ -32,10 +32,13 @@ pub struct ContactRows {
     pub closest: Vec<SurfacePoint>,
     /// Friction coefficient per contact.
     pub mu: Vec<f64>,
-    /// Per row, the second derivatives of its `u` in the candidate's local coordinates
-    /// `z = (node position [D], body translation [D], body angle)` (see [`contact_coordinates`]),
-    /// a symmetric `(2D + 1)^2` matrix: row `k`'s entries, column-major, at
-    /// `k (2D + 1)^2..(k + 1) (2D + 1)^2`, one allocation for all rows.
+    /// Number `m = 2D + r` of a candidate's local coordinates `z = (node position [D], body
+    /// translation [D], body rotations [r])` (see [`contact_coordinates`]); `r` is 3 if a pair's
+    /// body is free to turn, else 1.
+    pub coordinates: usize,
+    /// Per row, the second derivatives of its `u` in the candidate's local coordinates `z`, a
+    /// symmetric `m^2` matrix: row `k`'s entries, column-major, at `k m^2..(k + 1) m^2`, one
+    /// allocation for all rows.
     pub curvature: Vec<f64>,
 }
 
@@ -69,7 +72,7 @@ impl ContactRows {
     /// `r_N / rho`). `None` for a candidate without force.
     pub fn curvature_stiffness(&self, c: usize, r: &DVector<f64>) -> Option<DMatrix<f64>> {
         let d = self.components;
-        let size = 2 * d + 1;
+        let size = self.coordinates;
         let mut stiffness: Option<DMatrix<f64>> = None;
         for row in c * d..(c + 1) * d {
             let force = r.get(row).copied().unwrap_or(0.0);
@@ -197,7 +200,8 @@ impl ContactRows {
     }
 }
 
-/// Evaluates the contact rows of all pairs at displacement `x`. `previous` holds the closest
+/// Evaluates the contact rows of all pairs at displacement `x`, with the orientations of bodies
+/// free to turn from the records `orientations` (see [`crate::orientation`]). `previous` holds the closest
 /// points at the start of the increment, where the slips start (one per candidate, pair by
 /// pair; `None`: each node's own closest point, zero slips); `held` marks
 /// equations whose increment is zero in this step (their columns are dropped).
@@ -221,6 +225,7 @@ impl ContactRows {
 pub fn contact_rows<const D: usize>(
     model: &Model<D>,
     x: &DVector<f64>,
+    orientations: &[Orientation],
     start: Option<&DVector<f64>>,
     previous: Option<&[SurfacePoint]>,
     held: &[bool],
@@ -228,9 +233,10 @@ pub fn contact_rows<const D: usize>(
     let components = D;
     let dofs = model.dofs();
     let candidates: usize = model.contacts().iter().map(|pair| pair.nodes.len()).sum();
-    let size = 2 * D + 1;
+    let size = 2 * D + rotation_coordinates(model);
     let mut out = ContactRows {
         components,
+        coordinates: size,
         rows: Vec::with_capacity(candidates * D),
         u: DVector::zeros(0),
         closest: Vec::with_capacity(candidates),
@@ -240,41 +246,43 @@ pub fn contact_rows<const D: usize>(
     let mut u = Vec::with_capacity(candidates * D);
     let mut k = 0;
     for (p, pair) in model.contacts().iter().enumerate() {
-        let body = &model.bodies()[pair.body];
-        let frame = model.body_frame(x, pair.body);
-        let start_center =
-            start.map(|x0| embed(&(body.reference_point + dofs.body_displacement(x0, pair.body))));
+        let frame = model.body_frame(x, pair.body, orientations);
+        let start_frame = start.map(|x0| model.body_frame(x0, pair.body, orientations));
+        let rotations = dofs.body_rotations(pair.body);
         for &node in &pair.nodes {
             let pos = model.node_position(x, node);
             let from = previous.map(|points| &points[k]);
             let mut kin = evaluate(pair.surface.as_ref(), &frame, &pos, from)
                 .ok_or(IncrementFailure::NoProjection { pair: p, node })?;
-            if let (Some(x0), Some(c0)) = (start, start_center) {
-                let offset = model.node_position(x0, node) - c0;
+            if let (Some(x0), Some(frame0)) = (start, start_frame) {
+                let offset = model.node_position(x0, node) - frame0.center;
                 if let Some(secant) =
                     gap_discrete_gradient(pair.surface.as_ref(), &frame, &offset, &pos)
                 {
                     // the surface is invariant under the body's rotation: no angle terms
                     kin.d_dx[0] = secant.gradient;
-                    kin.d_dangle[0] = 0.0;
+                    kin.d_drotation[0] = Vector3::zeros();
                     kin.d2_dx2[0] = secant.jacobian;
-                    kin.d2_dx_dangle[0] = Vector3::zeros();
-                    kin.d2_dangle2[0] = 0.0;
-                } else {
+                    kin.d2_dx_drotation[0] = Matrix3::zeros();
+                    kin.d2_drotation2[0] = Matrix3::zeros();
+                } else if let Some(angle) = dofs.body_rotation(pair.body) {
                     let begin = IncrementStart {
-                        angle: dofs.body_angle(x0, pair.body),
+                        orientation: frame0.orientation,
+                        turn: x[angle] - x0[angle],
                         offset,
                     };
                     let end_offset = pos - frame.center;
                     if let Some(column) =
                         rotation_column(pair.surface.as_ref(), &frame, &begin, &end_offset, &kin)
                     {
-                        kin.d_dangle = column;
+                        for (derivative, c) in kin.d_drotation.iter_mut().zip(column) {
+                            derivative[0] = c;
+                        }
                     }
                 }
             }
             for comp in 0..components {
-                let mut row: Vec<(usize, f64)> = Vec::with_capacity(2 * D + 1);
+                let mut row: Vec<(usize, f64)> = Vec::with_capacity(size);
                 let mut add = |eq: Option<usize>, c: f64| {
                     if let Some(eq) = eq
                         && !held[eq]
@@ -291,9 +299,11 @@ pub fn contact_rows<const D: usize>(
                     // Moving the body by dc moves the body-frame point by -Q^T dc.
                     add(dofs.body_translation(pair.body)[i], -kin.d_dx[comp][i]);
                 }
-                add(dofs.body_rotation(pair.body), kin.d_dangle[comp]);
+                for (i, &eq) in rotations.iter().enumerate() {
+                    add(Some(eq), kin.d_drotation[comp][i]);
+                }
                 out.rows.push(row);
-                push_local_curvature::<D>(&kin, comp, &mut out.curvature);
+                push_local_curvature::<D>(&kin, comp, size, &mut out.curvature);
                 u.push(if comp == 0 {
                     kin.gap
                 } else {
@@ -309,8 +319,22 @@ pub fn contact_rows<const D: usize>(
     Ok(out)
 }
 
+/// The number `r` of rotation coordinates in a candidate's local coordinates: 3 if a contact
+/// pair's body is free to turn, else 1 (see [`ContactRows::coordinates`]).
+fn rotation_coordinates<const D: usize>(model: &Model<D>) -> usize {
+    let dofs = model.dofs();
+    model
+        .contacts()
+        .iter()
+        .map(|pair| dofs.body_rotations(pair.body).len())
+        .max()
+        .unwrap_or(0)
+        .max(1)
+}
+
 /// The equations of a candidate's local coordinates `z = (node position [D], body translation
-/// [D], body angle)`, `None` where fixed: the order of [`ContactRows::curvature`].
+/// [D], body rotations [r])`, `None` where fixed or beyond the body's rotations: the order of
+/// [`ContactRows::curvature`].
 pub fn contact_coordinates<const D: usize>(
     model: &Model<D>,
     pair: usize,
@@ -318,22 +342,30 @@ pub fn contact_coordinates<const D: usize>(
 ) -> Vec<Option<usize>> {
     let dofs = model.dofs();
     let body = model.contacts()[pair].body;
+    let rotations = dofs.body_rotations(body);
+    let slots = rotation_coordinates(model);
     dofs.node(node)
         .iter()
         .chain(dofs.body_translation(body))
         .copied()
-        .chain([dofs.body_rotation(body)])
+        .chain((0..slots).map(|i| rotations.get(i).copied()))
         .collect()
 }
 
-/// Second derivatives of component `comp` of `u` in the local coordinates of
+/// Second derivatives of component `comp` of `u` in the `m` local coordinates of
 /// [`contact_coordinates`], appended to `out` column by column. The node position `x` and the
-/// body translation `c` enter only as `x - c`, so with `A = d^2u/dx^2`, `b = d^2u/dx dtheta` and
-/// `s = d^2u/dtheta^2`: `[[A, -A, b], [-A, A, -b], [b^T, -b^T, s]]`.
-fn push_local_curvature<const D: usize>(kin: &ContactKinematics, comp: usize, out: &mut Vec<f64>) {
+/// body translation `c` enter only as `x - c`, so with `A = d^2u/dx^2`, `B = d^2u/dx ddelta`
+/// (`D x r`) and `S = d^2u/ddelta^2`: `[[A, -A, B], [-A, A, -B], [B^T, -B^T, S]]`.
+fn push_local_curvature<const D: usize>(
+    kin: &ContactKinematics,
+    comp: usize,
+    m: usize,
+    out: &mut Vec<f64>,
+) {
     let a = &kin.d2_dx2[comp];
-    let b = &kin.d2_dx_dangle[comp];
-    let m = 2 * D + 1;
+    let b = &kin.d2_dx_drotation[comp];
+    let s = &kin.d2_drotation2[comp];
+    let r = m - 2 * D;
     let start = out.len();
     out.resize(start + m * m, 0.0);
     let block = &mut out[start..];
@@ -345,12 +377,19 @@ fn push_local_curvature<const D: usize>(kin: &ContactKinematics, comp: usize, ou
             block[(j + D) * m + i] = -v;
             block[(j + D) * m + i + D] = v;
         }
-        block[2 * D * m + j] = b[j];
-        block[2 * D * m + j + D] = -b[j];
-        block[j * m + 2 * D] = b[j];
-        block[(j + D) * m + 2 * D] = -b[j];
+        for k in 0..r {
+            let v = b[(j, k)];
+            block[(2 * D + k) * m + j] = v;
+            block[(2 * D + k) * m + j + D] = -v;
+            block[j * m + 2 * D + k] = v;
+            block[(j + D) * m + 2 * D + k] = -v;
+        }
     }
-    block[2 * D * m + 2 * D] = kin.d2_dangle2[comp];
+    for k in 0..r {
+        for l in 0..r {
+            block[(2 * D + l) * m + 2 * D + k] = s[(k, l)];
+        }
+    }
 }
 
 #[cfg(test)]
@@ -364,11 +403,11 @@ mod tests {
         let n = model.dofs().len();
         let held = vec![false; n];
         let x = DVector::from_fn(n, |i, _| 1e-3 * (i as f64 * 0.9).sin());
-        let rows = contact_rows(&model, &x, None, None, &held).expect("rows");
+        let rows = contact_rows(&model, &x, &[], None, None, &held).expect("rows");
         let previous = Some(rows.closest.as_slice());
         let dx = DVector::from_fn(n, |i, _| 1e-7 * (i as f64 * 2.3).cos());
-        let plus = contact_rows(&model, &(&x + &dx), None, previous, &held).expect("rows");
-        let minus = contact_rows(&model, &(&x - &dx), None, previous, &held).expect("rows");
+        let plus = contact_rows(&model, &(&x + &dx), &[], None, previous, &held).expect("rows");
+        let minus = contact_rows(&model, &(&x - &dx), &[], None, previous, &held).expect("rows");
         let predicted = rows.times(&dx);
         let measured = (&plus.u - &minus.u) / 2.0;
         assert!(
@@ -387,7 +426,7 @@ mod tests {
         for &eq in &drum_eqs {
             held[eq] = true;
         }
-        let rows = contact_rows(&model, &x, None, None, &held).expect("rows");
+        let rows = contact_rows(&model, &x, &[], None, None, &held).expect("rows");
         assert!(
             rows.rows
                 .iter()
@@ -402,7 +441,8 @@ mod tests {
         let n = model.dofs().len();
         let x = DVector::from_fn(n, |i, _| 1e-3 * ((i as f64 * 1.3).sin() - 0.5));
         let start = coordinate_origins(&model);
-        let rows = contact_rows(&model, &x, None, Some(&start), &vec![false; n]).expect("rows");
+        let rows =
+            contact_rows(&model, &x, &[], None, Some(&start), &vec![false; n]).expect("rows");
         let m = 2 * D + 1;
         assert_eq!(rows.curvature.len(), rows.rows.len() * m * m);
         let block =

@@ -303,6 +303,7 @@ mod tests {
     use crate::contact_rows::contact_rows;
     use crate::error::LinearFailure;
     use crate::model::Model;
+    use crate::orientation::Orientation;
     use crate::test_support::{block_on_drum, coordinate_origins};
 
     /// Screening open candidates out of the conic solve gives the full problem's solution,
@@ -362,7 +363,7 @@ mod tests {
         let (model, mut assembler) = assembled::<D>(&x);
         let held = vec![false; n];
         let start = coordinate_origins(&model);
-        let rows = contact_rows(&model, &x, None, Some(&start), &held).expect("rows");
+        let rows = contact_rows(&model, &x, &[], None, Some(&start), &held).expect("rows");
         let subset: Vec<usize> = (0..rows.len()).step_by(2).collect();
         assembler
             .eliminate_last(&rows.equations(&subset))
@@ -400,7 +401,7 @@ mod tests {
         let (model, mut assembler) = assembled::<D>(&x);
         let held = vec![false; n];
         let start = coordinate_origins(&model);
-        let rows = contact_rows(&model, &x, None, Some(&start), &held).expect("rows");
+        let rows = contact_rows(&model, &x, &[], None, Some(&start), &held).expect("rows");
         // the drum is held by its mass term; every pad node is pushed down by 1 cm
         let mut residual = DVector::zeros(n);
         for node in 0..model.part().mesh.nodes.len() {
@@ -459,7 +460,8 @@ mod tests {
         let (model, mut assembler) = assembled::<D>(&x);
         let held = vec![false; n];
         let start = coordinate_origins(&model);
-        let rows = contact_rows(&model, &x, increment_start, Some(&start), &held).expect("rows");
+        let rows =
+            contact_rows(&model, &x, &[], increment_start, Some(&start), &held).expect("rows");
         let r = DVector::from_fn(rows.rows.len(), |k, _| {
             if k % D == 0 {
                 700.0 + 10.0 * k as f64
@@ -472,7 +474,8 @@ mod tests {
         assembler.add_contact_curvature(&rows, &r);
         let k = assembler.dense(n);
         let residual = |assembler: &mut Assembler, x: &DVector<f64>| {
-            let rows = contact_rows(&model, x, increment_start, Some(&start), &held).expect("rows");
+            let rows =
+                contact_rows(&model, x, &[], increment_start, Some(&start), &held).expect("rows");
             assembler.internal(&model, x, None).expect("internal").force
                 - rows.transpose_times(&r, n)
         };
@@ -499,6 +502,70 @@ mod tests {
             worst_without > 1e3 * worst,
             "{D}D: {worst_without:e} vs {worst:e}"
         );
+    }
+
+    /// A drum free to turn, at an orientation recorded where the rotation unknowns are: the
+    /// tangent with the contact curvature is the derivative of `f_int - H^T r` but in the
+    /// rotations' own block, where turning about `a_j` and then about `a_i` differs from the
+    /// reverse order; the difference is the skew matrix `1/2 [M]x` of the contact moment
+    /// `M = (H^T r)_rot`, which the symmetric tangent leaves out.
+    #[test]
+    fn contact_curvature_completes_the_tangent_of_a_drum_free_to_turn() {
+        let model = crate::test_support::block_on_free_drum();
+        let n = model.dofs().len();
+        let rotations = model.dofs().body_rotations(0).to_vec();
+        let x = DVector::from_fn(n, |i, _| 1e-3 * ((i as f64 * 1.3).sin() - 0.5));
+        let record = vec![Orientation {
+            body: 0,
+            quaternion: {
+                let q = nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::new(
+                    0.02, -0.03, 0.4,
+                ));
+                [q.w, q.i, q.j, q.k]
+            },
+            at: std::array::from_fn(|i| x[rotations[i]]),
+        }];
+        let mut assembler = Assembler::new(&model).expect("assembler");
+        let held = vec![false; n];
+        let start = coordinate_origins(&model);
+        let rows = contact_rows(&model, &x, &record, None, Some(&start), &held).expect("rows");
+        assert_eq!(rows.coordinates, 9);
+        let r = DVector::from_fn(rows.rows.len(), |k, _| {
+            if k % 3 == 0 {
+                700.0 + 10.0 * k as f64
+            } else {
+                -80.0 + 3.0 * k as f64
+            }
+        });
+        assembler.internal(&model, &x, Some(1.0)).expect("internal");
+        assembler.add_contact_curvature(&rows, &r);
+        let k = assembler.dense(n);
+        let moment = rows.transpose_times(&r, n);
+        let m = nalgebra::Vector3::from_fn(|i, _| moment[rotations[i]]);
+        assert!(m.norm() > 1.0, "the forces turn the drum: {m}");
+        let skew = m.cross_matrix() * -0.5;
+        let residual = |assembler: &mut Assembler, x: &DVector<f64>| {
+            let rows = contact_rows(&model, x, &record, None, Some(&start), &held).expect("rows");
+            assembler.internal(&model, x, None).expect("internal").force
+                - rows.transpose_times(&r, n)
+        };
+        let eps = 1e-7;
+        let mut worst: f64 = 0.0;
+        for j in 0..n {
+            let mut xp = x.clone();
+            let mut xm = x.clone();
+            xp[j] += eps;
+            xm[j] -= eps;
+            let mut column =
+                (residual(&mut assembler, &xp) - residual(&mut assembler, &xm)) / (2.0 * eps);
+            if let Some(b) = rotations.iter().position(|&eq| eq == j) {
+                for (a, &eq) in rotations.iter().enumerate() {
+                    column[eq] -= skew[(a, b)];
+                }
+            }
+            worst = worst.max((&column - k.column(j)).amax());
+        }
+        assert!(worst < 1e-6 * k.amax(), "worst {worst:e} vs {:e}", k.amax());
     }
 
     #[test]

@@ -35,10 +35,13 @@ pub enum EquationOwner {
         /// Translation component.
         component: usize,
     },
-    /// A rigid body's rotation.
+    /// A rigid body's rotation: its angle about its axis (component 0), or the material
+    /// rotation about its x, y or z axis of a body free to turn.
     BodyRotation {
         /// Body index in the model.
         body: usize,
+        /// Rotation component.
+        component: usize,
     },
 }
 
@@ -47,7 +50,7 @@ pub enum EquationOwner {
 pub struct DofMap<const D: usize> {
     node: Vec<[Option<usize>; D]>,
     body_translation: Vec<[Option<usize>; D]>,
-    body_rotation: Vec<Option<usize>>,
+    body_rotation: Vec<Vec<usize>>,
     kinds: Vec<EquationKind>,
 }
 
@@ -58,13 +61,14 @@ impl<const D: usize> DofMap<D> {
     /// - `tied_to`: for each node, the rigid body it is tied to, if any;
     /// - `fixed`: for each node, the components held at zero displacement (a shorter slice
     ///   leaves the remaining nodes free);
-    /// - `free_translations` / `free_rotation`: per body, which motions are free.
+    /// - `free_translations`: per body, which translations are free;
+    /// - `rotations`: per body, the number of rotation unknowns (0, 1 or 3; missing: 0).
     pub fn new(
         node_count: usize,
         tied_to: &[Option<usize>],
         fixed: &[[bool; D]],
         free_translations: &[[bool; D]],
-        free_rotation: &[bool],
+        rotations: &[usize],
     ) -> Self {
         let mut kinds = Vec::new();
         let mut next = |kind| {
@@ -83,7 +87,7 @@ impl<const D: usize> DofMap<D> {
             }
         }
         let mut body_translation = Vec::with_capacity(free_translations.len());
-        let mut body_rotation = Vec::with_capacity(free_rotation.len());
+        let mut body_rotation = Vec::with_capacity(rotations.len());
         for (b, free) in free_translations.iter().enumerate() {
             let mut eqs = [None; D];
             for i in 0..D {
@@ -92,13 +96,8 @@ impl<const D: usize> DofMap<D> {
                 }
             }
             body_translation.push(eqs);
-            body_rotation.push(
-                free_rotation
-                    .get(b)
-                    .copied()
-                    .unwrap_or(false)
-                    .then(|| next(EquationKind::Rotation)),
-            );
+            let count = rotations.get(b).copied().unwrap_or(0);
+            body_rotation.push((0..count).map(|_| next(EquationKind::Rotation)).collect());
         }
         for (n, body) in tied_to.iter().enumerate() {
             if let Some(b) = body {
@@ -138,18 +137,28 @@ impl<const D: usize> DofMap<D> {
         &self.body_translation[body]
     }
 
-    /// Equation of a body's rotation angle.
+    /// Equation of the angle of a body turning about one fixed axis (`None` for a body that
+    /// cannot rotate or is free to turn).
     pub fn body_rotation(&self, body: usize) -> Option<usize> {
-        self.body_rotation[body]
+        match self.body_rotation[body].as_slice() {
+            [angle] => Some(*angle),
+            _ => None,
+        }
     }
 
-    /// All equations of one rigid body (translations, then rotation).
+    /// Equations of all a body's rotation unknowns: none, its angle, or the three material
+    /// rotations of a body free to turn.
+    pub fn body_rotations(&self, body: usize) -> &[usize] {
+        &self.body_rotation[body]
+    }
+
+    /// All equations of one rigid body (translations, then rotations).
     pub fn body_equations(&self, body: usize) -> Vec<usize> {
         self.body_translation[body]
             .iter()
             .flatten()
+            .chain(&self.body_rotation[body])
             .copied()
-            .chain(self.body_rotation[body])
             .collect()
     }
 
@@ -161,8 +170,8 @@ impl<const D: usize> DofMap<D> {
             if let Some(component) = translation.iter().position(|e| *e == Some(eq)) {
                 return Some(EquationOwner::BodyTranslation { body, component });
             }
-            if *rotation == Some(eq) {
-                return Some(EquationOwner::BodyRotation { body });
+            if let Some(component) = rotation.iter().position(|e| *e == eq) {
+                return Some(EquationOwner::BodyRotation { body, component });
             }
         }
         self.node.iter().enumerate().find_map(|(node, eqs)| {
@@ -181,9 +190,9 @@ impl<const D: usize> DofMap<D> {
         gather(&self.body_translation[body], x)
     }
 
-    /// Rotation angle of a rigid body (0 if it cannot rotate).
+    /// Rotation angle of a rigid body turning about one fixed axis (0 for any other body).
     pub fn body_angle(&self, x: &DVector<f64>, body: usize) -> f64 {
-        self.body_rotation[body].map_or(0.0, |eq| x[eq])
+        self.body_rotation(body).map_or(0.0, |eq| x[eq])
     }
 }
 
@@ -204,7 +213,7 @@ mod tests {
             &[None, None, Some(0), Some(0)],
             &[],
             &[[false, true], [false, false]],
-            &[false, true],
+            &[0, 1],
         );
         assert_eq!(map.len(), 4 + 1 + 1);
         assert_eq!(map.node(0), &[Some(0), Some(1)]);
@@ -222,13 +231,47 @@ mod tests {
             component: 1,
         });
         assert_eq!(map.owner(4), translation);
-        assert_eq!(map.owner(5), Some(EquationOwner::BodyRotation { body: 1 }));
+        let rotation = EquationOwner::BodyRotation {
+            body: 1,
+            component: 0,
+        };
+        assert_eq!(map.owner(5), Some(rotation));
         let node = Some(EquationOwner::Node {
             node: 1,
             component: 1,
         });
         assert_eq!(map.owner(3), node);
         assert_eq!(map.owner(6), None);
+    }
+
+    #[test]
+    fn a_body_free_to_turn_has_three_rotation_equations() {
+        // body 0 translates along x and turns freely; body 1 turns about one axis
+        let map = DofMap::<3>::new(
+            1,
+            &[None],
+            &[],
+            &[[true, false, false], [false; 3]],
+            &[3, 1],
+        );
+        assert_eq!(map.len(), 3 + 1 + 3 + 1);
+        assert_eq!(map.body_rotations(0), &[4, 5, 6]);
+        assert_eq!(map.body_rotation(0), None, "no single angle");
+        assert_eq!(map.body_rotation(1), Some(7));
+        assert_eq!(map.body_equations(0), vec![3, 4, 5, 6]);
+        let x = DVector::from_fn(8, |i, _| i as f64);
+        assert_eq!(map.body_angle(&x, 0), 0.0);
+        assert_eq!(map.body_angle(&x, 1), 7.0);
+        let owner = EquationOwner::BodyRotation {
+            body: 0,
+            component: 2,
+        };
+        assert_eq!(map.owner(6), Some(owner));
+        assert!(
+            map.kinds()[4..]
+                .iter()
+                .all(|k| *k == EquationKind::Rotation)
+        );
     }
 
     #[test]

@@ -117,8 +117,8 @@ impl std::fmt::Display for WorstResidual {
             Self::Equation(EquationOwner::BodyTranslation { body, component }) => {
                 write!(f, "force on rigid body {body} ({})", axis(component))
             }
-            Self::Equation(EquationOwner::BodyRotation { body }) => {
-                write!(f, "moment on rigid body {body}")
+            Self::Equation(EquationOwner::BodyRotation { body, component }) => {
+                write!(f, "moment on rigid body {body} (rotation {component})")
             }
             Self::Contact { pair, node } => write!(f, "contact of node {node} in pair {pair}"),
         }

@@ -904,7 +904,7 @@ mod tests {
         }
         assembler.hold(&held);
         // slips counted from the nodes' current positions on the drum
-        let rows = contact_rows(&model, &x, None, None, &held).expect("rows");
+        let rows = contact_rows(&model, &x, &[], None, None, &held).expect("rows");
         let mut residual = DVector::zeros(n);
         for (node, p) in model.part().mesh.nodes.iter().enumerate() {
             let [Some(ex), Some(ey)] = [model.dofs().node(node)[0], model.dofs().node(node)[1]]

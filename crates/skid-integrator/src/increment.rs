@@ -18,8 +18,11 @@
 //! [`MAX_STEP_HALVINGS`] times, before the increment is given up for a cutback; so is the HHT
 //! predictor, which extrapolates the start velocity over the whole increment.
 //!
-//! Dynamic residual (HHT): `R = M a + (1 + alpha) F(x) - alpha F_n`; tangent
-//! `M/(beta h^2) + (1 + alpha) K_T`. Static residual: `R = F(x)` with `F = f_int - lambda f_ext`;
+//! Dynamic residual (HHT): `R = M a + (1 + alpha) (F(x) + G(v)) - alpha (F_n + G(v_n))`, with
+//! the gyroscopic moments `G = W x J W` of bodies free to turn (see [`crate::orientation`]),
+//! weighted as the forces are to keep the scheme of second order; tangent
+//! `M/(beta h^2) + (1 + alpha) K_T`, without `dG/dx` (about `gamma h |W|` of the inertia term, so
+//! Newton converges linearly at that rate on such bodies' equations). Static residual: `R = F(x)` with `F = f_int - lambda f_ext`;
 //! tangent `K_T + M/h_s^2`. The mass term of the static tangent only regularises the Newton
 //! step (it keeps a pad that is not yet held by contact from being singular); it is not in the
 //! residual, so the converged state is exactly static. Where the tangent without contact is
@@ -325,7 +328,15 @@ fn solve_increment_with<const D: usize>(
         };
         let f_ext = external_forces(model, &x, kind.loads())?;
         let net = &internal.force - &f_ext;
-        let inertia = mass.component_mul(&a);
+        let mut inertia = mass.component_mul(&a);
+        if let IncrementKind::Dynamic { hht, .. } = kind
+            && let (Some(end), Some(begin)) = (
+                model.gyroscopic_moments(&v),
+                model.gyroscopic_moments(&start.v),
+            )
+        {
+            inertia += end * (1.0 + hht.alpha) - begin * hht.alpha;
+        }
         let mut residual = match kind {
             IncrementKind::Static { .. } => net.clone(),
             IncrementKind::Dynamic { hht, .. } => {
@@ -336,7 +347,14 @@ fn solve_increment_with<const D: usize>(
                 r
             }
         };
-        let rows = contact_rows(model, &x, row_start, Some(&previous), held)?;
+        let rows = contact_rows(
+            model,
+            &x,
+            &start.orientations,
+            row_start,
+            Some(&previous),
+            held,
+        )?;
         // what the constraints must balance, before their rows become identities
         let held_residual: Vec<(usize, f64)> = held
             .iter()
@@ -414,7 +432,14 @@ fn solve_increment_with<const D: usize>(
                 let held_contact = if held_residual.is_empty() {
                     None
                 } else {
-                    let all = contact_rows(model, &x, row_start, Some(&previous), &vec![false; n])?;
+                    let all = contact_rows(
+                        model,
+                        &x,
+                        &start.orientations,
+                        row_start,
+                        Some(&previous),
+                        &vec![false; n],
+                    )?;
                     Some(all.transpose_times(r, n))
                 };
                 let (mut constrained, mut reaction) = (DVector::zeros(n), DVector::zeros(n));
@@ -888,9 +913,11 @@ fn finish<const D: usize>(
         normal_work: start.energy.normal_work + normal_work,
         algorithmic_dissipation: start.energy.algorithmic_dissipation + algorithmic,
     };
+    let orientations = model.record_orientations(&start.orientations, &x);
     State {
         time,
         load_factor,
+        orientations,
         contact_reaction,
         reaction,
         x,

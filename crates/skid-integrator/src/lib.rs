@@ -5,6 +5,8 @@
 //! - [`model`]: the assembled scene (mesh, material, rigid bodies, ties, loads, contact pairs);
 //! - [`loads`]: pressures, concentrated loads and gravity, and their amplitudes;
 //! - [`dof`]: which global equation each node component and rigid-body motion maps to;
+//! - [`orientation`]: the orientations of rigid bodies free to turn, and their gyroscopic
+//!   moments;
 //! - [`sparse`]: the fixed sparsity pattern and the Cholesky factorization whose symbolic
 //!   analysis is computed once per run and reused for every Newton iteration;
 //! - [`assembly`]: internal forces, tangent, lumped masses and follower pressure on that pattern;
@@ -40,6 +42,7 @@ pub mod mixed;
 pub mod model;
 pub mod motion;
 pub mod ordering;
+pub mod orientation;
 pub mod quasi_definite;
 pub mod settings;
 pub mod sparse;

@@ -15,7 +15,7 @@ use nalgebra::{DVector, SVector, Vector3};
 
 use crate::dof::DofMap;
 use crate::error::ModelError;
-use skid_fem::rigid::RigidBody;
+use skid_fem::rigid::{RigidBody, Rotation};
 use skid_fem::solid::OnePointSolid;
 
 /// A piecewise-linear function of the step time given by points `(t_k, a_k)` with increasing
@@ -301,8 +301,20 @@ impl<const D: usize> ConcentratedLoad<D> {
                     return invalid(format!("{what}: rigid body {b} does not exist"));
                 };
                 add(scene.dofs.body_translation(b));
-                let about_axis = body.rotation_axis.map_or(0.0, |e| self.moment.dot(&e));
-                let off_axis = match body.rotation_axis {
+                let axis = match body.rotation {
+                    Rotation::Free { .. } if self.moment != Vector3::zeros() => {
+                        return invalid(format!(
+                            "{what}: a moment on rigid body '{}', which is free to turn, is not \
+                             supported (its body-frame components change as it turns); give it \
+                             one rotation axis or apply the moment as forces",
+                            body.name
+                        ));
+                    }
+                    Rotation::Axis(e) => Some(e),
+                    _ => None,
+                };
+                let about_axis = axis.map_or(0.0, |e| self.moment.dot(&e));
+                let off_axis = match axis {
                     Some(e) => self.moment - e * about_axis,
                     None => self.moment,
                 };
@@ -312,7 +324,7 @@ impl<const D: usize> ConcentratedLoad<D> {
                          axis {:?}",
                         self.moment.as_slice(),
                         body.name,
-                        body.rotation_axis.map(|e| [e.x, e.y, e.z])
+                        axis.map(|e| [e.x, e.y, e.z])
                     ));
                 }
                 if let Some(eq) = scene.dofs.body_rotation(b) {

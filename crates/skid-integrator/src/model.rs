@@ -8,13 +8,14 @@ use skid_contact::surface::RigidSurface;
 use skid_fem::cell::embed;
 use skid_fem::material::Hyperelastic;
 use skid_fem::mesh::SolidMesh;
-use skid_fem::rigid::RigidBody;
+use skid_fem::rigid::{RigidBody, Rotation};
 use skid_fem::solid::OnePointSolid;
 
 use crate::dof::{DofMap, EquationOwner};
 use crate::error::ModelError;
 use crate::loads::{DeadLoad, Loads, PressureLoad, Scene};
 use crate::motion::{MotionTarget, PrescribedMotion, body_equation};
+use crate::orientation::{self, Orientation};
 
 /// A material and its mass density, shared by a group of elements.
 #[derive(Debug)]
@@ -202,7 +203,7 @@ impl<const D: usize> Model<D> {
         let mut tied_to = vec![None; n_nodes];
         for tie in &ties {
             check_body(tie.body, "tie")?;
-            if bodies[tie.body].rotation_axis.is_some() {
+            if bodies[tie.body].rotation != Rotation::None {
                 return invalid(format!(
                     "tie to rigid body '{}': ties to rotating bodies are not supported",
                     bodies[tie.body].name
@@ -272,14 +273,8 @@ impl<const D: usize> Model<D> {
 
         let free_translations: Vec<[bool; D]> =
             bodies.iter().map(|b| b.free_translations).collect();
-        let free_rotation: Vec<bool> = bodies.iter().map(|b| b.rotation_axis.is_some()).collect();
-        let dofs = DofMap::new(
-            n_nodes,
-            &tied_to,
-            &fixed,
-            &free_translations,
-            &free_rotation,
-        );
+        let rotations: Vec<usize> = bodies.iter().map(|b| b.rotation.unknowns()).collect();
+        let dofs = DofMap::new(n_nodes, &tied_to, &fixed, &free_translations, &rotations);
 
         let mut solid_mass = DVector::zeros(dofs.len());
         for (e, (element, conn)) in elements.iter().zip(&part.mesh.elements).enumerate() {
@@ -295,8 +290,14 @@ impl<const D: usize> Model<D> {
             for eq in dofs.body_translation(b).iter().flatten() {
                 body_mass[*eq] += body.mass;
             }
-            if let Some(eq) = dofs.body_rotation(b) {
-                body_mass[eq] += body.rotary_inertia;
+            let inertia = match body.rotation {
+                Rotation::Free {
+                    principal_inertia, ..
+                } => principal_inertia,
+                _ => Vector3::repeat(body.rotary_inertia),
+            };
+            for (i, &eq) in dofs.body_rotations(b).iter().enumerate() {
+                body_mass[eq] += inertia[i];
             }
         }
         let regularization_mass = &solid_mass + &body_mass;
@@ -581,16 +582,45 @@ impl<const D: usize> Model<D> {
         self.bodies.iter().position(|b| b.name == name)
     }
 
-    /// The frame of rigid body `body` in the state `x`: its current reference point `c` (the
-    /// reference point plus its displacement), its rotation axis (+z for a body that cannot
-    /// rotate) and its angle, so that a body-frame point `y` is at `c + Q(theta) y`.
-    pub fn body_frame(&self, x: &DVector<f64>, body: usize) -> RotatingFrame {
+    /// The frame of rigid body `body` at `x`: its current reference point `c` (the reference
+    /// point plus its displacement) and its orientation `Q`, so that a body-frame point `y` is at
+    /// `c + Q y`. `Q` turns by the angle about the axis of a body turning about one axis (`+z`
+    /// for a body that cannot rotate), and is the orientation from the records `orientations`
+    /// for a body free to turn (see [`crate::orientation`]).
+    pub fn body_frame(
+        &self,
+        x: &DVector<f64>,
+        body: usize,
+        orientations: &[Orientation],
+    ) -> RotatingFrame {
         let b = &self.bodies[body];
-        RotatingFrame {
-            center: embed(&(b.reference_point + self.dofs.body_displacement(x, body))),
-            axis: b.rotation_axis.unwrap_or_else(Vector3::z),
-            angle: self.dofs.body_angle(x, body),
+        let center = embed(&(b.reference_point + self.dofs.body_displacement(x, body)));
+        match b.rotation {
+            Rotation::Free { .. } => RotatingFrame::free(
+                center,
+                &orientation::orientation(&self.dofs, orientations, x, body),
+            ),
+            Rotation::Axis(axis) => {
+                RotatingFrame::about(center, axis, self.dofs.body_angle(x, body))
+            }
+            Rotation::None => RotatingFrame::about(center, Vector3::z(), 0.0),
         }
+    }
+
+    /// The orientations of the bodies free to turn at `x`, recorded there (see
+    /// [`crate::orientation::record`]).
+    pub fn record_orientations(
+        &self,
+        orientations: &[Orientation],
+        x: &DVector<f64>,
+    ) -> Vec<Orientation> {
+        orientation::record(&self.dofs, &self.bodies, orientations, x)
+    }
+
+    /// The gyroscopic moments of the bodies free to turn at the body-frame angular velocities
+    /// in `v` (see [`crate::orientation::gyroscopic_moments`]).
+    pub fn gyroscopic_moments(&self, v: &DVector<f64>) -> Option<DVector<f64>> {
+        orientation::gyroscopic_moments(&self.dofs, &self.bodies, v)
     }
 
     /// Current position of a node embedded in 3D (z = 0 in 2D).
@@ -615,8 +645,15 @@ impl<const D: usize> Model<D> {
                     v[*eq] = body.initial_velocity[i];
                 }
             }
-            if let Some(eq) = self.dofs.body_rotation(b) {
-                v[eq] = body.initial_angular_velocity;
+            let w = match body.rotation {
+                Rotation::Free {
+                    initial_angular_velocity,
+                    ..
+                } => initial_angular_velocity,
+                _ => Vector3::repeat(body.initial_angular_velocity),
+            };
+            for (i, &eq) in self.dofs.body_rotations(b).iter().enumerate() {
+                v[eq] = w[i];
             }
         }
         v

@@ -4,6 +4,8 @@ use nalgebra::{DVector, Vector2};
 use serde::{Deserialize, Serialize};
 use skid_contact::SurfacePoint;
 
+use crate::orientation::Orientation;
+
 /// State of one contact candidate (slave node of a pair) at the end of an increment.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ContactPointState {
@@ -87,9 +89,11 @@ pub struct State {
     pub time: f64,
     /// Load factor of the pressure loads.
     pub load_factor: f64,
-    /// Displacements and rotation angles per equation.
+    /// Displacements and rotations per equation (for a body free to turn, the sum of its
+    /// material rotation increments).
     pub x: DVector<f64>,
-    /// Velocities per equation.
+    /// Velocities per equation (for a body free to turn, its angular velocity in the body
+    /// frame).
     pub v: DVector<f64>,
     /// Accelerations per equation.
     pub a: DVector<f64>,
@@ -112,4 +116,9 @@ pub struct State {
     pub warm_forces: DVector<f64>,
     /// Energy bookkeeping.
     pub energy: EnergyLedger,
+    /// The orientations of the bodies free to turn, recorded at `x` (empty without such bodies,
+    /// and in a state written before they were kept, which had none; see
+    /// [`crate::orientation`]).
+    #[serde(default)]
+    pub orientations: Vec<Orientation>,
 }

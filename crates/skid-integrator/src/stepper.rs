@@ -576,7 +576,7 @@ pub fn initial_state<const D: usize>(
     let x = DVector::zeros(n);
     let v = model.initial_velocity();
     let held = vec![false; n];
-    let rows = contact_rows(model, &x, None, None, &held)?;
+    let rows = contact_rows(model, &x, &[], None, None, &held)?;
     let d = rows.components;
     let contacts = model
         .contacts()
@@ -621,6 +621,7 @@ pub fn initial_state<const D: usize>(
         warm_forces: DVector::zeros(contacts.len() * D),
         contacts,
         energy,
+        orientations: model.record_orientations(&[], &DVector::zeros(n)),
     })
 }
 
@@ -652,15 +653,19 @@ fn start_loads<const D: usize>(
     Ok(())
 }
 
-/// Smooth acceleration at the start of a dynamic step, `a = -M^{-1} (f_int - f_ext)`: the
-/// contact forces act as impulses and are never part of `a` (see [`crate::hht`]). Held
-/// and massless equations get zero.
+/// Smooth acceleration at the start of a dynamic step, `a = -M^{-1} (f_int - f_ext + G(v))`
+/// with the gyroscopic moments `G` of bodies free to turn: the contact forces act as impulses
+/// and are never part of `a` (see [`crate::hht`]). Held and massless equations get zero.
 fn consistent_acceleration<const D: usize>(
     model: &Model<D>,
     state: &State,
     held: &[bool],
 ) -> DVector<f64> {
-    let mut a = -model.acceleration_of(&state.net_force);
+    let mut force = state.net_force.clone();
+    if let Some(gyroscopic) = model.gyroscopic_moments(&state.v) {
+        force += gyroscopic;
+    }
+    let mut a = -model.acceleration_of(&force);
     for (a, _) in a.iter_mut().zip(held).filter(|(_, h)| **h) {
         *a = 0.0;
     }

@@ -4,7 +4,7 @@ use crate::model::Section;
 use nalgebra::{SVector, Vector2, Vector3};
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
-use skid_fem::rigid::RigidBody;
+use skid_fem::rigid::{RigidBody, Rotation};
 
 use skid_contact::SurfacePoint;
 use skid_contact::surface::AnalyticCylinder;
@@ -39,11 +39,11 @@ pub(crate) fn pad_block<const D: usize>(
     }
 }
 
-/// A rigid body at the origin, at rest, with the given free translations and rotation axis.
+/// A rigid body at the origin, at rest, with the given free translations and rotation.
 pub(crate) fn body<const D: usize>(
     name: &str,
     free_translations: [bool; D],
-    rotation_axis: Option<Vector3<f64>>,
+    rotation: Rotation,
     mass: f64,
     rotary_inertia: f64,
 ) -> RigidBody<D> {
@@ -53,7 +53,7 @@ pub(crate) fn body<const D: usize>(
         mass,
         rotary_inertia,
         free_translations,
-        rotation_axis,
+        rotation,
         initial_velocity: SVector::zeros(),
         initial_angular_velocity: 0.0,
     }
@@ -61,11 +61,23 @@ pub(crate) fn body<const D: usize>(
 
 /// A block above a drum of radius 0.2 that spins about z and may also translate in x.
 pub(crate) fn block_on_drum<const D: usize>() -> Model<D> {
+    block_on_turning_drum(Rotation::Axis(Vector3::z()))
+}
+
+/// [`block_on_drum`] with the drum free to turn about all three axes (3D).
+pub(crate) fn block_on_free_drum() -> Model<3> {
+    block_on_turning_drum(Rotation::Free {
+        principal_inertia: Vector3::new(0.1, 0.1, 0.175),
+        initial_angular_velocity: Vector3::zeros(),
+    })
+}
+
+fn block_on_turning_drum<const D: usize>(rotation: Rotation) -> Model<D> {
     let part = pad_block::<D>([-0.05, 0.2, -0.05], [0.1, 0.05, 0.1], [4, 1, 2]);
     let front = part.mesh.node_sets["ymin"].clone();
     let mut free = [false; D];
     free[0] = true;
-    let drum = body::<D>("drum", free, Some(Vector3::z()), 5.0, 0.175);
+    let drum = body::<D>("drum", free, rotation, 5.0, 0.175);
     let pair = ContactPair {
         name: "pad-drum".into(),
         nodes: front,

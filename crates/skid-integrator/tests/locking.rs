@@ -4,7 +4,7 @@
 use nalgebra::SVector;
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
-use skid_fem::rigid::RigidBody;
+use skid_fem::rigid::{RigidBody, Rotation};
 use skid_integrator::Section;
 use skid_integrator::settings::Settings;
 use skid_integrator::stepper::{IncrementReport, Observer, StaticIncrements, Step, StepKind, run};
@@ -57,7 +57,7 @@ fn tip_deflection(k_over_mu: f64) -> f64 {
         mass: 0.0,
         rotary_inertia: 0.0,
         free_translations: [false, false],
-        rotation_axis: None,
+        rotation: Rotation::None,
         initial_velocity: SVector::zeros(),
         initial_angular_velocity: 0.0,
     };

@@ -613,13 +613,23 @@ fn point_inertia(
         );
         *next_element += 1;
     }
-    if body.rotary_inertia > 0.0 {
-        let i = num(body.rotary_inertia);
-        let values = if dim == 2 {
-            i
+    let values = match body.principal_inertia {
+        Some(j) if j.iter().any(|&v| v > 0.0) => Some(if dim == 2 {
+            num(j[2])
         } else {
-            format!("{i}, {i}, {i}")
-        };
+            j.map(num).join(", ")
+        }),
+        _ if body.rotary_inertia > 0.0 => {
+            let i = num(body.rotary_inertia);
+            Some(if dim == 2 {
+                i
+            } else {
+                format!("{i}, {i}, {i}")
+            })
+        }
+        _ => None,
+    };
+    if let Some(values) = values {
         let _ = writeln!(
             out,
             "*ELEMENT, TYPE=ROTARYI, ELSET={0}-inertia\n{1}, {reference}\n*ROTARY INERTIA, ELSET={0}-inertia\n{values}",

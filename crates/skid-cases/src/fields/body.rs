@@ -7,6 +7,7 @@ use std::f64::consts::TAU;
 use std::io;
 
 use nalgebra::{SVector, Vector3};
+use skid_contact::kinematics::Turning;
 use skid_contact::surface::{RigidSurface, SurfaceShape};
 use skid_fem::cell::embed;
 use skid_integrator::{Model, State};
@@ -27,7 +28,9 @@ struct Drawing {
 }
 
 /// Rigid body `body`'s `surface` in its current pose in `state`, drawn over the part whose
-/// nodes are at `current`, with point data `velocity` = `v_c + omega e x (x - c)` (m/s).
+/// nodes are at `current`, with point data `velocity` = `v_c + omega x (x - c)` (m/s), `omega`
+/// the spatial angular velocity: `omega e` about a fixed axis `e`, `Q W` for a body free to turn
+/// with body-frame angular velocity `W`.
 pub(super) fn body_grid<const D: usize>(
     model: &Model<D>,
     state: &State,
@@ -35,7 +38,7 @@ pub(super) fn body_grid<const D: usize>(
     surface: &dyn RigidSurface,
     current: &[Vector3<f64>],
 ) -> io::Result<Grid> {
-    let frame = model.body_frame(&state.x, body);
+    let frame = model.body_frame(&state.x, body, &state.orientations);
     let name = &model.bodies()[body].name;
     let degenerate = || invalid_data(format!("rigid body '{name}': its frame is not finite"));
     let around = current
@@ -55,8 +58,15 @@ pub(super) fn body_grid<const D: usize>(
     let translation = embed(&SVector::<f64, D>::from_fn(|i, _| {
         equations[i].map_or(0.0, |eq| state.v[eq])
     }));
-    let omega = dofs.body_rotation(body).map_or(0.0, |eq| state.v[eq]);
-    let spin = frame.axis.normalize() * omega;
+    let rates = Vector3::from_fn(|i, _| {
+        dofs.body_rotations(body)
+            .get(i)
+            .map_or(0.0, |&eq| state.v[eq])
+    });
+    let spin = match frame.turning {
+        Turning::About(axis) => axis.into_inner() * rates[0],
+        Turning::Free => frame.orientation * rates,
+    };
     let velocity: Vec<Vector3<f64>> = points
         .iter()
         .map(|p| translation + spin.cross(&(p - frame.center)))

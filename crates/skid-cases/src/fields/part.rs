@@ -95,7 +95,7 @@ fn contact_tractions<const D: usize>(
             .contacts()
             .get(c.pair)
             .ok_or_else(|| invalid_data(format!("contact pair {} does not exist", c.pair)))?;
-        let frame = model.body_frame(&state.x, pair.body);
+        let frame = model.body_frame(&state.x, pair.body, &state.orientations);
         let position = current
             .get(c.node)
             .ok_or_else(|| invalid_data(format!("contact node {} does not exist", c.node)))?;

@@ -13,7 +13,7 @@ use skid_contact::triangles::{CylinderChart, SurfaceChart, TriangulatedSurface};
 use skid_fem::cell::{embed, face_corners};
 use skid_fem::material::{Hyperelastic, PolynomialN1};
 use skid_fem::mesh::SolidMesh;
-use skid_fem::rigid::RigidBody;
+use skid_fem::rigid::{RigidBody, Rotation};
 use skid_integrator::BodyMotion;
 use skid_integrator::settings::{ContactSolve, NewtonSettings};
 use skid_integrator::settings::{CutbackSettings, Settings};
@@ -578,7 +578,8 @@ fn body_names(spec: &ModelSpec) -> Result<BTreeMap<&str, usize>, SpecError> {
     Ok(index)
 }
 
-/// A rigid body whose motions are those `fixed` leaves free; at most one rotation may be free.
+/// A rigid body whose motions are those `fixed` leaves free: no rotation, one about a global
+/// axis, or (in 3D) all three.
 fn rigid_body<const D: usize>(
     i: usize,
     b: &crate::model_spec::RigidBodySpec,
@@ -588,32 +589,33 @@ fn rigid_body<const D: usize>(
     let reference_point = finite_point::<D>(&f("reference_point"), &b.reference_point)?;
     non_negative(&f("mass"), b.mass)?;
     non_negative(&f("rotary_inertia"), b.rotary_inertia)?;
+    let principal = match b.principal_inertia {
+        Some(j) => {
+            if b.rotary_inertia != 0.0 {
+                return fail(
+                    f("principal_inertia"),
+                    "give either rotary_inertia or principal_inertia, not both",
+                );
+            }
+            let j = vector3(&f("principal_inertia"), j)?;
+            if let Some(k) = (0..3).find(|&k| j[k] < 0.0) {
+                return fail(
+                    f("principal_inertia"),
+                    format!("expected moments >= 0, got {} at {k}", j[k]),
+                );
+            }
+            Some(j)
+        }
+        None => None,
+    };
     let free = |d: &Dof| !fixed.contains(d);
     let free_translations: [bool; D] =
         std::array::from_fn(|axis| [Dof::X, Dof::Y, Dof::Z][axis]).map(|d| free(&d));
-    let free_rotations: Vec<Dof> = Dof::all(D)
+    let free_rotations: Vec<usize> = Dof::all(D)
         .iter()
-        .filter(|d| d.rotation_axis().is_some() && free(d))
-        .copied()
+        .filter(|d| free(d))
+        .filter_map(|d| d.rotation_axis())
         .collect();
-    let rotation_axis = match free_rotations.as_slice() {
-        [] => None,
-        [d] => {
-            let mut axis = Vector3::zeros();
-            axis[d.rotation_axis().unwrap_or(2)] = 1.0;
-            Some(axis)
-        }
-        several => {
-            return fail(
-                format!("rigid_bodies[{i}]"),
-                format!(
-                    "rigid body '{}' may rotate about {several:?}: a rigid body rotates about at \
-                     most one axis; fix the others with a boundary condition",
-                    b.name
-                ),
-            );
-        }
-    };
     let initial_velocity = match &b.initial_velocity {
         Some(v) => finite_point::<D>(&f("initial_velocity"), v)?,
         None => SVector::zeros(),
@@ -628,14 +630,48 @@ fn rigid_body<const D: usize>(
         &f("initial_angular_velocity"),
         b.initial_angular_velocity.unwrap_or([0.0; 3]),
     )?;
-    let initial_angular_velocity = match rotation_axis {
-        Some(axis) if (w - axis * w.dot(&axis)).norm() == 0.0 => w.dot(&axis),
-        _ if w.norm() == 0.0 => 0.0,
-        _ => {
+    let (rotation, rotary_inertia, initial_angular_velocity) = match free_rotations.as_slice() {
+        [] if w.norm() == 0.0 => (Rotation::None, b.rotary_inertia, 0.0),
+        [k] if (0..3).all(|a| a == *k || w[a] == 0.0) => {
+            let axis = Vector3::ith(*k, 1.0);
+            let inertia = principal.map_or(b.rotary_inertia, |j| j[*k]);
+            (Rotation::Axis(axis), inertia, w[*k])
+        }
+        [_, _, _] => {
+            let Some(principal_inertia) = principal else {
+                return fail(
+                    f("principal_inertia"),
+                    format!(
+                        "rigid body '{}' is free to turn about x, y and z: expected its principal \
+                         moments of inertia [Jx, Jy, Jz]",
+                        b.name
+                    ),
+                );
+            };
+            let rotation = Rotation::Free {
+                principal_inertia,
+                initial_angular_velocity: w,
+            };
+            (rotation, 0.0, 0.0)
+        }
+        [] | [_] => {
             return fail(
                 f("initial_angular_velocity"),
                 format!(
-                    "expected a vector along the free rotation axis {rotation_axis:?}, got {w:?}"
+                    "expected a vector along the free rotation axes {:?}, got {:?}",
+                    free_rotations,
+                    w.as_slice()
+                ),
+            );
+        }
+        two => {
+            return fail(
+                format!("rigid_bodies[{i}]"),
+                format!(
+                    "rigid body '{}' may rotate about the axes {two:?} only: a rigid body turns \
+                     about no axis, one, or all three; fix the other with a boundary condition \
+                     or free it",
+                    b.name
                 ),
             );
         }
@@ -644,9 +680,9 @@ fn rigid_body<const D: usize>(
         name: b.name.clone(),
         reference_point,
         mass: b.mass,
-        rotary_inertia: b.rotary_inertia,
+        rotary_inertia,
         free_translations,
-        rotation_axis,
+        rotation,
         initial_velocity,
         initial_angular_velocity,
     })

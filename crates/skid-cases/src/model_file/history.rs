@@ -3,8 +3,10 @@
 //!
 //! Columns, in order: `time`, `step`, `increment`, `load_factor` (the ramp of the loads without
 //! amplitude), `dt`, `newton_iterations`, `contact_solves`; for each rigid body `B` (model order) `B.u_x`, `B.v_x` (displacement and
-//! velocity of the reference node, likewise `y`, `z`) for each free translation and `B.angle`,
-//! `B.omega` if it rotates; for each contact pair `P`:
+//! velocity of the reference node, likewise `y`, `z`) for each free translation, `B.angle`,
+//! `B.omega` if it turns about one axis, and `B.rotation_x`, `_y`, `_z` (the rotation vector
+//! of its orientation, rad) and `B.omega_x`, `_y`, `_z` (its angular velocity in the global
+//! frame, rad/s) if it is free to turn; for each contact pair `P`:
 //! `P.normal_force` (sum of the normal forces, N), `P.tangential_force_1` (and `_2` in 3D: sums
 //! of the friction force components along the master surface's coordinate directions, N),
 //! `P.active`, `P.sliding` (closed contacts, and those at the cone's boundary), `P.max_penetration`
@@ -20,6 +22,8 @@
 use std::collections::HashMap;
 use std::path::Path;
 
+use nalgebra::Vector3;
+use skid_integrator::orientation::orientation;
 use skid_integrator::state::EnergyLedger;
 use skid_integrator::stepper::{IncrementReport, Observer};
 use skid_integrator::{BodyMotion, Model, MotionTarget, State};
@@ -99,6 +103,13 @@ pub fn columns<const D: usize>(model: &Model<D>, reactions: &ReactionColumns) ->
             names.push(format!("{}.angle", body.name));
             names.push(format!("{}.omega", body.name));
         }
+        if dofs.body_rotations(b).len() == 3 {
+            for what in ["rotation", "omega"] {
+                for axis in ["x", "y", "z"] {
+                    names.push(format!("{}.{what}_{axis}", body.name));
+                }
+            }
+        }
     }
     for pair in model.contacts() {
         names.push(format!("{}.normal_force", pair.name));
@@ -161,9 +172,10 @@ pub struct BodyState {
     pub displacement: Vec<f64>,
     /// Velocity of the reference node, m/s.
     pub velocity: Vec<f64>,
-    /// Rotation angle about the free axis, rad (0 if it cannot rotate).
+    /// Rotation angle about the free axis, rad (0 if it cannot rotate or is free to turn about
+    /// all three axes, whose orientation the history gives).
     pub angle: f64,
-    /// Angular velocity about the free axis, rad/s.
+    /// Angular velocity about the free axis, rad/s (0 as for `angle`).
     pub omega: f64,
 }
 
@@ -310,6 +322,17 @@ impl<const D: usize> Observer<D> for ModelRecorder {
             if let Some(eq) = dofs.body_rotation(b) {
                 row.push(number(s.x[eq]));
                 row.push(number(s.v[eq]));
+            }
+            if let [e0, e1, e2] = *dofs.body_rotations(b) {
+                // the rotation vector of the orientation and the spatial angular velocity
+                let q = orientation(dofs, &s.orientations, &s.x, b);
+                let omega = q * Vector3::new(s.v[e0], s.v[e1], s.v[e2]);
+                row.extend(
+                    q.scaled_axis()
+                        .iter()
+                        .chain(omega.iter())
+                        .map(|&c| number(c)),
+                );
             }
         }
         let totals = pair_totals(model, s);

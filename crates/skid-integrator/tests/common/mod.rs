@@ -3,7 +3,7 @@
 use nalgebra::SVector;
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
-use skid_fem::rigid::RigidBody;
+use skid_fem::rigid::{RigidBody, Rotation};
 use skid_integrator::Section;
 use skid_integrator::SolidPart;
 
@@ -16,7 +16,7 @@ pub fn translating_body(name: &str, free: [bool; 2], y: f64) -> RigidBody<2> {
         mass: 0.0,
         rotary_inertia: 0.0,
         free_translations: free,
-        rotation_axis: None,
+        rotation: Rotation::None,
         initial_velocity: SVector::zeros(),
         initial_angular_velocity: 0.0,
     }

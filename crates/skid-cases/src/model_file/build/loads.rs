@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use nalgebra::{SVector, Vector3};
 use skid_fem::mesh::SolidMesh;
-use skid_fem::rigid::RigidBody;
+use skid_fem::rigid::{RigidBody, Rotation};
 use skid_integrator::{
     Amplitude, ConcentratedLoad, GravityLoad, LoadTarget, Loads, PressureLoad, StepVariation,
     Variation,
@@ -44,7 +44,18 @@ fn body_moment<const D: usize>(
                 format!("{dof:?} is not a degree of freedom in {D}D: expected 0 there"),
             );
         }
-        if body.rotation_axis.is_none_or(|e| e[axis] != 1.0) {
+        if let Rotation::Free { .. } = body.rotation {
+            return fail(
+                field,
+                format!(
+                    "rigid body '{}' is free to turn: a moment on it is not supported (its \
+                     body-frame components change as it turns); apply it as forces, or fix all \
+                     rotations but one",
+                    body.name
+                ),
+            );
+        }
+        if !matches!(body.rotation, Rotation::Axis(e) if e[axis] == 1.0) {
             return fail(
                 field,
                 format!(

@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 
 use skid_fem::mesh::SolidMesh;
-use skid_fem::rigid::RigidBody;
+use skid_fem::rigid::{RigidBody, Rotation};
 use skid_integrator::{BodyMotion, MotionTarget, PrescribedMotion};
 
 use super::loads::{TimedAmplitude, amplitude_named, variation};
@@ -56,8 +56,18 @@ pub(super) fn prescribed_motions<const D: usize>(
                 let motion = match dof.translation_axis() {
                     Some(axis) => BodyMotion::Translation(axis),
                     None => {
-                        let free = bodies[body].rotation_axis;
-                        if let (Some(e), Some(k)) = (free, dof.rotation_axis())
+                        let rotation = bodies[body].rotation;
+                        if let Rotation::Free { .. } = rotation {
+                            return fail(
+                                f("dofs"),
+                                format!(
+                                    "rigid body '{name}' is free to turn: prescribing its \
+                                     {dof:?} is not supported; fix its other rotations with a \
+                                     boundary condition"
+                                ),
+                            );
+                        }
+                        if let (Rotation::Axis(e), Some(k)) = (rotation, dof.rotation_axis())
                             && e[k].abs() != 1.0
                         {
                             return fail(

@@ -1,0 +1,138 @@
+//! A rigid body free to turn, with no moment on it: a torque-free symmetric top. With principal
+//! moments of inertia `(J, J, J_3)` and body-frame angular velocity `W(0) = (W_p, 0, W_3)`,
+//! Euler's equations `J W' + W x J W = 0` give `W_3` constant and `(W_1, W_2)` turning in the
+//! body frame at `Omega = (J_3 - J) / J W_3`: `W_1 = W_p cos(Omega t)`, `W_2 = W_p sin(Omega t)`.
+//! The kinetic energy and the spatial angular momentum `Q J W` are constant. The solid of the
+//! model is one element held fixed, away from the body.
+
+use nalgebra::{SVector, Vector3};
+use skid_fem::material::PolynomialN1;
+use skid_fem::mesh::SolidMesh;
+use skid_fem::rigid::{RigidBody, Rotation};
+use skid_integrator::orientation::orientation;
+use skid_integrator::settings::Settings;
+use skid_integrator::stepper::{IncrementReport, Observer, Step, StepKind, run};
+use skid_integrator::{Loads, Model, Section, SolidPart, State};
+
+const J: f64 = 0.01;
+const J3: f64 = 0.02;
+const W_P: f64 = 2.0;
+const W_3: f64 = 20.0;
+const DURATION: f64 = 0.5;
+
+struct Record(Vec<State>);
+
+impl<const D: usize> Observer<D> for Record {
+    fn on_increment(&mut self, _: &Model<D>, r: &IncrementReport<'_>) -> std::io::Result<()> {
+        self.0.push(r.state.clone());
+        Ok(())
+    }
+}
+
+/// One fixed hexahedron of the pad material and the top.
+fn top() -> Model<3> {
+    let mesh = SolidMesh::<3>::structured_block(
+        SVector::<f64, 3>::new(1.0, 1.0, 1.0),
+        SVector::<f64, 3>::repeat(0.01),
+        [1, 1, 1],
+    )
+    .expect("mesh");
+    let fixed = (0..mesh.nodes.len())
+        .flat_map(|n| (0..3).map(move |axis| (n, axis)))
+        .collect();
+    let part = SolidPart {
+        name: "block".into(),
+        mesh,
+        sections: vec![Section {
+            material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 1e-7).expect("material")),
+            density: 1000.0,
+        }],
+        element_sections: Vec::new(),
+        thickness: 1.0,
+        hourglass_scale: 1.0,
+        quasi_static: false,
+        fixed,
+    };
+    let body = RigidBody::<3> {
+        name: "top".into(),
+        reference_point: SVector::zeros(),
+        mass: 1.0,
+        rotary_inertia: 0.0,
+        free_translations: [false; 3],
+        rotation: Rotation::Free {
+            principal_inertia: Vector3::new(J, J, J3),
+            initial_angular_velocity: Vector3::new(W_P, 0.0, W_3),
+        },
+        initial_velocity: SVector::zeros(),
+        initial_angular_velocity: 0.0,
+    };
+    Model::new(part, vec![body], vec![], Loads::default(), vec![]).expect("model")
+}
+
+/// The worst errors of a run with increments `dt`, relative: the body-frame angular velocity
+/// against Euler's solution (over `W_p`), the drift of the spatial angular momentum and of the
+/// kinetic energy, and the ledger's kinetic energy against `1/2 W . J W`.
+fn worst_errors(dt: f64) -> [f64; 4] {
+    let model = top();
+    let dofs = model.dofs();
+    let rotations = dofs.body_rotations(0).to_vec();
+    assert_eq!(rotations.len(), 3);
+    let steps = vec![Step {
+        name: "spin".into(),
+        kind: StepKind::Dynamic {
+            duration: DURATION,
+            dt,
+            alpha: -0.3,
+            adaptive: None,
+        },
+        held: vec![],
+    }];
+    let mut record = Record(Vec::new());
+    let (_, result) = run(&model, &steps, &Settings::default(), &mut record);
+    result.expect("run completes");
+    let states = record.0;
+    let last = states.last().expect("states");
+    assert!((last.time - DURATION).abs() < 1e-9);
+    assert_eq!(last.orientations.len(), 1);
+    let inertia = Vector3::new(J, J, J3);
+    let w = |s: &State| Vector3::from_fn(|i, _| s.v[rotations[i]]);
+    let momentum =
+        |s: &State| orientation(dofs, &s.orientations, &s.x, 0) * inertia.component_mul(&w(s));
+    let energy = |s: &State| 0.5 * w(s).dot(&inertia.component_mul(&w(s)));
+    let (l0, e0) = (momentum(&states[0]), energy(&states[0]));
+    let omega = (J3 - J) / J * W_3;
+    let mut worst = [0.0_f64; 4];
+    for s in &states {
+        let t = s.time;
+        let expected = Vector3::new(W_P * (omega * t).cos(), W_P * (omega * t).sin(), W_3);
+        worst[0] = worst[0].max((w(s) - expected).norm() / W_P);
+        worst[1] = worst[1].max((momentum(s) - l0).norm() / l0.norm());
+        worst[2] = worst[2].max((energy(s) - e0).abs() / e0);
+        worst[3] = worst[3].max((s.energy.kinetic - energy(s)).abs() / e0);
+    }
+    worst
+}
+
+/// Measured: 5.7e-4 of `W_p` over ten radians of precession at `Omega h = 0.02`, the angular
+/// momentum constant to 1.2e-6 and the energy to 2.6e-7; halving the increment divides the
+/// angular velocity's error by four. Taking the gyroscopic moment at the end of the increment
+/// instead of HHT's `alpha` point makes the scheme first order: 5.8e-2 at `h = 1 ms`.
+#[test]
+fn a_torque_free_symmetric_top_precesses_at_the_rate_of_euler_s_equations() {
+    let fine = worst_errors(1e-3);
+    assert!(fine[0] < 1e-3, "angular velocity off by {} W_p", fine[0]);
+    assert!(
+        fine[1] < 1e-5,
+        "spatial angular momentum drifts by {}",
+        fine[1]
+    );
+    assert!(fine[2] < 1e-5, "kinetic energy drifts by {}", fine[2]);
+    assert!(
+        fine[3] < 1e-12,
+        "the ledger's kinetic energy is 1/2 W . J W: {}",
+        fine[3]
+    );
+    let coarse = worst_errors(2e-3);
+    let order = (coarse[0] / fine[0]).log2();
+    assert!(order > 1.8, "order {order}: {} then {}", coarse[0], fine[0]);
+}
