@@ -11,7 +11,9 @@ use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::{RigidBody, Rotation};
 use skid_integrator::orientation::orientation;
 use skid_integrator::settings::Settings;
-use skid_integrator::stepper::{IncrementReport, Observer, Step, StepKind, run};
+use skid_integrator::stepper::{
+    Checkpoint, IncrementReport, Observer, Step, StepKind, resume, run,
+};
 use skid_integrator::{Loads, Model, Section, SolidPart, State};
 
 const J: f64 = 0.01;
@@ -69,15 +71,9 @@ fn top() -> Model<3> {
     Model::new(part, vec![body], vec![], Loads::default(), vec![]).expect("model")
 }
 
-/// The worst errors of a run with increments `dt`, relative: the body-frame angular velocity
-/// against Euler's solution (over `W_p`), the drift of the spatial angular momentum and of the
-/// kinetic energy, and the ledger's kinetic energy against `1/2 W . J W`.
-fn worst_errors(dt: f64) -> [f64; 4] {
-    let model = top();
-    let dofs = model.dofs();
-    let rotations = dofs.body_rotations(0).to_vec();
-    assert_eq!(rotations.len(), 3);
-    let steps = vec![Step {
+/// The spin of the top: one dynamic step of increments `dt`.
+fn spin(dt: f64) -> Vec<Step> {
+    vec![Step {
         name: "spin".into(),
         kind: StepKind::Dynamic {
             duration: DURATION,
@@ -86,9 +82,19 @@ fn worst_errors(dt: f64) -> [f64; 4] {
             adaptive: None,
         },
         held: vec![],
-    }];
+    }]
+}
+
+/// The worst errors of a run with increments `dt`, relative: the body-frame angular velocity
+/// against Euler's solution (over `W_p`), the drift of the spatial angular momentum and of the
+/// kinetic energy, and the ledger's kinetic energy against `1/2 W . J W`.
+fn worst_errors(dt: f64) -> [f64; 4] {
+    let model = top();
+    let dofs = model.dofs();
+    let rotations = dofs.body_rotations(0).to_vec();
+    assert_eq!(rotations.len(), 3);
     let mut record = Record(Vec::new());
-    let (_, result) = run(&model, &steps, &Settings::default(), &mut record);
+    let (_, result) = run(&model, &spin(dt), &Settings::default(), &mut record);
     result.expect("run completes");
     let states = record.0;
     let last = states.last().expect("states");
@@ -135,4 +141,64 @@ fn a_torque_free_symmetric_top_precesses_at_the_rate_of_euler_s_equations() {
     let coarse = worst_errors(2e-3);
     let order = (coarse[0] / fine[0]).log2();
     assert!(order > 1.8, "order {order}: {} then {}", coarse[0], fine[0]);
+}
+
+/// Records the states and keeps a checkpoint, as JSON, after the increment `at` (counting the
+/// initial state).
+struct Checkpointing {
+    at: usize,
+    seen: usize,
+    states: Vec<State>,
+    checkpoint: Option<String>,
+}
+
+impl Observer<3> for Checkpointing {
+    fn on_increment(&mut self, _: &Model<3>, r: &IncrementReport<'_>) -> std::io::Result<()> {
+        self.seen += 1;
+        self.states.push(r.state.clone());
+        Ok(())
+    }
+
+    fn wants_checkpoint(&mut self, _: bool) -> bool {
+        self.seen == self.at
+    }
+
+    fn on_checkpoint(&mut self, _: &Model<3>, checkpoint: &Checkpoint) -> std::io::Result<()> {
+        self.checkpoint = Some(serde_json::to_string(checkpoint).map_err(std::io::Error::other)?);
+        Ok(())
+    }
+}
+
+/// A run resumed from a checkpoint written as JSON after 200 increments ends in the
+/// uninterrupted run's state, bit for bit: the checkpoint carries the orientation the run goes
+/// on from (without it the resumed top would start from the world orientation).
+#[test]
+fn a_top_resumed_from_a_checkpoint_ends_where_the_whole_run_ends() {
+    let model = top();
+    let settings = Settings::default();
+    let mut whole = Checkpointing {
+        at: 201,
+        seen: 0,
+        states: Vec::new(),
+        checkpoint: None,
+    };
+    run(&model, &spin(1e-3), &settings, &mut whole)
+        .1
+        .expect("run");
+    let text = whole.checkpoint.expect("a checkpoint");
+    let checkpoint: Checkpoint = serde_json::from_str(&text).expect("checkpoint reads");
+    assert_eq!(checkpoint.state.orientations.len(), 1);
+    assert!((checkpoint.state.time - 0.2).abs() < 1e-12);
+    let mut resumed = Record(Vec::new());
+    resume(&model, &spin(1e-3), &settings, &mut resumed, &checkpoint)
+        .1
+        .expect("resumed run");
+    let (a, b) = (
+        whole.states.last().expect("states"),
+        resumed.0.last().expect("states"),
+    );
+    assert_eq!(a.time, b.time);
+    assert_eq!(a.x, b.x);
+    assert_eq!(a.v, b.v);
+    assert_eq!(a.orientations, b.orientations);
 }
