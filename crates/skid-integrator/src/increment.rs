@@ -888,14 +888,23 @@ fn finish<const D: usize>(
             for &eq in &moved {
                 impulse_forces[eq] += constrained[eq];
             }
+            // the gyroscopic moments enter HHT's equations as the forces do (see the module
+            // documentation), so they are part of the smooth forces here
+            let (f0, f1) = match (
+                model.gyroscopic_moments(&start.v),
+                model.gyroscopic_moments(&v),
+            ) {
+                (Some(g0), Some(g1)) => (&start.net_force + g0, &net + g1),
+                _ => (start.net_force.clone(), net.clone()),
+            };
             hht.algorithmic_dissipation(
                 h,
                 &IncrementEnds {
                     mass: model.mass(),
                     quasi_static: model.quasi_static(),
                     dx: &dx,
-                    f0: &start.net_force,
-                    f1: &net,
+                    f0: &f0,
+                    f1: &f1,
                     a0: &start.a,
                     a1: &a,
                     contact: &impulse_forces,
