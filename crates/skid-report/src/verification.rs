@@ -15,9 +15,12 @@
 //!   resultant never exceeds `mu N` and equals it while every contact slides; a block on a
 //!   fixed flat sticks or slides as its held loads say, and the runs of a scene that stick and
 //!   slide bracket its threshold; a block moved over a fixed flat by prescribed motions makes
-//!   its reactions balance the friction.
+//!   its reactions balance the friction;
+//! - a torque-free rigid body ([`free_rotation`]): its angular momentum and kinetic energy are
+//!   constant, and a symmetric top precesses as Euler's equations say.
 
 pub mod coulomb;
+pub mod free_rotation;
 mod reactions;
 
 use std::fmt::Write as _;
@@ -29,6 +32,7 @@ use super::format::{Checks, Counts, Sig, percent};
 use super::hertz::{self, HertzMeasure, HertzScene};
 use super::plot::{HERTZ_SVG, plot_hertz_pressure};
 use super::{ReportError, read};
+use free_rotation::FreeBody;
 use skid_cases::model_file::contact_nodes::CONTACT_NODES_CSV;
 use skid_cases::model_spec::ModelSpec;
 use skid_cases::runner::MODEL_JSON;
@@ -168,11 +172,14 @@ pub fn section(
     let mut unchecked = Vec::new();
     let mut hertz_runs = Vec::new();
     let mut coulomb_runs = Vec::new();
+    let mut free_runs = Vec::new();
     for run in runs {
         if let Some(scene) = HertzScene::recognise(&run.spec) {
             hertz_runs.push((run, scene));
         } else if run.spec.contact.iter().any(|p| p.mu > 0.0) {
             coulomb_runs.push(run);
+        } else if let Some(body) = FreeBody::recognise(&run.spec) {
+            free_runs.push((run, body));
         } else {
             unchecked.push(run.name.as_str());
         }
@@ -184,6 +191,9 @@ pub fn section(
     }
     if !coulomb_runs.is_empty() {
         out.push_str(&coulomb::section(&coulomb_runs, &mut checks)?);
+    }
+    if !free_runs.is_empty() {
+        out.push_str(&free_rotation::section(&free_runs, &mut checks)?);
     }
     for name in unchecked {
         checks.skip(
