@@ -517,8 +517,9 @@ pub enum LoadSpec {
         /// Force, `dimension` components, N (absent: none).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         force: Option<Vec<f64>>,
-        /// Moment on a rigid body `[mx, my, mz]`, N m (absent: none); it must lie along the
-        /// body's free rotation axis.
+        /// Moment on a rigid body `[mx, my, mz]`, N m (absent: none), fixed in the global
+        /// frame; it must lie along the body's free rotation axis, or be any vector on a body
+        /// free to turn.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         moment: Option<[f64; 3]>,
         /// Amplitude name.

@@ -16,6 +16,7 @@ use crate::error::{IncrementFailure, LinearFailure, ModelError};
 use crate::loads::LoadInstant;
 use crate::mixed::MixedPressures;
 use crate::model::Model;
+use crate::orientation::{Orientation, orientation};
 use crate::sparse::{Factorization, PatternBuilder, SparsePattern};
 
 /// Below this many elements the element loop runs sequentially (threads cost more than they
@@ -488,10 +489,15 @@ pub const MAX_SHIFT_DECADES: usize = 8;
 
 /// External nodal forces per equation at `instant`: `f = sum_l c_l f_l` with each load's
 /// factor `c_l` (its amplitude at the step time, or the ramp; see [`crate::loads`]), the
-/// pressures' `f_l` on the current geometry at `x` (follower pressure), the dead loads' fixed.
+/// pressures' `f_l` on the current geometry at `x` (follower pressure), the dead loads' fixed,
+/// but for their moments `M` on bodies free to turn, which act on the body-frame rotation
+/// equations as `Q^T M` with the body's orientation `Q` at `x` from the records `orientations`
+/// (see [`crate::orientation`]; their load stiffness, the skew `[Q^T M]x`, is left out of the
+/// tangent).
 pub fn external_forces<const D: usize>(
     model: &Model<D>,
     x: &DVector<f64>,
+    orientations: &[Orientation],
     instant: LoadInstant,
 ) -> Result<DVector<f64>, IncrementFailure> {
     let mut f = DVector::zeros(model.dofs().len());
@@ -517,7 +523,15 @@ pub fn external_forces<const D: usize>(
         }
     }
     for load in model.dead_loads() {
-        f.axpy(instant.factor(&load.variation), &load.force, 1.0);
+        let factor = instant.factor(&load.variation);
+        f.axpy(factor, &load.force, 1.0);
+        for &(body, moment) in &load.body_moments {
+            let q = orientation(model.dofs(), orientations, x, body);
+            let local = q.inverse_transform_vector(&moment) * factor;
+            for (&eq, m) in model.dofs().body_rotations(body).iter().zip(local.iter()) {
+                f[eq] += m;
+            }
+        }
     }
     Ok(f)
 }

@@ -326,7 +326,7 @@ fn solve_increment_with<const D: usize>(
             }
             Err(failure) => return Err(failure),
         };
-        let f_ext = external_forces(model, &x, kind.loads())?;
+        let f_ext = external_forces(model, &x, &start.orientations, kind.loads())?;
         let net = &internal.force - &f_ext;
         let mut inertia = mass.component_mul(&a);
         if let IncrementKind::Dynamic { hht, .. } = kind

@@ -236,6 +236,10 @@ impl<const D: usize> From<Vec<PressureLoad>> for Loads<D> {
 pub struct DeadLoad {
     /// Forces (and moments) per equation at factor 1.
     pub force: DVector<f64>,
+    /// Moments at factor 1 (global frame) on bodies free to turn, `(body, M)`: their rotation
+    /// equations take the body-frame components `Q^T M`, which change as the body turns (see
+    /// [`crate::assembly::external_forces`]).
+    pub body_moments: Vec<(usize, Vector3<f64>)>,
     /// Time variation.
     pub variation: Variation,
 }
@@ -274,6 +278,7 @@ impl<const D: usize> ConcentratedLoad<D> {
             return invalid(format!("{what}: force and moment must be finite"));
         }
         let mut f = DVector::zeros(scene.dofs.len());
+        let mut body_moments = Vec::new();
         let mut add = |eqs: &[Option<usize>; D]| {
             for (eq, fi) in eqs.iter().zip(self.force.iter()) {
                 if let Some(eq) = eq {
@@ -302,16 +307,18 @@ impl<const D: usize> ConcentratedLoad<D> {
                 };
                 add(scene.dofs.body_translation(b));
                 let axis = match body.rotation {
-                    Rotation::Free { .. } if self.moment != Vector3::zeros() => {
-                        return invalid(format!(
-                            "{what}: a moment on rigid body '{}', which is free to turn, is not \
-                             supported (its body-frame components change as it turns); give it \
-                             one rotation axis or apply the moment as forces",
-                            body.name
-                        ));
+                    Rotation::Free { .. } => {
+                        if self.moment != Vector3::zeros() {
+                            body_moments.push((b, self.moment));
+                        }
+                        return Ok(DeadLoad {
+                            force: f,
+                            body_moments,
+                            variation: self.variation.clone(),
+                        });
                     }
                     Rotation::Axis(e) => Some(e),
-                    _ => None,
+                    Rotation::None => None,
                 };
                 let about_axis = axis.map_or(0.0, |e| self.moment.dot(&e));
                 let off_axis = match axis {
@@ -334,6 +341,7 @@ impl<const D: usize> ConcentratedLoad<D> {
         }
         Ok(DeadLoad {
             force: f,
+            body_moments,
             variation: self.variation.clone(),
         })
     }
@@ -384,6 +392,7 @@ impl<const D: usize> GravityLoad<D> {
         }
         Ok(DeadLoad {
             force: f,
+            body_moments: Vec::new(),
             variation: self.variation.clone(),
         })
     }

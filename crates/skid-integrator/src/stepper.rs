@@ -597,6 +597,7 @@ pub fn initial_state<const D: usize>(
     let f_ext = external_forces(
         model,
         &x,
+        &[],
         LoadInstant {
             ramp: load_factor,
             step_time: 0.0,
@@ -645,7 +646,7 @@ fn start_loads<const D: usize>(
         step: index,
         fraction: 0.0,
     };
-    let f_ext = external_forces(model, &state.x, instant)?;
+    let f_ext = external_forces(model, &state.x, &state.orientations, instant)?;
     if f_ext != state.external_force {
         state.net_force += &state.external_force - &f_ext;
         state.external_force = f_ext;

@@ -27,7 +27,8 @@ pub(super) fn check_element_sets(spec: &ModelSpec, elements: usize) -> Result<()
     Ok(())
 }
 
-/// A moment on `body`, which must lie along the body's free rotation axis (in 2D: z).
+/// A moment on `body`, which must lie along the body's free rotation axis (in 2D: z), or be any
+/// vector on a body free to turn.
 fn body_moment<const D: usize>(
     field: &str,
     moment: [f64; 3],
@@ -44,18 +45,12 @@ fn body_moment<const D: usize>(
                 format!("{dof:?} is not a degree of freedom in {D}D: expected 0 there"),
             );
         }
-        if let Rotation::Free { .. } = body.rotation {
-            return fail(
-                field,
-                format!(
-                    "rigid body '{}' is free to turn: a moment on it is not supported (its \
-                     body-frame components change as it turns); apply it as forces, or fix all \
-                     rotations but one",
-                    body.name
-                ),
-            );
-        }
-        if !matches!(body.rotation, Rotation::Axis(e) if e[axis] == 1.0) {
+        let turns = match body.rotation {
+            Rotation::Free { .. } => true,
+            Rotation::Axis(e) => e[axis] == 1.0,
+            Rotation::None => false,
+        };
+        if !turns {
             return fail(
                 field,
                 format!(
