@@ -541,7 +541,7 @@ mod tests {
     use super::*;
     use crate::loads::Loads;
     use crate::model::Tie;
-    use crate::test_support::{body, pad_block};
+    use crate::test_support::{body, central_difference, pad_block};
     use nalgebra::DMatrix;
     use skid_fem::rigid::Rotation;
     use skid_fem::solid::Tangent;
@@ -588,13 +588,9 @@ mod tests {
         let eps = 1e-7;
         let mut worst: f64 = 0.0;
         for j in 0..n {
-            let mut xp = x.clone();
-            let mut xm = x.clone();
-            xp[j] += eps;
-            xm[j] -= eps;
-            let fp = assembler.internal(&model, &xp, None).expect("f").force;
-            let fm = assembler.internal(&model, &xm, None).expect("f").force;
-            let column = (fp - fm) / (2.0 * eps);
+            let column = central_difference(&x, j, eps, |x| {
+                assembler.internal(&model, x, None).expect("f").force
+            });
             worst = worst.max((column - k.column(j)).amax());
         }
         assert!(

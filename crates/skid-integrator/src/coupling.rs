@@ -304,7 +304,7 @@ mod tests {
     use crate::error::LinearFailure;
     use crate::model::Model;
     use crate::orientation::Orientation;
-    use crate::test_support::{block_on_drum, coordinate_origins};
+    use crate::test_support::{block_on_drum, central_difference, coordinate_origins};
 
     /// Screening open candidates out of the conic solve gives the full problem's solution,
     /// including for a candidate that only closes because a neighbour's force pulls it in.
@@ -483,12 +483,7 @@ mod tests {
         let mut worst: f64 = 0.0;
         let mut worst_without: f64 = 0.0;
         for j in 0..n {
-            let mut xp = x.clone();
-            let mut xm = x.clone();
-            xp[j] += eps;
-            xm[j] -= eps;
-            let column =
-                (residual(&mut assembler, &xp) - residual(&mut assembler, &xm)) / (2.0 * eps);
+            let column = central_difference(&x, j, eps, |x| residual(&mut assembler, x));
             worst = worst.max((&column - k.column(j)).amax());
             worst_without = worst_without.max((&column - without.column(j)).amax());
         }
@@ -552,12 +547,7 @@ mod tests {
         let eps = 1e-7;
         let mut worst: f64 = 0.0;
         for j in 0..n {
-            let mut xp = x.clone();
-            let mut xm = x.clone();
-            xp[j] += eps;
-            xm[j] -= eps;
-            let mut column =
-                (residual(&mut assembler, &xp) - residual(&mut assembler, &xm)) / (2.0 * eps);
+            let mut column = central_difference(&x, j, eps, |x| residual(&mut assembler, x));
             if let Some(b) = rotations.iter().position(|&eq| eq == j) {
                 for (a, &eq) in rotations.iter().enumerate() {
                     column[eq] -= skew[(a, b)];

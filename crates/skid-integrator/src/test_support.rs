@@ -1,7 +1,7 @@
 //! Small scenes shared by the unit tests.
 
 use crate::model::Section;
-use nalgebra::{SVector, Vector2, Vector3};
+use nalgebra::{DVector, SVector, Vector2, Vector3};
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::{RigidBody, Rotation};
@@ -100,4 +100,19 @@ pub(crate) fn coordinate_origins<const D: usize>(model: &Model<D>) -> Vec<Surfac
     };
     let candidates = model.contacts().iter().map(|p| p.nodes.len()).sum();
     vec![origin; candidates]
+}
+
+/// The central difference of `f` along unknown `j` at `x`:
+/// `(f(x + eps e_j) - f(x - eps e_j)) / (2 eps)`, a column of its Jacobian.
+pub(crate) fn central_difference(
+    x: &DVector<f64>,
+    j: usize,
+    eps: f64,
+    mut f: impl FnMut(&DVector<f64>) -> DVector<f64>,
+) -> DVector<f64> {
+    let mut plus = x.clone();
+    let mut minus = x.clone();
+    plus[j] += eps;
+    minus[j] -= eps;
+    (f(&plus) - f(&minus)) / (2.0 * eps)
 }
