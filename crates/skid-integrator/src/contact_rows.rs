@@ -201,10 +201,10 @@ impl ContactRows {
 }
 
 /// Evaluates the contact rows of all pairs at displacement `x`, with the orientations of bodies
-/// free to turn from the records `orientations` (see [`crate::orientation`]). `previous` holds the closest
-/// points at the start of the increment, where the slips start (one per candidate, pair by
-/// pair; `None`: each node's own closest point, zero slips); `held` marks
-/// equations whose increment is zero in this step (their columns are dropped).
+/// free to turn from the records `orientations` (see [`crate::orientation`]). `previous` holds
+/// the closest points at the start of the increment, where the slips start (one per candidate,
+/// pair by pair; `None`: each node's own closest point, zero slips); `held` marks equations
+/// whose increment is zero in this step (their columns are dropped).
 ///
 /// `start` is the displacement at the start of a dynamic increment (`None` for rows at the
 /// start itself and for static equilibrium, which needs the normal at the solution). Against a

@@ -21,9 +21,9 @@
 //! Dynamic residual (HHT): `R = M a + (1 + alpha) (F(x) + G(v)) - alpha (F_n + G(v_n))`, with
 //! the gyroscopic moments `G = W x J W` of bodies free to turn (see [`crate::orientation`]),
 //! weighted as the forces are to keep the scheme of second order; tangent
-//! `M/(beta h^2) + (1 + alpha) K_T`, without `dG/dx` (about `gamma h |W|` of the inertia term, so
-//! Newton converges linearly at that rate on such bodies' equations). Static residual: `R = F(x)` with `F = f_int - lambda f_ext`;
-//! tangent `K_T + M/h_s^2`. The mass term of the static tangent only regularises the Newton
+//! `M/(beta h^2) + (1 + alpha) K_T`, without `dG/dx` (about `gamma h |W|` of the inertia term,
+//! so Newton converges linearly at that rate on such bodies' equations). Static residual:
+//! `R = F(x)` with `F = f_int - lambda f_ext`; tangent `K_T + M/h_s^2`. The mass term of the static tangent only regularises the Newton
 //! step (it keeps a pad that is not yet held by contact from being singular); it is not in the
 //! residual, so the converged state is exactly static. Where the tangent without contact is
 //! indefinite, the mass term of either matrix grows tenfold at a time until it can be factorized
