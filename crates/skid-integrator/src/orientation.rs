@@ -106,3 +106,64 @@ pub fn gyroscopic_moments<const D: usize>(
     }
     moments
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::SVector;
+
+    fn spinning_body() -> (DofMap<3>, Vec<RigidBody<3>>) {
+        let body = RigidBody::<3> {
+            name: "top".into(),
+            reference_point: SVector::zeros(),
+            mass: 1.0,
+            rotary_inertia: 0.0,
+            free_translations: [true, false, false],
+            rotation: Rotation::Free {
+                principal_inertia: Vector3::new(1.0, 2.0, 2.5),
+                initial_angular_velocity: Vector3::zeros(),
+            },
+            initial_velocity: SVector::zeros(),
+            initial_angular_velocity: 0.0,
+        };
+        (
+            DofMap::new(0, &[], &[], &[[true, false, false]], &[3]),
+            vec![body],
+        )
+    }
+
+    /// A record keeps the orientation where it was made, and later turns compose on it as
+    /// material increments: recording after each of two turns gives `exp(a) exp(b)`, not
+    /// `exp(a + b)`.
+    #[test]
+    fn records_compose_material_increments() {
+        let (dofs, bodies) = spinning_body();
+        let (a, b) = (Vector3::new(0.3, -0.2, 0.5), Vector3::new(-0.1, 0.4, 0.2));
+        let x = |r: Vector3<f64>| DVector::from_vec(vec![0.7, r.x, r.y, r.z]);
+        let first = record(&dofs, &bodies, &[], &x(a));
+        assert_eq!(first[0].at, [a.x, a.y, a.z]);
+        let expected = UnitQuaternion::from_scaled_axis(a);
+        assert!(orientation(&dofs, &first, &x(a), 0).angle_to(&expected) < 1e-15);
+        let second = orientation(&dofs, &first, &x(a + b), 0);
+        let composed = expected * UnitQuaternion::from_scaled_axis(b);
+        assert!(second.angle_to(&composed) < 1e-15);
+        assert!(second.angle_to(&UnitQuaternion::from_scaled_axis(a + b)) > 1e-3);
+        // without a record the body starts at the world orientation with x_r = 0
+        assert!(orientation(&dofs, &[], &x(a), 0).angle_to(&expected) < 1e-15);
+    }
+
+    /// The gyroscopic moment `W x J W` does no work and vanishes about a principal axis.
+    #[test]
+    fn gyroscopic_moments_are_euler_s() {
+        let (dofs, bodies) = spinning_body();
+        let w = Vector3::new(1.0, -2.0, 3.0);
+        let v = DVector::from_vec(vec![5.0, w.x, w.y, w.z]);
+        let g = gyroscopic_moments(&dofs, &bodies, &v).expect("a free body");
+        let expected = w.cross(&Vector3::new(1.0, 2.0, 2.5).component_mul(&w));
+        assert_eq!(g.as_slice(), &[0.0, expected.x, expected.y, expected.z]);
+        assert!(expected.dot(&w).abs() < 1e-14);
+        let about_z = DVector::from_vec(vec![5.0, 0.0, 0.0, 3.0]);
+        let g = gyroscopic_moments(&dofs, &bodies, &about_z).expect("a free body");
+        assert_eq!(g.amax(), 0.0);
+    }
+}
