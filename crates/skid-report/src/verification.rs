@@ -17,11 +17,14 @@
 //!   slide bracket its threshold; a block moved over a fixed flat by prescribed motions makes
 //!   its reactions balance the friction;
 //! - a torque-free rigid body ([`free_rotation`]): its angular momentum and kinetic energy are
-//!   constant, and a symmetric top precesses as Euler's equations say.
+//!   constant, and a symmetric top precesses as Euler's equations say;
+//! - a ball launched onto a deformable block ([`rolling`]): it slides, then rolls at the speed
+//!   and from the time Coulomb friction and its inertia give.
 
 pub mod coulomb;
 pub mod free_rotation;
 mod reactions;
+pub mod rolling;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -33,6 +36,7 @@ use super::hertz::{self, HertzMeasure, HertzScene};
 use super::plot::{HERTZ_SVG, plot_hertz_pressure};
 use super::{ReportError, read};
 use free_rotation::FreeBody;
+use rolling::RollingBall;
 use skid_cases::model_file::contact_nodes::CONTACT_NODES_CSV;
 use skid_cases::model_spec::ModelSpec;
 use skid_cases::runner::MODEL_JSON;
@@ -173,9 +177,12 @@ pub fn section(
     let mut hertz_runs = Vec::new();
     let mut coulomb_runs = Vec::new();
     let mut free_runs = Vec::new();
+    let mut ball_runs = Vec::new();
     for run in runs {
         if let Some(scene) = HertzScene::recognise(&run.spec) {
             hertz_runs.push((run, scene));
+        } else if let Some(ball) = RollingBall::recognise(&run.spec) {
+            ball_runs.push((run, ball));
         } else if run.spec.contact.iter().any(|p| p.mu > 0.0) {
             coulomb_runs.push(run);
         } else if let Some(body) = FreeBody::recognise(&run.spec) {
@@ -194,6 +201,9 @@ pub fn section(
     }
     if !free_runs.is_empty() {
         out.push_str(&free_rotation::section(&free_runs, &mut checks)?);
+    }
+    if !ball_runs.is_empty() {
+        out.push_str(&rolling::section(&ball_runs, &mut checks)?);
     }
     for name in unchecked {
         checks.skip(

@@ -356,7 +356,7 @@ fn bracket_check(out: &mut String, checks: &mut Checks, members: &[(&str, HeldSt
 }
 
 /// The rows of `pair` in a model run's `history.csv` text of dimension `dimension`.
-fn friction_rows(
+pub(super) fn friction_rows(
     text: &str,
     path: &Path,
     pair: &str,
