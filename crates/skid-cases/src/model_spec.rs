@@ -205,12 +205,18 @@ pub struct RigidBodySpec {
     /// Rotary inertia about the free rotation axis of a body turning about one axis, kg m^2.
     #[serde(default)]
     pub rotary_inertia: f64,
-    /// Principal moments of inertia `[Jx, Jy, Jz]` about the global axes through the reference
-    /// node, which are the body's principal axes at the start, kg m^2. A body free to turn about
-    /// all three axes needs them; a body turning about one axis may take its moment from here
-    /// instead of `rotary_inertia` (give one or the other).
+    /// Moments of inertia `[Ixx, Iyy, Izz]` about the global axes through the reference node
+    /// at the start, kg m^2. A body free to turn about all three axes needs them; a body
+    /// turning about one axis may take its moment from here instead of `rotary_inertia` (give
+    /// one or the other).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub principal_inertia: Option<[f64; 3]>,
+    pub moments_of_inertia: Option<[f64; 3]>,
+    /// Products of inertia `[Ixy, Ixz, Iyz]`, the off-diagonal components of the inertia tensor
+    /// about the reference node at the start (`Ixy = -integral x y dm`), kg m^2 (absent: 0,
+    /// the global axes are principal axes); only with `moments_of_inertia`. A body free to
+    /// turn turns about its principal axes, the tensor's eigenvectors.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub products_of_inertia: Option<[f64; 3]>,
     /// Contact surface, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub surface: Option<RigidSurfaceSpec>,

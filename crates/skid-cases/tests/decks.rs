@@ -873,18 +873,25 @@ fn automatic_static_incrementation_reads_with_the_keyword_defaults() {
 }
 
 /// A rigid body with no boundary condition on its rotations turns freely about all three axes,
-/// with the principal moments of its `*ROTARY INERTIA`; products of inertia are refused there.
+/// with the moments and products of its `*ROTARY INERTIA`: about its principal axes, the
+/// tensor's eigenvectors.
 #[test]
 fn a_body_without_rotation_boundaries_turns_freely() {
     let deck = std::fs::read_to_string(repo("cases/inp/3d-analytic.inp")).expect("deck");
-    let free = deck.replacen("drum, 4, 4\ndrum, 5, 5\n", "", 1).replacen(
+    let unheld = deck.replacen("drum, 4, 4\ndrum, 5, 5\n", "", 1).replacen(
         "0.175, 0.175, 0.175",
         "0.1, 0.1, 0.175",
         1,
     );
+    // the preload holds the drum's spin alone: for a body free to turn, all or none
+    let read = read_text(&unheld).expect("deck reads");
+    let error = skid_cases::model_file::build::<3>(&read.model).expect_err("a partial hold");
+    assert_eq!(error.field, "steps[0].boundary[0].dofs");
+    let free = unheld.replacen("*BOUNDARY\ndrum, 6, 6\n", "*BOUNDARY\ndrum, 4, 6\n", 1);
     let read = read_text(&free).expect("deck reads");
     let drum = &read.model.rigid_bodies[0];
-    assert_eq!(drum.principal_inertia, Some([0.1, 0.1, 0.175]));
+    assert_eq!(drum.moments_of_inertia, Some([0.1, 0.1, 0.175]));
+    assert_eq!(drum.products_of_inertia, None);
     assert_eq!(drum.rotary_inertia, 0.0);
     let scene = skid_cases::model_file::build::<3>(&read.model).expect("model builds");
     let body = &scene.model.bodies()[0];
@@ -892,27 +899,42 @@ fn a_body_without_rotation_boundaries_turns_freely() {
         body.rotation,
         skid_fem::rigid::Rotation::Free {
             principal_inertia: nalgebra::Vector3::new(0.1, 0.1, 0.175),
+            principal_axes: nalgebra::Rotation3::identity(),
             initial_angular_velocity: nalgebra::Vector3::new(0.0, 0.0, 60.0),
         }
     );
     assert_eq!(scene.model.dofs().body_rotations(0).len(), 3);
-    let tilted = free.replacen("0.1, 0.1, 0.175", "0.1, 0.1, 0.175, 0.01", 1);
-    let error = read_text(&tilted).expect_err("products of inertia");
-    // at the *RIGID BODY line
-    let line = tilted
-        .lines()
-        .position(|l| l.starts_with("*RIGID BODY"))
-        .expect("a rigid body")
-        + 1;
-    assert!(
-        error.contains("products of inertia") && error.contains(&format!("scene.inp:{line}:")),
-        "{error}"
+    // with a product I12 the principal axes turn about z
+    let tilted = free.replacen("0.1, 0.1, 0.175", "0.1, 0.1, 0.175, 0.02", 1);
+    let read = read_text(&tilted).expect("deck reads");
+    assert_eq!(
+        read.model.rigid_bodies[0].products_of_inertia,
+        Some([0.02, 0.0, 0.0])
     );
+    let scene = skid_cases::model_file::build::<3>(&read.model).expect("model builds");
+    let skid_fem::rigid::Rotation::Free {
+        principal_inertia,
+        principal_axes,
+        ..
+    } = scene.model.bodies()[0].rotation
+    else {
+        panic!("a body free to turn");
+    };
+    let tensor = nalgebra::Matrix3::new(0.1, 0.02, 0.0, 0.02, 0.1, 0.0, 0.0, 0.0, 0.175);
+    let p = principal_axes.matrix();
+    assert!(
+        (p * nalgebra::Matrix3::from_diagonal(&principal_inertia) * p.transpose() - tensor).amax()
+            < 1e-15
+    );
+    let mut moments: Vec<f64> = principal_inertia.iter().copied().collect();
+    moments.sort_by(f64::total_cmp);
+    assert!((moments[0] - 0.08).abs() < 1e-15 && (moments[1] - 0.12).abs() < 1e-15);
 }
 
 /// The rolling ball's model file written as a deck (`skid convert`) reads back as a body free
 /// to turn (no `*BOUNDARY` on its rotations, `*ROTARY INERTIA` of its principal moments) and
-/// runs to the model file's history, column for column, over the first 5 ms of its slide.
+/// runs to the model file's history, column for column, over the first 5 ms of its slide; its
+/// press, which holds the ball's rotations, leaves it unturned.
 #[test]
 fn the_rolling_ball_written_as_a_deck_runs_as_its_model_file() {
     let scratch = tempfile::tempdir().expect("tempdir");
@@ -924,7 +946,7 @@ fn the_rolling_ball_written_as_a_deck_runs_as_its_model_file() {
         .expect("the deck subset expresses the scene");
     let read = read_text(&deck).expect("deck reads");
     let ball = &read.model.rigid_bodies[0];
-    assert_eq!(ball.principal_inertia, Some([0.001; 3]));
+    assert_eq!(ball.moments_of_inertia, Some([0.001; 3]));
     let (deck_dir, file_dir) = (scratch.path().join("deck"), scratch.path().join("file"));
     for (model, dir) in [(&read.model, &deck_dir), (&spec, &file_dir)] {
         let summary = run_model(model, Path::new("ball"), dir).expect("run");
@@ -936,4 +958,12 @@ fn the_rolling_ball_written_as_a_deck_runs_as_its_model_file() {
     assert!(file_header.iter().any(|c| c == "ball.omega_z"));
     assert!(file_rows.len() > 20, "{} rows", file_rows.len());
     assert_eq!(deck_rows, file_rows);
+    // the press holds the ball's rotations, all three: it does not turn before it is launched
+    let column = |name: &str| file_header.iter().position(|c| c == name).expect(name);
+    let (step, turn) = (column("step"), column("ball.rotation_z"));
+    let pressed: Vec<&Vec<String>> = file_rows.iter().filter(|r| r[step] == "press").collect();
+    assert_eq!(pressed.len(), 4);
+    for row in pressed {
+        assert_eq!(row[turn].parse::<f64>().expect("a number"), 0.0);
+    }
 }

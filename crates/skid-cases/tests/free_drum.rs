@@ -51,7 +51,7 @@ fn drum_spin(spec: &ModelSpec) -> Vec<(f64, Vector3<f64>)> {
             let spin = match dofs.body_rotations(0) {
                 &[about_z] => Vector3::new(0.0, 0.0, s.v[about_z]),
                 &[e0, e1, e2] => {
-                    orientation(dofs, &s.orientations, &s.x, 0)
+                    orientation(dofs, model.bodies(), &s.orientations, &s.x, 0)
                         * Vector3::new(s.v[e0], s.v[e1], s.v[e2])
                 }
                 other => panic!("drum rotations {other:?}"),
@@ -81,7 +81,7 @@ fn drums(solve: ContactSolveSpec) -> (f64, ModelSpec, ModelSpec) {
     assert_eq!(drum, free.rigid_bodies[0].name);
     free.boundary[0].dofs = vec![Dof::X, Dof::Y, Dof::Z];
     free.rigid_bodies[0].rotary_inertia = 0.0;
-    free.rigid_bodies[0].principal_inertia = Some([0.1, 0.1, case.drum.rotary_inertia]);
+    free.rigid_bodies[0].moments_of_inertia = Some([0.1, 0.1, case.drum.rotary_inertia]);
     (case.drum.omega0, fixed, free)
 }
 

@@ -381,7 +381,7 @@ fn every_model_error_names_its_field() {
     )
     .expect("json");
     type Edit = fn(&mut Value);
-    let cases: [(&Value, Edit, &str, &str); 21] = [
+    let cases: [(&Value, Edit, &str, &str); 24] = [
         (
             &base,
             |v| v["skid_model"] = json!(2),
@@ -457,25 +457,54 @@ fn every_model_error_names_its_field() {
         (
             &base3,
             |v| v["boundary"][1]["dofs"] = json!(["x", "z"]),
-            "rigid_bodies[1].principal_inertia",
-            "expected its principal moments of inertia",
+            "rigid_bodies[1].moments_of_inertia",
+            "expected its moments of inertia",
         ),
         (
             &base3,
             |v| {
                 v["boundary"][1]["dofs"] = json!(["x", "z"]);
-                v["rigid_bodies"][1]["principal_inertia"] = json!([0.1, 0.1, -0.2]);
+                v["rigid_bodies"][1]["moments_of_inertia"] = json!([0.1, 0.1, -0.2]);
             },
-            "rigid_bodies[1].principal_inertia",
+            "rigid_bodies[1].moments_of_inertia",
             "expected moments >= 0",
         ),
         (
             &base3,
             |v| {
-                v["rigid_bodies"][1]["rotary_inertia"] = json!(0.1);
-                v["rigid_bodies"][1]["principal_inertia"] = json!([0.1, 0.1, 0.1]);
+                v["boundary"][1]["dofs"] = json!(["x", "z"]);
+                v["rigid_bodies"][1]["products_of_inertia"] = json!([0.01, 0.0, 0.0]);
             },
-            "rigid_bodies[1].principal_inertia",
+            "rigid_bodies[1].products_of_inertia",
+            "expected moments_of_inertia beside the products",
+        ),
+        (
+            &base3,
+            |v| {
+                v["boundary"][1]["dofs"] = json!(["x", "z"]);
+                v["rigid_bodies"][1]["moments_of_inertia"] = json!([0.1, 0.1, 0.1]);
+                v["rigid_bodies"][1]["products_of_inertia"] = json!([0.2, 0.0, 0.0]);
+            },
+            "rigid_bodies[1].products_of_inertia",
+            "not positive semi-definite",
+        ),
+        (
+            &base3,
+            |v| {
+                v["boundary"][1]["dofs"] = json!(["x", "z"]);
+                v["rigid_bodies"][1]["moments_of_inertia"] = json!([0.1, 0.1, 0.1]);
+                v["steps"][0]["boundary"] = json!([{"body": "plate", "dofs": ["y", "rz"]}]);
+            },
+            "steps[0].boundary[0].dofs",
+            "holds all its rotations (rx, ry, rz) or none",
+        ),
+        (
+            &base3,
+            |v| {
+                v["rigid_bodies"][1]["rotary_inertia"] = json!(0.1);
+                v["rigid_bodies"][1]["moments_of_inertia"] = json!([0.1, 0.1, 0.1]);
+            },
+            "rigid_bodies[1].moments_of_inertia",
             "not both",
         ),
         (

@@ -25,8 +25,10 @@ pub enum Turning {
     /// About one fixed unit axis `e` (world frame, which is also its body frame direction):
     /// one unknown, the angle.
     About(Unit<Vector3<f64>>),
-    /// Freely: three unknowns, the material increments about the body's own x, y and z axes.
-    Free,
+    /// Freely: three unknowns, the material increments about the body's own axes, whose
+    /// directions in the body frame are the columns of `P` (the identity for a body whose own
+    /// axes are its frame's).
+    Free(Rotation3<f64>),
 }
 
 /// Placement of a rigid body: reference point, orientation and rotation unknowns.
@@ -54,12 +56,18 @@ impl RotatingFrame {
         }
     }
 
-    /// The frame of a body free to turn, at `orientation` with its reference point at `center`.
-    pub fn free(center: Vector3<f64>, orientation: &UnitQuaternion<f64>) -> Self {
+    /// The frame of a body free to turn with its reference point at `center`, whose own axes
+    /// are at `orientation` `R` and were at `axes` `P` when the body frame was the world's: the
+    /// frame's orientation is `Q = R P^T`, and the unknowns turn about `P`'s columns.
+    pub fn free(
+        center: Vector3<f64>,
+        orientation: &UnitQuaternion<f64>,
+        axes: &Rotation3<f64>,
+    ) -> Self {
         Self {
             center,
-            orientation: orientation.to_rotation_matrix(),
-            turning: Turning::Free,
+            orientation: orientation.to_rotation_matrix() * axes.inverse(),
+            turning: Turning::Free(*axes),
         }
     }
 
@@ -67,7 +75,7 @@ impl RotatingFrame {
     pub fn rotations(&self) -> usize {
         match self.turning {
             Turning::About(_) => 1,
-            Turning::Free => 3,
+            Turning::Free(_) => 3,
         }
     }
 
@@ -75,7 +83,7 @@ impl RotatingFrame {
     pub fn rotation_axis(&self, i: usize) -> Vector3<f64> {
         match self.turning {
             Turning::About(axis) => axis.into_inner(),
-            Turning::Free => Vector3::ith(i, 1.0),
+            Turning::Free(axes) => axes.matrix().column(i).into_owned(),
         }
     }
 
@@ -84,7 +92,7 @@ impl RotatingFrame {
     pub fn is_finite(&self) -> bool {
         let axis_finite = match self.turning {
             Turning::About(axis) => axis.iter().all(|c| c.is_finite()),
-            Turning::Free => true,
+            Turning::Free(axes) => axes.matrix().iter().all(|c| c.is_finite()),
         };
         axis_finite
             && self.center.iter().all(|c| c.is_finite())
@@ -285,7 +293,7 @@ pub fn rotation_column(
 ) -> Option<[f64; 3]> {
     let turn = start.turn;
     if !(turn.abs() >= MIN_SECANT_TURN && turn.is_finite())
-        || frame.turning == Turning::Free
+        || matches!(frame.turning, Turning::Free(_))
         || !frame.is_finite()
     {
         return None;
@@ -502,16 +510,23 @@ mod tests {
             Vector3::new(1.1, 0.7, 0.4),
         ];
         let center = Vector3::new(0.9, 0.5, 0.3);
-        for turn in [
-            Vector3::zeros(),
-            Vector3::new(0.3, -1.2, 0.4),
-            Vector3::new(-2.0, 0.1, 1.5),
+        // the body's own axes along the frame's, and tilted
+        for axes in [
+            Rotation3::identity(),
+            Rotation3::from_scaled_axis(Vector3::new(0.4, 0.2, -0.7)),
         ] {
-            let frame = RotatingFrame::free(center, &UnitQuaternion::from_scaled_axis(turn));
-            assert_eq!(frame.rotations(), 3);
-            for x in &points {
-                check_derivatives(&cylinder, &frame, x)?;
-                check_derivatives(&facets, &frame, &(center + (x - center) * 0.21 / 0.2))?;
+            for turn in [
+                Vector3::zeros(),
+                Vector3::new(0.3, -1.2, 0.4),
+                Vector3::new(-2.0, 0.1, 1.5),
+            ] {
+                let own = UnitQuaternion::from_scaled_axis(turn);
+                let frame = RotatingFrame::free(center, &own, &axes);
+                assert_eq!(frame.rotations(), 3);
+                for x in &points {
+                    check_derivatives(&cylinder, &frame, x)?;
+                    check_derivatives(&facets, &frame, &(center + (x - center) * 0.21 / 0.2))?;
+                }
             }
         }
         // about a fixed axis the free body's derivative along that axis is the angle's
@@ -519,6 +534,7 @@ mod tests {
         let free = RotatingFrame::free(
             center,
             &UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), 0.7),
+            &Rotation3::identity(),
         );
         let (a, b) = (
             eval(&cylinder, &fixed, &points[0])?,
@@ -604,6 +620,7 @@ mod tests {
         let free = RotatingFrame::free(
             c0,
             &UnitQuaternion::from_axis_angle(&Vector3::z_axis(), theta0 + 1e-6),
+            &Rotation3::identity(),
         );
         assert!(rotation_column(&drum, &free, &begin, &r0, &still).is_none());
         Ok(())

@@ -7,15 +7,14 @@
 //! radial translation free.
 //!
 //! About a single fixed axis the rotation is additive (`Q(theta) = exp(theta [e]x)`), so its
-//! equation of motion is the scalar `I theta'' = M_e`. A body free to turn has principal axes
-//! along the global axes at the start and rotates by material increments,
-//! `Q <- Q exp([delta]x)`; its equations are Euler's, `J W' + W x J W = M` in the body frame
-//! (see the integrator's dynamics).
+//! equation of motion is the scalar `I theta'' = M_e`. A body free to turn rotates about its
+//! principal axes of inertia by material increments, `Q <- Q exp([delta]x)`; its equations are
+//! Euler's, `J W' + W x J W = M` in those axes (see the integrator's dynamics).
 //!
 //! Nodes tied to a body follow its translations only (see the integrator's DOF map), which is
 //! exact for bodies without a free rotation such as the back plate.
 
-use nalgebra::{SVector, Vector3};
+use nalgebra::{Rotation3, SVector, Vector3};
 
 /// How a rigid body may rotate.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -25,12 +24,16 @@ pub enum Rotation {
     /// About one fixed unit axis through the reference node (world frame; `+z` in 2D), with
     /// the body's `rotary_inertia` about it.
     Axis(Vector3<f64>),
-    /// About all three axes (3D only), with principal moments of inertia about the body's axes,
-    /// which are the global x, y and z axes at the start, kg m^2.
+    /// About all three axes (3D only). The body's axes are its principal axes of inertia:
+    /// `principal_axes` `P` holds their global directions at the start as columns, so that the
+    /// inertia tensor about the reference node is `P diag(J) P^T` then; the body's surfaces
+    /// are given in the global orientation at the start, as every body's are.
     Free {
-        /// `(J_1, J_2, J_3)`.
+        /// Principal moments of inertia `(J_1, J_2, J_3)` about the principal axes, kg m^2.
         principal_inertia: Vector3<f64>,
-        /// Initial angular velocity, rad/s (the body and global axes coincide at the start).
+        /// `P`: the principal axes at the start (columns, global frame).
+        principal_axes: Rotation3<f64>,
+        /// Initial angular velocity (global frame), rad/s.
         initial_angular_velocity: Vector3<f64>,
     },
 }
@@ -112,6 +115,7 @@ impl<const D: usize> RigidBody<D> {
             }
             Rotation::Free {
                 principal_inertia,
+                principal_axes,
                 initial_angular_velocity,
             } => {
                 if D == 2 {
@@ -133,6 +137,13 @@ impl<const D: usize> RigidBody<D> {
                          other two (no mass distribution has them)",
                         principal_inertia.as_slice()
                     ));
+                }
+                let p = principal_axes.matrix();
+                if !p.iter().all(|v| v.is_finite())
+                    || (p.transpose() * p - nalgebra::Matrix3::identity()).amax() > 1e-9
+                    || p.determinant() <= 0.0
+                {
+                    return fail(format!("principal axes must be a rotation, got {p}"));
                 }
                 if !initial_angular_velocity.iter().all(|w| w.is_finite()) {
                     return fail("initial angular velocity must be finite".into());
@@ -185,6 +196,7 @@ mod tests {
         d.initial_angular_velocity = 0.0;
         d.rotation = Rotation::Free {
             principal_inertia: Vector3::repeat(0.1),
+            principal_axes: Rotation3::identity(),
             initial_angular_velocity: Vector3::zeros(),
         };
         assert!(d.validate().is_err(), "free rotation in 2D");
@@ -200,6 +212,7 @@ mod tests {
             free_translations: [true; 3],
             rotation: Rotation::Free {
                 principal_inertia,
+                principal_axes: Rotation3::identity(),
                 initial_angular_velocity: Vector3::new(0.0, 1.0, 30.0),
             },
             initial_velocity: SVector::<f64, 3>::zeros(),

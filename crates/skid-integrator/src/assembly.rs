@@ -526,7 +526,7 @@ pub fn external_forces<const D: usize>(
         let factor = instant.factor(&load.variation);
         f.axpy(factor, &load.force, 1.0);
         for &(body, moment) in &load.body_moments {
-            let q = orientation(model.dofs(), orientations, x, body);
+            let q = orientation(model.dofs(), model.bodies(), orientations, x, body);
             let local = q.inverse_transform_vector(&moment) * factor;
             for (&eq, m) in model.dofs().body_rotations(body).iter().zip(local.iter()) {
                 f[eq] += m;

@@ -596,9 +596,10 @@ impl<const D: usize> Model<D> {
         let b = &self.bodies[body];
         let center = embed(&(b.reference_point + self.dofs.body_displacement(x, body)));
         match b.rotation {
-            Rotation::Free { .. } => RotatingFrame::free(
+            Rotation::Free { principal_axes, .. } => RotatingFrame::free(
                 center,
-                &orientation::orientation(&self.dofs, orientations, x, body),
+                &orientation::orientation(&self.dofs, &self.bodies, orientations, x, body),
+                &principal_axes,
             ),
             Rotation::Axis(axis) => {
                 RotatingFrame::about(center, axis, self.dofs.body_angle(x, body))
@@ -645,11 +646,13 @@ impl<const D: usize> Model<D> {
                     v[*eq] = body.initial_velocity[i];
                 }
             }
+            // a body free to turn: in its principal axes
             let w = match body.rotation {
                 Rotation::Free {
                     initial_angular_velocity,
+                    principal_axes,
                     ..
-                } => initial_angular_velocity,
+                } => principal_axes.inverse() * initial_angular_velocity,
                 _ => Vector3::repeat(body.initial_angular_velocity),
             };
             for (i, &eq) in self.dofs.body_rotations(b).iter().enumerate() {

@@ -16,7 +16,8 @@ use crate::loads::{LoadInstant, Variation};
 pub enum BodyMotion {
     /// Translation along global axis `i`.
     Translation(usize),
-    /// The rotation about the body's free axis.
+    /// The rotation about the body's free axis. Held in a step (see
+    /// [`crate::stepper::HeldMotion`]), the rotations of a body free to turn: all three.
     Rotation,
 }
 

@@ -5,11 +5,12 @@
 //! the unknowns there, `(Q_n, x_r,n)`, and at any later iterate
 //! `Q = Q_n exp([x_r - x_r,n]x)`: the increment's turn `Theta = x_r - x_r,n` is a rotation
 //! vector in the body frame. The Newmark relations then hold for `Theta`, the body-frame angular
-//! velocity `W` and acceleration `W'` (the material form of Simo and Vu-Quoc), and with the
-//! principal axes as body axes the mass stays the diagonal `J`; Euler's equations add the
+//! velocity `W` and acceleration `W'` (the material form of Simo and Vu-Quoc), and with its
+//! principal axes as the unknowns' axes the mass stays the diagonal `J`; Euler's equations add the
 //! gyroscopic moment `W x J W` (see [`gyroscopic_moments`]).
 //!
-//! A body never recorded (the start of a run) is at the world orientation with `x_r = 0`.
+//! A body never recorded (the start of a run) has its principal axes at their initial
+//! directions `P` with `x_r = 0`.
 
 use nalgebra::{DVector, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
@@ -41,10 +42,12 @@ fn rotation_unknowns<const D: usize>(
     r
 }
 
-/// The orientation of the body free to turn `body` at `x`, from the records `recorded`:
-/// `Q_n exp([x_r - x_r,n]x)`.
+/// The orientation of the principal axes of the body free to turn `body` at `x`, from the
+/// records `recorded`: `Q_n exp([x_r - x_r,n]x)`, or `P exp([x_r]x)` for a body never
+/// recorded, `P` its principal axes at the start.
 pub fn orientation<const D: usize>(
     dofs: &DofMap<D>,
+    bodies: &[RigidBody<D>],
     recorded: &[Orientation],
     x: &DVector<f64>,
     body: usize,
@@ -56,7 +59,15 @@ pub fn orientation<const D: usize>(
             let q = UnitQuaternion::new_normalize(nalgebra::Quaternion::new(w, i, j, k));
             q * UnitQuaternion::from_scaled_axis(r - Vector3::from(o.at))
         }
-        None => UnitQuaternion::from_scaled_axis(r),
+        None => {
+            let start = match bodies.get(body).map(|b| b.rotation) {
+                Some(Rotation::Free { principal_axes, .. }) => {
+                    UnitQuaternion::from_rotation_matrix(&principal_axes)
+                }
+                _ => UnitQuaternion::identity(),
+            };
+            start * UnitQuaternion::from_scaled_axis(r)
+        }
     }
 }
 
@@ -71,7 +82,7 @@ pub fn record<const D: usize>(
     (0..bodies.len())
         .filter(|&b| matches!(bodies[b].rotation, Rotation::Free { .. }))
         .map(|body| {
-            let q = orientation(dofs, recorded, x, body);
+            let q = orientation(dofs, bodies, recorded, x, body);
             Orientation {
                 body,
                 quaternion: [q.w, q.i, q.j, q.k],
@@ -121,6 +132,7 @@ mod tests {
             free_translations: [true, false, false],
             rotation: Rotation::Free {
                 principal_inertia: Vector3::new(1.0, 2.0, 2.5),
+                principal_axes: nalgebra::Rotation3::identity(),
                 initial_angular_velocity: Vector3::zeros(),
             },
             initial_velocity: SVector::zeros(),
@@ -143,13 +155,13 @@ mod tests {
         let first = record(&dofs, &bodies, &[], &x(a));
         assert_eq!(first[0].at, [a.x, a.y, a.z]);
         let expected = UnitQuaternion::from_scaled_axis(a);
-        assert!(orientation(&dofs, &first, &x(a), 0).angle_to(&expected) < 1e-15);
-        let second = orientation(&dofs, &first, &x(a + b), 0);
+        assert!(orientation(&dofs, &bodies, &first, &x(a), 0).angle_to(&expected) < 1e-15);
+        let second = orientation(&dofs, &bodies, &first, &x(a + b), 0);
         let composed = expected * UnitQuaternion::from_scaled_axis(b);
         assert!(second.angle_to(&composed) < 1e-15);
         assert!(second.angle_to(&UnitQuaternion::from_scaled_axis(a + b)) > 1e-3);
         // without a record the body starts at the world orientation with x_r = 0
-        assert!(orientation(&dofs, &[], &x(a), 0).angle_to(&expected) < 1e-15);
+        assert!(orientation(&dofs, &bodies, &[], &x(a), 0).angle_to(&expected) < 1e-15);
     }
 
     /// The gyroscopic moment `W x J W` does no work and vanishes about a principal axis.

@@ -294,6 +294,12 @@ impl HeldMotion {
     fn equations<const D: usize>(&self, model: &Model<D>) -> Vec<usize> {
         match *self {
             Self::Body { body, motion: None } => model.dofs().body_equations(body),
+            // the angle of a body turning about one axis, or all the rotations of a body free
+            // to turn (see `BodyMotion::Rotation`)
+            Self::Body {
+                body,
+                motion: Some(BodyMotion::Rotation),
+            } => model.dofs().body_rotations(body).to_vec(),
             Self::Body {
                 body,
                 motion: Some(motion),

@@ -68,6 +68,7 @@ pub(crate) fn block_on_drum<const D: usize>() -> Model<D> {
 pub(crate) fn block_on_free_drum() -> Model<3> {
     block_on_turning_drum(Rotation::Free {
         principal_inertia: Vector3::new(0.1, 0.1, 0.175),
+        principal_axes: nalgebra::Rotation3::identity(),
         initial_angular_velocity: Vector3::zeros(),
     })
 }

@@ -5,7 +5,7 @@
 //! The kinetic energy and the spatial angular momentum `Q J W` are constant. The solid of the
 //! model is one element held fixed, away from the body.
 
-use nalgebra::{SVector, Vector3};
+use nalgebra::{Rotation3, SVector, Vector3};
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::{RigidBody, Rotation};
@@ -35,11 +35,12 @@ impl<const D: usize> Observer<D> for Record {
 
 /// One fixed hexahedron of the pad material and the top.
 fn top() -> Model<3> {
-    top_with(Loads::default())
+    top_with(Loads::default(), Rotation3::identity())
 }
 
-/// [`top`] with `loads`.
-fn top_with(loads: Loads<3>) -> Model<3> {
+/// [`top`] with `loads`, its principal axes at `axes` at the start (columns) and its initial
+/// angular velocity turned alike.
+fn top_with(loads: Loads<3>, axes: Rotation3<f64>) -> Model<3> {
     let mesh = SolidMesh::<3>::structured_block(
         SVector::<f64, 3>::new(1.0, 1.0, 1.0),
         SVector::<f64, 3>::repeat(0.01),
@@ -70,7 +71,8 @@ fn top_with(loads: Loads<3>) -> Model<3> {
         free_translations: [false; 3],
         rotation: Rotation::Free {
             principal_inertia: Vector3::new(J, J, J3),
-            initial_angular_velocity: Vector3::new(W_P, 0.0, W_3),
+            principal_axes: axes,
+            initial_angular_velocity: axes * Vector3::new(W_P, 0.0, W_3),
         },
         initial_velocity: SVector::zeros(),
         initial_angular_velocity: 0.0,
@@ -109,8 +111,9 @@ fn worst_errors(dt: f64) -> [f64; 4] {
     assert_eq!(last.orientations.len(), 1);
     let inertia = Vector3::new(J, J, J3);
     let w = |s: &State| Vector3::from_fn(|i, _| s.v[rotations[i]]);
-    let momentum =
-        |s: &State| orientation(dofs, &s.orientations, &s.x, 0) * inertia.component_mul(&w(s));
+    let momentum = |s: &State| {
+        orientation(dofs, model.bodies(), &s.orientations, &s.x, 0) * inertia.component_mul(&w(s))
+    };
     let energy = |s: &State| 0.5 * w(s).dot(&inertia.component_mul(&w(s)));
     let (l0, e0) = (momentum(&states[0]), energy(&states[0]));
     let omega = (J3 - J) / J * W_3;
@@ -225,7 +228,7 @@ fn a_constant_moment_changes_the_angular_momentum_at_its_rate() {
         }],
         ..Loads::default()
     };
-    let model = top_with(loads);
+    let model = top_with(loads, Rotation3::identity());
     let dofs = model.dofs();
     let rotations = dofs.body_rotations(0).to_vec();
     let mut record = Record(Vec::new());
@@ -235,7 +238,7 @@ fn a_constant_moment_changes_the_angular_momentum_at_its_rate() {
     let inertia = Vector3::new(J, J, J3);
     let momentum = |s: &State| {
         let w = Vector3::from_fn(|i, _| s.v[rotations[i]]);
-        orientation(dofs, &s.orientations, &s.x, 0) * inertia.component_mul(&w)
+        orientation(dofs, model.bodies(), &s.orientations, &s.x, 0) * inertia.component_mul(&w)
     };
     let l0 = momentum(&record.0[0]);
     let mut worst: f64 = 0.0;
@@ -256,4 +259,37 @@ fn a_constant_moment_changes_the_angular_momentum_at_its_rate() {
         balance < 1e-6,
         "the ledger misses {balance} of the kinetic energy"
     );
+}
+
+/// The top with its principal axes tilted at the start moves as the aligned top turned by the
+/// tilt `P`: the same body-frame angular velocity in every increment (to round-off) and its
+/// orientation `P` times the aligned one's, so that its angular momentum is `P` times the
+/// aligned one's.
+#[test]
+fn a_top_with_tilted_principal_axes_moves_as_the_aligned_top_turned() {
+    let tilt = Rotation3::from_scaled_axis(Vector3::new(0.3, -0.5, 0.8));
+    let (aligned, tilted) = (top(), top_with(Loads::default(), tilt));
+    let mut records = [Record(Vec::new()), Record(Vec::new())];
+    for (model, record) in [&aligned, &tilted].into_iter().zip(records.iter_mut()) {
+        run(model, &spin(1e-3), &Settings::default(), record)
+            .1
+            .expect("run completes");
+    }
+    let [a, b] = &records;
+    assert_eq!(a.0.len(), b.0.len());
+    let dofs = aligned.dofs();
+    let mut worst: [f64; 2] = [0.0; 2];
+    for (sa, sb) in a.0.iter().zip(&b.0) {
+        worst[0] = worst[0].max((&sa.v - &sb.v).amax());
+        let qa = orientation(dofs, aligned.bodies(), &sa.orientations, &sa.x, 0);
+        let qb = orientation(dofs, tilted.bodies(), &sb.orientations, &sb.x, 0);
+        let turned = nalgebra::UnitQuaternion::from_rotation_matrix(&tilt) * qa;
+        worst[1] = worst[1].max(qb.angle_to(&turned));
+    }
+    assert!(
+        worst[0] < 1e-9 * W_3,
+        "body-frame angular velocities differ by {}",
+        worst[0]
+    );
+    assert!(worst[1] < 1e-9, "orientations differ by {} rad", worst[1]);
 }

@@ -613,11 +613,17 @@ fn point_inertia(
         );
         *next_element += 1;
     }
-    let values = match body.principal_inertia {
+    let values = match body.moments_of_inertia {
         Some(j) if j.iter().any(|&v| v > 0.0) => Some(if dim == 2 {
             num(j[2])
         } else {
-            j.map(num).join(", ")
+            // I11, I22, I33, then I12, I13, I23 where there are products
+            let products = body.products_of_inertia.filter(|p| *p != [0.0; 3]);
+            j.iter()
+                .chain(products.iter().flatten())
+                .map(|&v| num(v))
+                .collect::<Vec<_>>()
+                .join(", ")
         }),
         _ if body.rotary_inertia > 0.0 => {
             let i = num(body.rotary_inertia);

@@ -65,7 +65,7 @@ pub(super) fn body_grid<const D: usize>(
     });
     let spin = match frame.turning {
         Turning::About(axis) => axis.into_inner() * rates[0],
-        Turning::Free => frame.orientation * rates,
+        Turning::Free(axes) => frame.orientation * (axes * rates),
     };
     let velocity: Vec<Vector3<f64>> = points
         .iter()

@@ -3,7 +3,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use nalgebra::{SVector, Vector3};
+use nalgebra::{Matrix3, Rotation3, SVector, Vector3};
 use skid_contact::extrusion::RigidExtrusion;
 use skid_contact::facets::FacetedCylinder;
 use skid_contact::plane::RigidPlane;
@@ -285,6 +285,7 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
     if steps.is_empty() {
         return fail("steps", "expected at least one step");
     }
+    whole_rotation_holds(spec, &bodies, &body_of)?;
     if let Some(interval) = spec.output.field_interval {
         positive("output.field_interval", interval)?;
         check_field_file_names(spec)?;
@@ -589,25 +590,7 @@ fn rigid_body<const D: usize>(
     let reference_point = finite_point::<D>(&f("reference_point"), &b.reference_point)?;
     non_negative(&f("mass"), b.mass)?;
     non_negative(&f("rotary_inertia"), b.rotary_inertia)?;
-    let principal = match b.principal_inertia {
-        Some(j) => {
-            if b.rotary_inertia != 0.0 {
-                return fail(
-                    f("principal_inertia"),
-                    "give either rotary_inertia or principal_inertia, not both",
-                );
-            }
-            let j = vector3(&f("principal_inertia"), j)?;
-            if let Some(k) = (0..3).find(|&k| j[k] < 0.0) {
-                return fail(
-                    f("principal_inertia"),
-                    format!("expected moments >= 0, got {} at {k}", j[k]),
-                );
-            }
-            Some(j)
-        }
-        None => None,
-    };
+    let tensor = inertia_tensor(&f, b)?;
     let free = |d: &Dof| !fixed.contains(d);
     let free_translations: [bool; D] =
         std::array::from_fn(|axis| [Dof::X, Dof::Y, Dof::Z][axis]).map(|d| free(&d));
@@ -634,22 +617,24 @@ fn rigid_body<const D: usize>(
         [] if w.norm() == 0.0 => (Rotation::None, b.rotary_inertia, 0.0),
         [k] if (0..3).all(|a| a == *k || w[a] == 0.0) => {
             let axis = Vector3::ith(*k, 1.0);
-            let inertia = principal.map_or(b.rotary_inertia, |j| j[*k]);
+            let inertia = tensor.map_or(b.rotary_inertia, |t| t[(*k, *k)]);
             (Rotation::Axis(axis), inertia, w[*k])
         }
         [_, _, _] => {
-            let Some(principal_inertia) = principal else {
+            let Some(tensor) = tensor else {
                 return fail(
-                    f("principal_inertia"),
+                    f("moments_of_inertia"),
                     format!(
-                        "rigid body '{}' is free to turn about x, y and z: expected its principal \
-                         moments of inertia [Jx, Jy, Jz]",
+                        "rigid body '{}' is free to turn about x, y and z: expected its moments \
+                         of inertia [Ixx, Iyy, Izz]",
                         b.name
                     ),
                 );
             };
+            let (principal_inertia, principal_axes) = principal_axes(&tensor);
             let rotation = Rotation::Free {
                 principal_inertia,
+                principal_axes,
                 initial_angular_velocity: w,
             };
             (rotation, 0.0, 0.0)
@@ -686,6 +671,66 @@ fn rigid_body<const D: usize>(
         initial_velocity,
         initial_angular_velocity,
     })
+}
+
+/// The inertia tensor about the reference node of body `b`, from its moments and products of
+/// inertia (`None` without moments).
+fn inertia_tensor(
+    f: &dyn Fn(&str) -> String,
+    b: &crate::model_spec::RigidBodySpec,
+) -> Result<Option<Matrix3<f64>>, SpecError> {
+    let Some(moments) = b.moments_of_inertia else {
+        if b.products_of_inertia.is_some() {
+            return fail(
+                f("products_of_inertia"),
+                "expected moments_of_inertia beside the products",
+            );
+        }
+        return Ok(None);
+    };
+    if b.rotary_inertia != 0.0 {
+        return fail(
+            f("moments_of_inertia"),
+            "give either rotary_inertia or moments_of_inertia, not both",
+        );
+    }
+    let j = vector3(&f("moments_of_inertia"), moments)?;
+    if let Some(k) = (0..3).find(|&k| j[k] < 0.0) {
+        return fail(
+            f("moments_of_inertia"),
+            format!("expected moments >= 0, got {} at {k}", j[k]),
+        );
+    }
+    let p = vector3(
+        &f("products_of_inertia"),
+        b.products_of_inertia.unwrap_or([0.0; 3]),
+    )?;
+    let tensor = Matrix3::new(j.x, p.x, p.y, p.x, j.y, p.z, p.y, p.z, j.z);
+    if tensor.symmetric_eigenvalues().min() < -1e-12 * j.amax() {
+        return fail(
+            f("products_of_inertia"),
+            format!(
+                "the inertia tensor {tensor} is not positive semi-definite: no mass \
+                 distribution has it"
+            ),
+        );
+    }
+    Ok(Some(tensor))
+}
+
+/// The principal moments and axes `(J, P)` of an inertia tensor `I = P diag(J) P^T`, `P` a
+/// rotation; `P` is the identity for a diagonal tensor.
+fn principal_axes(tensor: &Matrix3<f64>) -> (Vector3<f64>, Rotation3<f64>) {
+    let diagonal = tensor.diagonal();
+    if *tensor == Matrix3::from_diagonal(&diagonal) {
+        return (diagonal, Rotation3::identity());
+    }
+    let eigen = tensor.symmetric_eigen();
+    let mut axes = eigen.eigenvectors;
+    if axes.determinant() < 0.0 {
+        axes.column_mut(2).neg_mut();
+    }
+    (eigen.eigenvalues, Rotation3::from_matrix_unchecked(axes))
 }
 
 /// The contact surface of a body, in its body frame.
@@ -1033,6 +1078,41 @@ fn held_motions<const D: usize>(
         }
     }
     Ok(held)
+}
+
+/// Checks that every step holding rotations of a body free to turn holds all three: a hold
+/// fixes its rotation unknowns, material increments about its own axes, which are the global
+/// axes only at the start, so that one of them alone is not a rotation about a global axis.
+fn whole_rotation_holds<const D: usize>(
+    spec: &ModelSpec,
+    bodies: &[RigidBody<D>],
+    body_of: &impl Fn(&str, &str) -> Result<usize, SpecError>,
+) -> Result<(), SpecError> {
+    for (i, step) in spec.steps.iter().enumerate() {
+        let (ModelStepSpec::Static { boundary, .. } | ModelStepSpec::Dynamic { boundary, .. }) =
+            step;
+        for (k, bc) in boundary.iter().enumerate() {
+            let (Some(name), Some(dofs)) = (&bc.body, &bc.dofs) else {
+                continue;
+            };
+            let field = format!("steps[{i}].boundary[{k}].dofs");
+            let body = body_of(&field, name)?;
+            let rotations = [Dof::Rx, Dof::Ry, Dof::Rz]
+                .iter()
+                .filter(|d| dofs.contains(d))
+                .count();
+            if matches!(bodies[body].rotation, Rotation::Free { .. }) && rotations % 3 != 0 {
+                return fail(
+                    field,
+                    format!(
+                        "rigid body '{name}' is free to turn: a step holds all its rotations \
+                         (rx, ry, rz) or none"
+                    ),
+                );
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Solver settings; `auto` takes the contact solve `preferred` for the model

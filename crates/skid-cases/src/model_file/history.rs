@@ -324,11 +324,14 @@ impl<const D: usize> Observer<D> for ModelRecorder {
                 row.push(number(s.v[eq]));
             }
             if let [e0, e1, e2] = *dofs.body_rotations(b) {
-                // the rotation vector of the orientation and the spatial angular velocity
-                let q = orientation(dofs, &s.orientations, &s.x, b);
-                let omega = q * Vector3::new(s.v[e0], s.v[e1], s.v[e2]);
+                // the rotation vector of the turn from the start and the spatial angular
+                // velocity, `Q_p W` with `Q_p` the principal axes' orientation
+                let turned = model.body_frame(&s.x, b, &s.orientations).orientation;
+                let principal = orientation(dofs, model.bodies(), &s.orientations, &s.x, b);
+                let omega = principal * Vector3::new(s.v[e0], s.v[e1], s.v[e2]);
                 row.extend(
-                    q.scaled_axis()
+                    turned
+                        .scaled_axis()
                         .iter()
                         .chain(omega.iter())
                         .map(|&c| number(c)),

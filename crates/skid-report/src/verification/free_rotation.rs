@@ -1,5 +1,6 @@
 //! The torque-free rigid body of the verification section: a scene whose only motion is a
-//! rigid body free to turn about all three axes, with no contact and no load. From its
+//! rigid body free to turn about all three axes, its principal axes along the global ones, with
+//! no contact and no load. From its
 //! `history.csv` (the rotation vector `B.rotation_*` of its orientation `Q` and its global
 //! angular velocity `B.omega_*`), with the body-frame angular velocity `W = Q^T omega` and the
 //! principal moments of inertia `J` of its model:
@@ -63,9 +64,12 @@ impl FreeBody {
         if ![Dof::Rx, Dof::Ry, Dof::Rz].iter().all(turns) {
             return None;
         }
+        if body.products_of_inertia.is_some_and(|p| p != [0.0; 3]) {
+            return None;
+        }
         Some(Self {
             name: body.name.clone(),
-            inertia: Vector3::from(body.principal_inertia?),
+            inertia: Vector3::from(body.moments_of_inertia?),
             spin: Vector3::from(body.initial_angular_velocity.unwrap_or([0.0; 3])),
         })
     }
@@ -299,7 +303,7 @@ mod tests {
         held.boundary[0].dofs.push(Dof::Rx);
         assert_eq!(FreeBody::recognise(&held), None);
         let mut asymmetric = spec;
-        asymmetric.rigid_bodies[0].principal_inertia = Some([0.01, 0.015, 0.02]);
+        asymmetric.rigid_bodies[0].moments_of_inertia = Some([0.01, 0.015, 0.02]);
         let body = FreeBody::recognise(&asymmetric).expect("still a free body");
         assert_eq!(body.symmetry(), None);
     }

@@ -173,25 +173,19 @@ pub(super) fn body_spec(
         }
     }
     let turns_freely = dim == 3 && (4..=6).all(|k| !body.fixed.contains(&k));
-    let (rotary_inertia, principal_inertia) = if turns_freely {
-        if inertia != Matrix3::from_diagonal(&inertia.diagonal()) {
-            return Err(error(
-                &body.def.location,
-                format!(
-                    "*RIGID BODY {}: it is free to turn about x, y and z, and its *ROTARY INERTIA \
-                     has products of inertia: expected its principal axes along the global axes \
-                     (I12 = I13 = I23 = 0)",
-                    body.def.name
-                ),
-            ));
-        }
-        (0.0, Some(inertia.diagonal().into()))
+    let (rotary_inertia, moments_of_inertia, products_of_inertia) = if turns_freely {
+        let products = [inertia[(0, 1)], inertia[(0, 2)], inertia[(1, 2)]];
+        (
+            0.0,
+            Some(inertia.diagonal().into()),
+            (products != [0.0; 3]).then_some(products),
+        )
     } else {
         let about = match free_axis(dim, body) {
             Some(e) => (e.transpose() * inertia * e)[(0, 0)],
             None => inertia[(2, 2)],
         };
-        (about, None)
+        (about, None, None)
     };
     let analytical = match &body.def.analytical {
         Some(name) => {
@@ -222,7 +216,8 @@ pub(super) fn body_spec(
         reference_point: body.reference.as_slice()[..dim].to_vec(),
         mass,
         rotary_inertia,
-        principal_inertia,
+        moments_of_inertia,
+        products_of_inertia,
         surface: analytical,
         initial_velocity: None,
         initial_angular_velocity: None,
