@@ -220,6 +220,8 @@ fn solve_increment_with<const D: usize>(
     let quasi_static = model.quasi_static();
     let length = model.length_scale();
     let previous: Vec<SurfacePoint> = start.contacts.iter().map(|c| c.closest).collect();
+    // the gyroscopic moments at the start, HHT's history term for bodies free to turn
+    let start_gyroscopic = model.gyroscopic_moments(&start.v);
     // Dynamic increments take the normal rows between the start and the end positions, so
     // that the contact impulse does the work `p_N dg` (see `contact_rows`); a static
     // equilibrium takes the normal at the solution itself.
@@ -330,10 +332,7 @@ fn solve_increment_with<const D: usize>(
         let net = &internal.force - &f_ext;
         let mut inertia = mass.component_mul(&a);
         if let IncrementKind::Dynamic { hht, .. } = kind
-            && let (Some(end), Some(begin)) = (
-                model.gyroscopic_moments(&v),
-                model.gyroscopic_moments(&start.v),
-            )
+            && let (Some(end), Some(begin)) = (model.gyroscopic_moments(&v), &start_gyroscopic)
         {
             inertia += end * (1.0 + hht.alpha) - begin * hht.alpha;
         }
