@@ -496,13 +496,29 @@ fn solve_increment_with<const D: usize>(
             }
         }
 
+        // Once the forces nearly balance (see `CHORD_WITHIN`) or only the contact kinematics
+        // is left to converge (the secant rows' gap converges linearly, see `contact_rows`),
+        // the reduced path's last factorization serves again: the matrix has changed by the
+        // order of the last, small step, so the chord step reaches the tolerance as the Newton
+        // step would, at a fraction of the cost. Its tangent is then not assembled: the
+        // assembler keeps the matrix of that factorization, which also serves if the step
+        // must factorize after all (a candidate joining the near set, see `contact_step`).
+        let chord = method == ContactSolve::Reduced
+            && !rows.is_empty()
+            && reusable.is_some()
+            && counters
+                .residuals
+                .last()
+                .is_some_and(|&(force, _)| force <= CHORD_WITHIN * newton.force_tolerance);
         let clock = Instant::now();
-        if check {
-            assembler.internal(model, &x, Some(k_factor))?;
+        if !chord {
+            if check {
+                assembler.internal(model, &x, Some(k_factor))?;
+            }
+            assembler.add_diagonal(&(m_term * m_factor));
+            assembler.add_contact_curvature(&rows, &warm);
+            assembler.hold(held);
         }
-        assembler.add_diagonal(&(m_term * m_factor));
-        assembler.add_contact_curvature(&rows, &warm);
-        assembler.hold(held);
         timings.assembly += clock.elapsed();
 
         // The mass term of the matrix is raised until `K + c M` can be factorized (see
@@ -543,16 +559,7 @@ fn solve_increment_with<const D: usize>(
             });
             step.dx
         } else {
-            // Once the forces nearly balance (see `CHORD_WITHIN`) or only the contact
-            // kinematics is left to converge (the secant rows' gap converges linearly, see
-            // `contact_rows`), the last factorization serves again: the matrix has changed by
-            // the order of the last, small step, so the chord step reaches the tolerance as the
-            // Newton step would, at a fraction of the cost.
-            let nearly_converged = counters
-                .residuals
-                .last()
-                .is_some_and(|&(force, _)| force <= CHORD_WITHIN * newton.force_tolerance);
-            let mut reuse = reusable.take().filter(|_| nearly_converged);
+            let mut reuse = reusable.take().filter(|_| chord);
             if weights.is_none() {
                 let k = assembler.lower_triangle()?;
                 weights = Some(contact_weights(k, &rows));
