@@ -34,7 +34,7 @@ pub fn corners<const D: usize>() -> Vec<SVector<f64, D>> {
 
 /// Sign of coordinate `axis` of corner number `corner`: the first two axes run
 /// counter-clockwise through (-,-), (+,-), (+,+), (-,+); further axes follow the binary digits.
-fn corner_sign(corner: usize, axis: usize) -> f64 {
+pub fn corner_sign(corner: usize, axis: usize) -> f64 {
     let positive = match axis {
         0 => matches!(corner & 3, 1 | 2),
         1 => corner & 2 != 0,

@@ -2,9 +2,7 @@
 
 use nalgebra::{SVector, Vector2, Vector3};
 
-use crate::cell::{
-    check_dimension, corner_count, embed, gauss_points, restrict, shape_functions, shape_gradients,
-};
+use crate::cell::{check_dimension, corner_count, corner_sign, embed, restrict};
 use crate::error::FemError;
 
 /// Nodal forces of a uniform pressure p (positive pushes INTO the body, i.e. force = -p n dA
@@ -42,8 +40,7 @@ pub fn pressure_face_forces<const D: usize>(
             expected: "finite",
         });
     }
-    let x: Vec<Vector3<f64>> = x.iter().map(embed).collect();
-    let forces = if D == 2 {
+    if D == 2 {
         if !(thickness > 0.0 && thickness.is_finite()) {
             return Err(FemError::InvalidParameter {
                 name: "thickness",
@@ -51,24 +48,32 @@ pub fn pressure_face_forces<const D: usize>(
                 expected: "finite and > 0",
             });
         }
-        let d = x[1] - x[0];
+        let d = embed(&x[1]) - embed(&x[0]);
         let half = Vector3::new(d.y, -d.x, 0.0) * (-0.5 * pressure * thickness);
-        vec![half; 2]
-    } else {
-        let mut forces = vec![Vector3::zeros(); x.len()];
-        for (s, weight) in gauss_points::<2>() {
-            let dn: Vec<Vector2<f64>> = shape_gradients(&s);
-            let (x_s, x_t) = x.iter().zip(&dn).fold(
-                (Vector3::zeros(), Vector3::zeros()),
-                |(x_s, x_t), (x_i, dn_i)| (x_s + x_i * dn_i.x, x_t + x_i * dn_i.y),
-            );
-            let area = x_s.cross(&x_t) * weight;
-            for (f, n_i) in forces.iter_mut().zip(shape_functions(&s)) {
-                *f -= area * (pressure * n_i);
-            }
+        return Ok(vec![restrict(&half); 2]);
+    }
+    let x: [Vector3<f64>; 4] = std::array::from_fn(|i| embed(&x[i]));
+    // the face's corners (s_I, t_I) in the cell corner order, and the 2 x 2 Gauss points
+    // (s_I, t_I) / sqrt(3), each of weight 1
+    let corners: [Vector2<f64>; 4] =
+        std::array::from_fn(|i| Vector2::new(corner_sign(i, 0), corner_sign(i, 1)));
+    let a = 1.0 / 3.0_f64.sqrt();
+    let mut forces = [Vector3::zeros(); 4];
+    for point in &corners {
+        let (s, t) = (point.x * a, point.y * a);
+        // N_I = (1 + s s_I)(1 + t t_I) / 4 and its derivatives along s and t
+        let along_s = |c: &Vector2<f64>| 0.5 * (1.0 + c.x * s);
+        let along_t = |c: &Vector2<f64>| 0.5 * (1.0 + c.y * t);
+        let (mut x_s, mut x_t) = (Vector3::zeros(), Vector3::zeros());
+        for (x_i, c) in x.iter().zip(&corners) {
+            x_s += x_i * (0.5 * c.x * along_t(c));
+            x_t += x_i * (along_s(c) * (0.5 * c.y));
         }
-        forces
-    };
+        let area = x_s.cross(&x_t);
+        for (f, c) in forces.iter_mut().zip(&corners) {
+            *f -= area * (pressure * (along_s(c) * along_t(c)));
+        }
+    }
     Ok(forces.iter().map(restrict).collect())
 }
 

@@ -502,13 +502,15 @@ pub fn external_forces<const D: usize>(
 ) -> Result<DVector<f64>, IncrementFailure> {
     let mut f = DVector::zeros(model.dofs().len());
     let mesh = &model.part().mesh;
+    let mut xf: Vec<SVector<f64, D>> = Vec::new();
     for load in model.pressures() {
         let pressure = instant.factor(&load.variation) * load.pressure;
         for face in &load.faces {
-            let xf: Vec<SVector<f64, D>> = face
-                .iter()
-                .map(|&n| mesh.nodes[n] + model.dofs().node_displacement(x, n))
-                .collect();
+            xf.clear();
+            xf.extend(
+                face.iter()
+                    .map(|&n| mesh.nodes[n] + model.dofs().node_displacement(x, n)),
+            );
             let forces =
                 pressure_face_forces(&xf, pressure, model.part().thickness).map_err(|err| {
                     IncrementFailure::Load(format!("pressure on face {face:?}: {err}"))
