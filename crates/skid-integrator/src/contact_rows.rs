@@ -19,13 +19,73 @@ use crate::model::Model;
 use crate::orientation::Orientation;
 use crate::sparse::Factorization;
 
+/// The rows of a sparse matrix, one after another: row `k`'s `(column, value)` entries are
+/// `entries[starts[k]..starts[k + 1]]`, one allocation for all rows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SparseRows {
+    entries: Vec<(usize, f64)>,
+    starts: Vec<usize>,
+}
+
+impl SparseRows {
+    /// No rows, with room for `rows` rows of `entries` entries in all.
+    pub fn with_capacity(rows: usize, entries: usize) -> Self {
+        let mut starts = Vec::with_capacity(rows + 1);
+        starts.push(0);
+        Self {
+            entries: Vec::with_capacity(entries),
+            starts,
+        }
+    }
+
+    /// The number of rows.
+    pub fn len(&self) -> usize {
+        self.starts.len() - 1
+    }
+
+    /// True if there are no rows.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The rows in order, each as its entries.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = &[(usize, f64)]> + '_ {
+        self.starts
+            .windows(2)
+            .map(|range| &self.entries[range[0]..range[1]])
+    }
+
+    /// Adds `value` to column `column` of the row being built (see [`Self::end_row`]): to its
+    /// entry there, or as a new entry.
+    pub fn add(&mut self, column: usize, value: f64) {
+        let start = self.starts[self.starts.len() - 1];
+        match self.entries[start..].iter_mut().find(|(c, _)| *c == column) {
+            Some(entry) => entry.1 += value,
+            None => self.entries.push((column, value)),
+        }
+    }
+
+    /// Ends the row being built: the entries added since the last call make row [`Self::len`].
+    pub fn end_row(&mut self) {
+        self.starts.push(self.entries.len());
+    }
+}
+
+impl std::ops::Index<usize> for SparseRows {
+    type Output = [(usize, f64)];
+
+    fn index(&self, row: usize) -> &[(usize, f64)] {
+        &self.entries[self.starts[row]..self.starts[row + 1]]
+    }
+}
+
 /// Linearised contact kinematics at one configuration.
 #[derive(Clone, Debug)]
 pub struct ContactRows {
     /// Components per contact: 1 normal + (D - 1) tangential.
     pub components: usize,
     /// Sparse rows of H: (equation, coefficient); `components` rows per contact.
-    pub rows: Vec<Vec<(usize, f64)>>,
+    pub rows: SparseRows,
     /// Current local quantities u (gap, slip increment per tangent), per row.
     pub u: DVector<f64>,
     /// Current closest point per contact (body frame), where the next increment's slip starts.
@@ -237,7 +297,7 @@ pub fn contact_rows<const D: usize>(
     let mut out = ContactRows {
         components,
         coordinates: size,
-        rows: Vec::with_capacity(candidates * D),
+        rows: SparseRows::with_capacity(candidates * D, candidates * D * size),
         u: DVector::zeros(0),
         closest: Vec::with_capacity(candidates),
         mu: Vec::with_capacity(candidates),
@@ -282,16 +342,13 @@ pub fn contact_rows<const D: usize>(
                 }
             }
             for comp in 0..components {
-                let mut row: Vec<(usize, f64)> = Vec::with_capacity(size);
+                let row = &mut out.rows;
                 let mut add = |eq: Option<usize>, c: f64| {
                     if let Some(eq) = eq
                         && !held[eq]
                         && c != 0.0
                     {
-                        match row.iter_mut().find(|(e, _)| *e == eq) {
-                            Some(entry) => entry.1 += c,
-                            None => row.push((eq, c)),
-                        }
+                        row.add(eq, c);
                     }
                 };
                 for i in 0..D {
@@ -302,7 +359,7 @@ pub fn contact_rows<const D: usize>(
                 for (i, &eq) in rotations.iter().enumerate() {
                     add(Some(eq), kin.d_drotation[comp][i]);
                 }
-                out.rows.push(row);
+                out.rows.end_row();
                 push_local_curvature::<D>(&kin, comp, size, &mut out.curvature);
                 u.push(if comp == 0 {
                     kin.gap
