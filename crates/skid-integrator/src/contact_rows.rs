@@ -454,6 +454,27 @@ mod tests {
     use super::*;
     use crate::test_support::{block_on_drum, coordinate_origins};
 
+    /// Entries added to one column of a row sum into one entry; each row keeps its own entries,
+    /// in the order first added, and a row may be empty.
+    #[test]
+    fn sparse_rows_merge_a_row_s_entries_per_column() {
+        let mut rows = SparseRows::with_capacity(3, 4);
+        assert!(rows.is_empty());
+        rows.add(4, 1.0);
+        rows.add(2, -0.5);
+        rows.add(4, 0.25);
+        rows.end_row();
+        rows.end_row();
+        rows.add(4, 3.0);
+        rows.end_row();
+        assert_eq!(rows.len(), 3);
+        assert_eq!(&rows[0], &[(4, 1.25), (2, -0.5)]);
+        assert!(rows[1].is_empty());
+        assert_eq!(&rows[2], &[(4, 3.0)]);
+        let lengths: Vec<usize> = rows.iter().map(<[(usize, f64)]>::len).collect();
+        assert_eq!(lengths, [2, 0, 1]);
+    }
+
     /// `H dx` predicts the change of gaps and slips for a small motion of nodes and drum.
     fn rows_are_the_derivative_of_the_kinematics<const D: usize>() {
         let model = block_on_drum::<D>();
