@@ -17,7 +17,7 @@
 
 use nalgebra::{Matrix3, Rotation3, Unit, UnitQuaternion, Vector2, Vector3};
 
-use crate::surface::{DiscreteGradient, RigidSurface, SurfacePoint};
+use crate::surface::{DiscreteGradient, Projection, RigidSurface, SurfacePoint};
 
 /// How a rigid body may turn: which rotation unknowns its kinematics are differentiated in.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -262,6 +262,15 @@ pub struct IncrementStart {
     pub offset: Vector3<f64>,
 }
 
+impl IncrementStart {
+    /// The node's start position in the body frame of the start, `y_0 = Q_0^T r_0`: the
+    /// projection [`rotation_column`] takes is this point's, the same in every Newton iteration
+    /// of the increment.
+    pub fn body_point(&self) -> Vector3<f64> {
+        self.orientation.inverse_transform_vector(&self.offset)
+    }
+}
+
 /// Rotation column of a node's rows `f = [g, s_0, s_1]` over an increment that makes them a
 /// discrete gradient, for a body turning about a fixed axis. With the end-point `df/dx`
 /// (`end.d_dx`, the kinematics evaluated from the contact point at the start `y_0`, so that
@@ -281,6 +290,8 @@ pub struct IncrementStart {
 /// if that makes a component exceed [`MAX_COLUMN_LEVER`] `|r_0|`, the secant in the rotation
 /// alone is returned instead.
 ///
+/// `before` is the projection of the start point [`IncrementStart::body_point`] on `surface`.
+///
 /// `None` if the turn is below [`MIN_SECANT_TURN`] or not finite, the body is free to turn (its
 /// end-point derivatives stand), the frame is not finite, or a projection is undefined: then the
 /// end-point derivative stands.
@@ -288,6 +299,7 @@ pub fn rotation_column(
     surface: &dyn RigidSurface,
     frame: &RotatingFrame,
     start: &IncrementStart,
+    before: &Projection,
     end_offset: &Vector3<f64>,
     end: &ContactKinematics,
 ) -> Option<[f64; 3]> {
@@ -298,8 +310,6 @@ pub fn rotation_column(
     {
         return None;
     }
-    let y_before = start.orientation.inverse_transform_vector(&start.offset);
-    let before = surface.project(&y_before)?;
     let moved = end_offset - start.offset;
     let whole = [end.gap - before.gap, end.slip[0], end.slip[1]];
     let column: [f64; 3] = std::array::from_fn(|k| (whole[k] - end.d_dx[k].dot(&moved)) / turn);
@@ -310,7 +320,7 @@ pub fn rotation_column(
     let y_turned = frame.orientation.inverse_transform_vector(&start.offset);
     let turned = surface.project(&y_turned)?;
     let slip = surface
-        .slip(&before.closest(&y_before), &y_turned, &turned)
+        .slip(&before.closest(&start.body_point()), &y_turned, &turned)
         .value;
     let secant = [turned.gap - before.gap, slip[0], slip[1]].map(|d| d / turn);
     secant.iter().all(|c| c.is_finite()).then_some(secant)
@@ -584,7 +594,9 @@ mod tests {
                 turn: theta1 - theta0,
                 offset: r0,
             };
-            let column = rotation_column(&drum, &end, &begin, &r1, &k1).ok_or_else(none)?;
+            let before = drum.project(&begin.body_point()).ok_or_else(none)?;
+            let column =
+                rotation_column(&drum, &end, &begin, &before, &r1, &k1).ok_or_else(none)?;
             let turn = theta1 - theta0;
             for c in 0..2 {
                 let predicted = k1.d_dx[c].dot(&(r1 - r0)) + column[c] * turn;
@@ -606,7 +618,9 @@ mod tests {
         let k0 = eval(&drum, &start, &(c0 + r0))?;
         let close = RotatingFrame::about(c0, axis, theta0 + 1e-6);
         let still = eval_from(&drum, &close, &(c0 + r0), &k0.closest)?;
-        let limit = rotation_column(&drum, &close, &begin, &r0, &still).ok_or_else(none)?;
+        let before = drum.project(&begin.body_point()).ok_or_else(none)?;
+        let limit =
+            rotation_column(&drum, &close, &begin, &before, &r0, &still).ok_or_else(none)?;
         for (secant, derivative) in limit.iter().zip(k0.d_drotation).take(2) {
             assert_relative_eq!(*secant, derivative[0], epsilon = 1e-6);
         }
@@ -615,14 +629,14 @@ mod tests {
             turn: 0.1 * MIN_SECANT_TURN,
             ..begin
         };
-        assert!(rotation_column(&drum, &stopped, &barely, &r0, &still).is_none());
+        assert!(rotation_column(&drum, &stopped, &barely, &before, &r0, &still).is_none());
         // a body free to turn keeps its end-point derivatives
         let free = RotatingFrame::free(
             c0,
             &UnitQuaternion::from_axis_angle(&Vector3::z_axis(), theta0 + 1e-6),
             &Rotation3::identity(),
         );
-        assert!(rotation_column(&drum, &free, &begin, &r0, &still).is_none());
+        assert!(rotation_column(&drum, &free, &begin, &before, &r0, &still).is_none());
         Ok(())
     }
 
@@ -643,8 +657,9 @@ mod tests {
             offset: r0,
         };
         let end = eval_from(&drum, &frame, &r1, &eval(&drum, &unturned, &r0)?.closest)?;
-        let column = rotation_column(&drum, &frame, &begin, &r1, &end)
-            .ok_or_else(|| ContactError::InvalidSurface("no rotation column".into()))?;
+        let none = || ContactError::InvalidSurface("no rotation column".into());
+        let before = drum.project(&begin.body_point()).ok_or_else(none)?;
+        let column = rotation_column(&drum, &frame, &begin, &before, &r1, &end).ok_or_else(none)?;
         for c in column {
             assert!(c.abs() <= MAX_COLUMN_LEVER * r0.norm(), "{c}");
         }

@@ -8,11 +8,13 @@
 //! to the node's components and the carrying body's translation and rotation, and each row's
 //! second derivatives give the stiffness of the contact forces on a curved, turning surface.
 
+use std::cell::OnceCell;
+
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
-use skid_contact::SurfacePoint;
 use skid_contact::kinematics::{
     ContactKinematics, IncrementStart, evaluate, gap_discrete_gradient, rotation_column,
 };
+use skid_contact::{Projection, SurfacePoint};
 
 use crate::error::{IncrementFailure, LinearFailure};
 use crate::model::Model;
@@ -260,14 +262,36 @@ impl ContactRows {
     }
 }
 
+/// The start of a dynamic increment for [`contact_rows`]: the displacement there and, for each
+/// candidate whose rows take a rotation column, the projection of its start position on its
+/// surface ([`skid_contact::rotation_column`]). That projection depends on the start alone, so
+/// it is made at the first Newton iteration that needs it and shared by the later ones.
+#[derive(Debug)]
+pub struct RowStart<'a> {
+    x: &'a DVector<f64>,
+    projections: Vec<OnceCell<Option<Projection>>>,
+}
+
+impl<'a> RowStart<'a> {
+    /// The start at displacement `x` of an increment of `model`.
+    pub fn new<const D: usize>(model: &Model<D>, x: &'a DVector<f64>) -> Self {
+        let candidates = model.contacts().iter().map(|pair| pair.nodes.len()).sum();
+        Self {
+            x,
+            projections: (0..candidates).map(|_| OnceCell::new()).collect(),
+        }
+    }
+}
+
 /// Evaluates the contact rows of all pairs at displacement `x`, with the orientations of bodies
 /// free to turn from the records `orientations` (see [`crate::orientation`]). `previous` holds
 /// the closest points at the start of the increment, where the slips start (one per candidate,
 /// pair by pair; `None`: each node's own closest point, zero slips); `held` marks equations
 /// whose increment is zero in this step (their columns are dropped).
 ///
-/// `start` is the displacement at the start of a dynamic increment (`None` for rows at the
-/// start itself and for static equilibrium, which needs the normal at the solution). Against a
+/// `start` is the start of a dynamic increment (`None` for rows at the start itself and for
+/// static equilibrium, which needs the normal at the solution; it is the same `start` for
+/// every iteration of an increment, whose orientations are `orientations`). Against a
 /// surface with a discrete gap gradient (the analytical circle and cylinder, see
 /// [`skid_contact::RigidSurface::gap_discrete_gradient`]) the normal row is that gradient
 /// between the start and current positions instead of the current normal: the contact force
@@ -286,7 +310,7 @@ pub fn contact_rows<const D: usize>(
     model: &Model<D>,
     x: &DVector<f64>,
     orientations: &[Orientation],
-    start: Option<&DVector<f64>>,
+    start: Option<&RowStart<'_>>,
     previous: Option<&[SurfacePoint]>,
     held: &[bool],
 ) -> Result<ContactRows, IncrementFailure> {
@@ -307,14 +331,15 @@ pub fn contact_rows<const D: usize>(
     let mut k = 0;
     for (p, pair) in model.contacts().iter().enumerate() {
         let frame = model.body_frame(x, pair.body, orientations);
-        let start_frame = start.map(|x0| model.body_frame(x0, pair.body, orientations));
+        let start_frame = start.map(|s| model.body_frame(s.x, pair.body, orientations));
         let rotations = dofs.body_rotations(pair.body);
         for &node in &pair.nodes {
             let pos = model.node_position(x, node);
             let from = previous.map(|points| &points[k]);
             let mut kin = evaluate(pair.surface.as_ref(), &frame, &pos, from)
                 .ok_or(IncrementFailure::NoProjection { pair: p, node })?;
-            if let (Some(x0), Some(frame0)) = (start, start_frame) {
+            if let (Some(start), Some(frame0)) = (start, start_frame) {
+                let x0 = start.x;
                 let offset = model.node_position(x0, node) - frame0.center;
                 if let Some(secant) =
                     gap_discrete_gradient(pair.surface.as_ref(), &frame, &offset, &pos)
@@ -332,9 +357,14 @@ pub fn contact_rows<const D: usize>(
                         offset,
                     };
                     let end_offset = pos - frame.center;
-                    if let Some(column) =
-                        rotation_column(pair.surface.as_ref(), &frame, &begin, &end_offset, &kin)
-                    {
+                    let surface = pair.surface.as_ref();
+                    let before = start.projections.get(k).and_then(|cell| {
+                        cell.get_or_init(|| surface.project(&begin.body_point()))
+                            .as_ref()
+                    });
+                    if let Some(column) = before.and_then(|before| {
+                        rotation_column(surface, &frame, &begin, before, &end_offset, &kin)
+                    }) {
                         for (derivative, c) in kin.d_drotation.iter_mut().zip(column) {
                             derivative[0] = c;
                         }
@@ -452,7 +482,7 @@ fn push_local_curvature<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_support::{block_on_drum, coordinate_origins};
+    use crate::test_support::{block_on_drum, block_on_faceted_drum, coordinate_origins};
 
     /// Entries added to one column of a row sum into one entry; each row keeps its own entries,
     /// in the order first added, and a row may be empty.
@@ -473,6 +503,52 @@ mod tests {
         assert_eq!(&rows[2], &[(4, 3.0)]);
         let lengths: Vec<usize> = rows.iter().map(<[(usize, f64)]>::len).collect();
         assert_eq!(lengths, [2, 0, 1]);
+    }
+
+    /// Against a faceted drum, the rows of an iterate take rotation columns from the start's
+    /// projections, which a [`RowStart`] makes once: rows from a start already used by an
+    /// earlier iterate are those from a new one, and the columns differ from the end-point
+    /// derivatives that rows without a start take.
+    fn a_shared_start_gives_the_rows_of_a_new_one<const D: usize>() {
+        let model = block_on_faceted_drum::<D>();
+        let n = model.dofs().len();
+        let held = vec![false; n];
+        let angle = model.dofs().body_rotation(0).expect("the drum turns");
+        let x0 = DVector::from_fn(n, |i, _| 1e-3 * ((i as f64 * 1.3).sin() - 0.5));
+        let at_start = contact_rows(&model, &x0, &[], None, None, &held).expect("rows");
+        let previous = Some(at_start.closest.as_slice());
+        let iterate = |scale: f64| {
+            let mut x = &x0 + DVector::from_fn(n, |i, _| scale * (i as f64 * 0.7).cos());
+            x[angle] = x0[angle] + 40.0 * scale;
+            x
+        };
+        let (x1, x2) = (iterate(1e-5), iterate(2e-5));
+        let shared = RowStart::new(&model, &x0);
+        let first = contact_rows(&model, &x1, &[], Some(&shared), previous, &held).expect("rows");
+        assert!(shared.projections.iter().all(|p| p.get().is_some()));
+        let again = contact_rows(&model, &x2, &[], Some(&shared), previous, &held).expect("rows");
+        let fresh = RowStart::new(&model, &x0);
+        let new = contact_rows(&model, &x2, &[], Some(&fresh), previous, &held).expect("rows");
+        assert_eq!(again.rows, new.rows, "{D}D");
+        assert_eq!(again.u, new.u, "{D}D");
+        assert_ne!(first.rows, again.rows, "{D}D: the iterates differ");
+        let end_point = contact_rows(&model, &x2, &[], None, previous, &held).expect("rows");
+        let column = |rows: &ContactRows| -> Vec<f64> {
+            (rows.rows.iter())
+                .flat_map(|row| row.iter().filter(|(eq, _)| *eq == angle).map(|e| e.1))
+                .collect()
+        };
+        assert_ne!(
+            column(&again),
+            column(&end_point),
+            "{D}D: rotation columns formed"
+        );
+    }
+
+    #[test]
+    fn a_shared_start_gives_the_rows_of_a_new_one_2d_and_3d() {
+        a_shared_start_gives_the_rows_of_a_new_one::<2>();
+        a_shared_start_gives_the_rows_of_a_new_one::<3>();
     }
 
     /// `H dx` predicts the change of gaps and slips for a small motion of nodes and drum.

@@ -300,7 +300,7 @@ mod tests {
     use nalgebra::DMatrix;
 
     use super::*;
-    use crate::contact_rows::contact_rows;
+    use crate::contact_rows::{RowStart, contact_rows};
     use crate::error::LinearFailure;
     use crate::model::Model;
     use crate::orientation::Orientation;
@@ -456,8 +456,9 @@ mod tests {
         // the block pressed 1 mm into the drum, sheared, the drum turned and shifted
         let x = DVector::from_fn(n, |i, _| 1e-3 * ((i as f64 * 1.3).sin() - 0.5));
         let x0 = DVector::from_fn(n, |i, _| x[i] - 1e-5 * (i as f64 * 0.7).cos());
-        let increment_start = secant.then_some(&x0);
         let (model, mut assembler) = assembled::<D>(&x);
+        let row_start = RowStart::new(&model, &x0);
+        let increment_start = secant.then_some(&row_start);
         let held = vec![false; n];
         let start = coordinate_origins(&model);
         let rows =

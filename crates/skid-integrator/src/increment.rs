@@ -42,7 +42,7 @@ use nalgebra::{DVector, Vector2};
 use skid_contact::SurfacePoint;
 
 use crate::assembly::{Assembler, InternalState, external_forces};
-use crate::contact_rows::{ContactRows, contact_rows};
+use crate::contact_rows::{ContactRows, RowStart, contact_rows};
 use crate::cost::{SolveCounts, Timings};
 use crate::coupling::contact_step;
 use crate::dof::EquationKind;
@@ -227,7 +227,7 @@ fn solve_increment_with<const D: usize>(
     // equilibrium takes the normal at the solution itself.
     let row_start = match kind {
         IncrementKind::Static { .. } => None,
-        IncrementKind::Dynamic { .. } => Some(&start.x),
+        IncrementKind::Dynamic { .. } => Some(RowStart::new(model, &start.x)),
     };
     // The solid's rows of the tangent are `c_K K_T`, the mass term `c_M M` (regularising in a
     // static increment, inertial in a dynamic one).
@@ -350,7 +350,7 @@ fn solve_increment_with<const D: usize>(
             model,
             &x,
             &start.orientations,
-            row_start,
+            row_start.as_ref(),
             Some(&previous),
             held,
         )?;
@@ -435,7 +435,7 @@ fn solve_increment_with<const D: usize>(
                         model,
                         &x,
                         &start.orientations,
-                        row_start,
+                        row_start.as_ref(),
                         Some(&previous),
                         &vec![false; n],
                     )?;

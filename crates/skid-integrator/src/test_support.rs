@@ -6,8 +6,8 @@ use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::{RigidBody, Rotation};
 
-use skid_contact::SurfacePoint;
-use skid_contact::surface::AnalyticCylinder;
+use skid_contact::surface::{AnalyticCylinder, RigidSurface};
+use skid_contact::{FacetedCylinder, SurfacePoint};
 
 use crate::loads::Loads;
 use crate::model::{ContactPair, Model, SolidPart};
@@ -73,7 +73,21 @@ pub(crate) fn block_on_free_drum() -> Model<3> {
     })
 }
 
+/// [`block_on_drum`] against a drum of 72 flat facets.
+pub(crate) fn block_on_faceted_drum<const D: usize>() -> Model<D> {
+    let facets = FacetedCylinder::new(0.2, Vector3::z(), 72, 0.0).expect("surface");
+    block_on_surface(Rotation::Axis(Vector3::z()), Box::new(facets))
+}
+
 fn block_on_turning_drum<const D: usize>(rotation: Rotation) -> Model<D> {
+    let cylinder = AnalyticCylinder::new(0.2, Vector3::z()).expect("surface");
+    block_on_surface(rotation, Box::new(cylinder))
+}
+
+fn block_on_surface<const D: usize>(
+    rotation: Rotation,
+    surface: Box<dyn RigidSurface>,
+) -> Model<D> {
     let part = pad_block::<D>([-0.05, 0.2, -0.05], [0.1, 0.05, 0.1], [4, 1, 2]);
     let front = part.mesh.node_sets["ymin"].clone();
     let mut free = [false; D];
@@ -83,7 +97,7 @@ fn block_on_turning_drum<const D: usize>(rotation: Rotation) -> Model<D> {
         name: "pad-drum".into(),
         nodes: front,
         body: 0,
-        surface: Box::new(AnalyticCylinder::new(0.2, Vector3::z()).expect("surface")),
+        surface,
         mu: 0.15,
     };
     Model::new(part, vec![drum], vec![], Loads::default(), vec![pair]).expect("model")
