@@ -506,10 +506,109 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
             percent(r.t_stop_difference),
         );
     }
+    md.push_str(&within_target(records));
     md.push_str(&own_time_step(records));
     md.push_str(&model_change(records));
     let path = out.join(BENCH_MD);
     write_atomic(&path, &md).map_err(|source| BenchError::Write { path, source })
+}
+
+/// The accuracy a level is asked for in [`within_target`]: the sliding deceleration within
+/// this fraction of its reference.
+pub const TARGET_DECELERATION_ERROR: f64 = 1e-3;
+/// The accuracy a level is asked for in [`within_target`]: `e_slide` at most this.
+pub const TARGET_E_SLIDE: f64 = 2e-3;
+
+/// Whether a level reached the error target: it completed, is not a reference (which has no
+/// error of its own) and its deceleration error and e_slide are within
+/// [`TARGET_DECELERATION_ERROR`] and [`TARGET_E_SLIDE`].
+fn meets_target(r: &BenchRecord) -> bool {
+    r.status == "completed"
+        && !r.reference
+        && r.deceleration_error
+            .is_some_and(|e| e <= TARGET_DECELERATION_ERROR)
+        && r.e_slide.is_some_and(|e| e <= TARGET_E_SLIDE)
+}
+
+/// For each case and method, the level of least median wall time among those that reach the
+/// error target ([`meets_target`]), the fastest of a case in bold; a method none of whose
+/// levels does is listed with its most accurate level. The answer to "what does this accuracy
+/// cost", read off the ladder.
+fn within_target(records: &[BenchRecord]) -> String {
+    use crate::format::{percent, show};
+    use std::fmt::Write as _;
+    if !records.iter().any(|r| r.deceleration_error.is_some()) {
+        return String::new();
+    }
+    use crate::format::plain;
+    let mut md = format!(
+        "\n## The cheapest level within the error target\n\nFor each case and method, the \
+         level of least wall time whose deceleration is within {} % and whose e_slide is at \
+         most {} % of its reference (the method's finest level, or the fixed-step one it is \
+         measured against); the fastest of a case in bold. The quasi-static methods answer a \
+         model without the pad's inertia: what that changes is in the last section.\n\n\
+         | case | method | dt [s] | wall [s] | deceleration error [%] | e_slide [%] |\n\
+         |---|---|---|---|---|---|\n",
+        plain(100.0 * TARGET_DECELERATION_ERROR),
+        plain(100.0 * TARGET_E_SLIDE)
+    );
+    let mut cases: Vec<&str> = records.iter().map(|r| r.case.as_str()).collect();
+    cases.dedup();
+    for case in cases {
+        let of_case: Vec<&BenchRecord> = records.iter().filter(|r| r.case == case).collect();
+        let fastest = of_case
+            .iter()
+            .filter(|r| meets_target(r))
+            .map(|r| r.wall_time_s)
+            .fold(f64::INFINITY, f64::min);
+        let mut methods: Vec<&str> = of_case.iter().map(|r| r.method.as_str()).collect();
+        methods.dedup();
+        for method in methods {
+            let levels = of_case.iter().filter(|r| r.method == method);
+            let cheapest = levels
+                .clone()
+                .filter(|r| meets_target(r))
+                .min_by(|a, b| a.wall_time_s.total_cmp(&b.wall_time_s));
+            let line = match cheapest {
+                Some(r) => {
+                    let bold = if r.wall_time_s == fastest { "**" } else { "" };
+                    format!(
+                        "| {case} | {method} | {} | {bold}{:.4}{bold} | {} | {} |",
+                        show(Some(r.dt)),
+                        r.wall_time_s,
+                        percent(r.deceleration_error),
+                        percent(r.e_slide)
+                    )
+                }
+                None => {
+                    let best = levels
+                        .filter(|r| r.status == "completed" && !r.reference)
+                        .min_by(|a, b| {
+                            let worst = |r: &BenchRecord| {
+                                (r.deceleration_error.unwrap_or(f64::INFINITY)
+                                    / TARGET_DECELERATION_ERROR)
+                                    .max(r.e_slide.unwrap_or(f64::INFINITY) / TARGET_E_SLIDE)
+                            };
+                            worst(a).total_cmp(&worst(b))
+                        });
+                    match best {
+                        Some(r) => format!(
+                            "| {case} | {method} | none within the target; most accurate: {} | {:.4} | {} | {} |",
+                            show(Some(r.dt)),
+                            r.wall_time_s,
+                            percent(r.deceleration_error),
+                            percent(r.e_slide)
+                        ),
+                        None => format!(
+                            "| {case} | {method} | no completed level with an error | | | |"
+                        ),
+                    }
+                }
+            };
+            let _ = writeln!(md, "{line}");
+        }
+    }
+    md
 }
 
 /// The cases at their own time step (`dt_factor` 1), method by method, with the sum of their
@@ -615,6 +714,72 @@ mod tests {
         assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
         assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
         assert!(median(&[]).is_nan());
+    }
+
+    /// A completed level of case `a` with the given errors and wall time.
+    fn level(method: &str, dt: f64, wall: f64, errors: Option<(f64, f64)>) -> BenchRecord {
+        BenchRecord {
+            case: "a".into(),
+            method: method.into(),
+            dt,
+            dt_factor: None,
+            status: "completed".into(),
+            wall_time_s: wall,
+            wall_times_s: vec![wall],
+            assembly_s: 0.0,
+            linear_solve_s: 0.0,
+            contact_solve_s: 0.0,
+            increments: 1,
+            newton_iterations: 1,
+            contact_fallbacks: 0,
+            t_stop: Some(0.1),
+            deceleration: Some(600.0),
+            deceleration_error: Some(errors.map_or(0.0, |e| e.0)),
+            e_slide: Some(errors.map_or(0.0, |e| e.1)),
+            t_stop_difference: Some(0.0),
+            reference: errors.is_none(),
+        }
+    }
+
+    /// Of the levels within the error target, the cheapest of each method is listed, the
+    /// fastest of the case in bold; neither a reference (no error of its own) nor a level over
+    /// either limit counts, and a method with no level within the target shows its most
+    /// accurate one.
+    #[test]
+    fn cheapest_level_within_the_error_target() {
+        let records = [
+            level("case", 4e-4, 0.02, Some((2e-3, 1e-3))),
+            level("case", 2e-4, 0.05, Some((5e-4, 1e-3))),
+            level("case", 1e-4, 0.1, Some((1e-4, 5e-4))),
+            level("case", 5e-5, 0.2, None),
+            level("global", 4e-4, 0.03, Some((3e-3, 1e-3))),
+            level("global", 2e-4, 0.06, Some((2e-3, 4e-3))),
+            level("global", 1e-4, 0.001, None),
+            level("quasi-static-adaptive", 1e-3, 0.01, Some((1e-8, 9e-4))),
+        ];
+        let md = within_target(&records);
+        let rows: Vec<&str> = md.lines().filter(|l| l.starts_with("| a |")).collect();
+        assert_eq!(rows.len(), 3, "{md}");
+        assert!(
+            rows[0].starts_with("| a | case | 2.000e-4 | 0.0500 |"),
+            "{md}"
+        );
+        assert!(
+            rows[1].starts_with("| a | global | none within the target; most accurate: 2.000e-4 |"),
+            "{md}"
+        );
+        assert!(
+            rows[2].starts_with("| a | quasi-static-adaptive | 0.001000 | **0.0100** |"),
+            "{md}"
+        );
+        assert!(
+            md.contains("within 0.1 %") && md.contains("at most 0.2 %"),
+            "{md}"
+        );
+        // a bench of one level has no errors and no such section
+        let mut own = level("case", 1e-4, 0.1, None);
+        own.deceleration_error = None;
+        assert!(within_target(&[own]).is_empty());
     }
 
     /// `2d-analytic` with 10 ms of spin-down, and its file name.
