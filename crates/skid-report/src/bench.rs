@@ -821,12 +821,16 @@ mod tests {
         assert!(coarse.wall_times_s.len() == 3 && coarse.wall_time_s > 0.0);
         write_bench_report(&records, dir.path()).expect("report");
         let md = std::fs::read_to_string(dir.path().join(BENCH_MD)).expect("bench.md");
-        assert_eq!(
-            md.lines()
+        // a row per level in the table, and one for the method in the error-target section
+        let rows = |text: &str| {
+            text.lines()
                 .filter(|l| l.starts_with("| 2d-analytic"))
-                .count(),
-            2
-        );
+                .count()
+        };
+        let (table, target) = md
+            .split_once("## The cheapest level within the error target")
+            .expect("error-target section");
+        assert_eq!((rows(table), rows(target)), (2, 1), "{md}");
         assert!(dir.path().join(crate::plot::WORK_PRECISION_SVG).is_file());
         let written: Vec<BenchRecord> = serde_json::from_str(
             &std::fs::read_to_string(dir.path().join(BENCH_JSON)).expect("bench.json"),
