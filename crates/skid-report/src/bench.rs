@@ -580,34 +580,25 @@ fn within_target(records: &[BenchRecord]) -> String {
                 .clone()
                 .filter(|r| meets_target(r))
                 .min_by(|a, b| a.wall_time_s.total_cmp(&b.wall_time_s));
-            let line = match cheapest {
-                Some(r) => {
-                    let bold = if r.wall_time_s == fastest { "**" } else { "" };
+            let shown = cheapest.map(|r| (r, "")).or_else(|| {
+                levels
+                    .filter(|r| is_measured(r))
+                    .min_by(|a, b| target_ratio(a).total_cmp(&target_ratio(b)))
+                    .map(|r| (r, "none within the target; most accurate: "))
+            });
+            let line = match shown {
+                Some((r, note)) => {
+                    let fastest = meets_target(r) && r.wall_time_s == fastest;
+                    let bold = if fastest { "**" } else { "" };
                     format!(
-                        "| {case} | {method} | {} | {bold}{:.4}{bold} | {} | {} |",
+                        "| {case} | {method} | {note}{} | {bold}{:.4}{bold} | {} | {} |",
                         show(Some(r.dt)),
                         r.wall_time_s,
                         percent(r.deceleration_error),
                         percent(r.e_slide)
                     )
                 }
-                None => {
-                    let best = levels
-                        .filter(|r| is_measured(r))
-                        .min_by(|a, b| target_ratio(a).total_cmp(&target_ratio(b)));
-                    match best {
-                        Some(r) => format!(
-                            "| {case} | {method} | none within the target; most accurate: {} | {:.4} | {} | {} |",
-                            show(Some(r.dt)),
-                            r.wall_time_s,
-                            percent(r.deceleration_error),
-                            percent(r.e_slide)
-                        ),
-                        None => format!(
-                            "| {case} | {method} | no completed level with an error | | | |"
-                        ),
-                    }
-                }
+                None => format!("| {case} | {method} | no completed level with an error | | | |"),
             };
             let _ = writeln!(md, "{line}");
         }
