@@ -5,6 +5,8 @@
 //! effective tangent has the form `K_eff = c_K K_T + diag(c_M m)` (HHT: `c_K = 1 + alpha`,
 //! `c_M = 1/(beta h^2)`); equations held fixed in a step get an identity row and column.
 
+use std::time::{Duration, Instant};
+
 use faer::sparse::SparseColMatRef;
 use nalgebra::{DVector, SVector};
 use skid_fem::error::FemError;
@@ -153,6 +155,8 @@ pub struct Assembler {
     mixed: MixedPressures,
     /// Numeric factorizations of the tangent so far.
     pub factorizations: usize,
+    /// Their wall time.
+    pub factorization_time: Duration,
 }
 
 impl Assembler {
@@ -196,6 +200,7 @@ impl Assembler {
             responses: vec![ElementResponse::default(); elements],
             mixed: MixedPressures::new(elements),
             factorizations: 0,
+            factorization_time: Duration::ZERO,
         })
     }
 
@@ -341,8 +346,11 @@ impl Assembler {
     /// [`IncrementFailure::LinearSolve`] if it is not positive definite.
     pub fn factorize(&mut self) -> Result<Factorization, IncrementFailure> {
         self.factorizations += 1;
+        let clock = Instant::now();
         self.pattern.compress(&self.values, &mut self.compressed)?;
-        self.pattern.factorize(&self.compressed)
+        let factor = self.pattern.factorize(&self.compressed);
+        self.factorization_time += clock.elapsed();
+        factor
     }
 
     /// Runs `solve` (which factorizes the current matrix) on `K + c_k M` (the current values

@@ -10,8 +10,15 @@ pub struct Timings {
     pub assembly: Duration,
     /// Numeric factorizations and triangular solves (including the Delassus operator).
     pub linear_solve: Duration,
-    /// Conic (clarabel) solves and their fixed point.
+    /// Of `linear_solve`: the numeric factorizations of every kind.
+    #[serde(default)]
+    pub factorization: Duration,
+    /// Exact Coulomb solves of the reduced contact path (semismooth Newton, and the conic
+    /// solves behind it).
     pub contact_solve: Duration,
+    /// The observer: history and field output and restart files of converged increments.
+    #[serde(default)]
+    pub output: Duration,
 }
 
 /// Factorizations and iterative solves of the linear systems.
@@ -29,6 +36,11 @@ pub struct SolveCounts {
 }
 
 impl SolveCounts {
+    /// Factorizations of every kind.
+    pub fn factorizations(&self) -> usize {
+        self.tangent_factorizations + self.lu_factorizations + self.preconditioner_factorizations
+    }
+
     /// Adds the work done between the snapshots `before` and `after` of a workspace's counts.
     pub fn add_between(&mut self, before: &Self, after: &Self) {
         self.tangent_factorizations += after.tangent_factorizations - before.tangent_factorizations;

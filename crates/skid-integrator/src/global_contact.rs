@@ -63,6 +63,7 @@
 //! structure) are computed once and reused for as long as that does not change.
 
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use faer::Conj;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -250,6 +251,8 @@ pub struct GlobalContactSolver {
     /// Its factorizations and GMRES iterations so far (the tangent's factorizations are the
     /// assembler's).
     pub counts: SolveCounts,
+    /// The wall time of its numeric factorizations so far.
+    pub factorization_time: Duration,
 }
 
 impl Default for GlobalContactSolver {
@@ -270,6 +273,7 @@ impl Default for GlobalContactSolver {
             order: None,
             analyses: 0,
             counts: SolveCounts::default(),
+            factorization_time: Duration::ZERO,
         }
     }
 }
@@ -550,7 +554,10 @@ impl GlobalContactSolver {
         self.counts.lu_factorizations += 1;
         let (pairs, values) = system.entries();
         let matrix = self.assemble(dim, pairs, &values)?;
-        self.factorize(matrix.as_ref())?;
+        let clock = Instant::now();
+        let factorized = self.factorize(matrix.as_ref());
+        self.factorization_time += clock.elapsed();
+        factorized?;
         let factors = self.factors.as_ref().ok_or_else(|| {
             IncrementFailure::linear(SYSTEM, LinearFailure::Structure("not factorized".into()))
         })?;
@@ -610,11 +617,16 @@ impl GlobalContactSolver {
         };
         for &precision in precisions {
             self.counts.preconditioner_factorizations += 1;
-            if self
-                .quasi_definite
-                .factorize(symbolic, values, system.equations(), order, precision)
-                .is_err()
-            {
+            let clock = Instant::now();
+            let factorized = self.quasi_definite.factorize(
+                symbolic,
+                values,
+                system.equations(),
+                order,
+                precision,
+            );
+            self.factorization_time += clock.elapsed();
+            if factorized.is_err() {
                 continue;
             }
             let preconditioner = &self.quasi_definite;

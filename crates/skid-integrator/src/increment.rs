@@ -36,7 +36,7 @@
 //! `F = H^T p` and action equals reaction. Their rate is the mean one, `v = (x - x_n)/h`,
 //! `a = 0`. The regularisation and the mass shift use the solid's density all the same.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use nalgebra::{DVector, Vector2};
 use skid_contact::SurfacePoint;
@@ -148,6 +148,11 @@ impl Workspace {
             tangent_factorizations: self.assembler.factorizations,
             ..self.global.counts
         }
+    }
+
+    /// The wall time of this workspace's numeric factorizations so far.
+    pub fn factorization_time(&self) -> Duration {
+        self.assembler.factorization_time + self.global.factorization_time
     }
 }
 

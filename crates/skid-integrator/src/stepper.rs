@@ -871,23 +871,38 @@ struct Run<'a, const D: usize> {
 }
 
 impl<const D: usize> Run<'_, D> {
+    /// Hands the observer the converged increment `report`; the time it takes is added to
+    /// `output`.
+    fn report(
+        &mut self,
+        report: &IncrementReport<'_>,
+        output: &mut Duration,
+    ) -> Result<(), RunError> {
+        let clock = Instant::now();
+        let written = self.observer.on_increment(self.model, report);
+        *output += clock.elapsed();
+        Ok(written?)
+    }
+
     /// Hands the observer a checkpoint if it wants one after the increment just reported,
     /// made by `make` from the workspace; a checkpoint ends the reuse of the global solver's
     /// quasi-definite factors (see [`GlobalContactSolver::forget_preconditioner`]), so that the
-    /// run goes on as one resumed from it would.
+    /// run goes on as one resumed from it would. Returns the time the observer took with it
+    /// (the checkpoint's own statistics cannot hold that).
     fn offer_checkpoint(
         &mut self,
         boundary: bool,
         workspace: &mut Workspace,
         make: impl FnOnce(&Workspace) -> Checkpoint,
-    ) -> Result<(), RunError> {
+    ) -> Result<Duration, RunError> {
+        let clock = Instant::now();
         if self.observer.wants_checkpoint(boundary) {
             let mut checkpoint = make(workspace);
             checkpoint.statistics.wall_time = self.earlier + self.clock.elapsed();
             self.observer.on_checkpoint(self.model, &checkpoint)?;
             workspace.global.forget_preconditioner();
         }
-        Ok(())
+        Ok(clock.elapsed())
     }
 
     /// The steps from the start, or from `checkpoint`.
@@ -938,8 +953,7 @@ impl<const D: usize> Run<'_, D> {
         let mut workspace = Workspace { assembler, global };
         if checkpoint.is_none() {
             let none = IncrementCounters::default();
-            self.observer.on_increment(
-                model,
+            self.report(
                 &IncrementReport {
                     step: "initial",
                     dynamic: false,
@@ -948,14 +962,16 @@ impl<const D: usize> Run<'_, D> {
                     state: &state,
                     counters: &none,
                 },
+                &mut stats.timings.output,
             )?;
-            self.offer_checkpoint(true, &mut workspace, |workspace| Checkpoint {
-                state: state.clone(),
-                step: 0,
-                position: None,
-                statistics: stats.clone(),
-                solver: SolverMemory::of(workspace),
-            })?;
+            stats.timings.output +=
+                self.offer_checkpoint(true, &mut workspace, |workspace| Checkpoint {
+                    state: state.clone(),
+                    step: 0,
+                    position: None,
+                    statistics: stats.clone(),
+                    solver: SolverMemory::of(workspace),
+                })?;
         }
         for (index, step) in steps.iter().enumerate().skip(first_step) {
             let at = position.take();
@@ -1077,7 +1093,7 @@ impl<const D: usize> Run<'_, D> {
                 .iter()
                 .map(|(eq, motion)| (*eq, motion.at(&instant)))
                 .collect();
-            let before = workspace.counts();
+            let (before, factorizing) = (workspace.counts(), workspace.factorization_time());
             let solved = solve_increment(
                 model,
                 workspace,
@@ -1088,6 +1104,7 @@ impl<const D: usize> Run<'_, D> {
                 &mut stats.timings,
             );
             stats.solves.add_between(&before, &workspace.counts());
+            stats.timings.factorization += workspace.factorization_time() - factorizing;
             stats.steps[index]
                 .solves
                 .add_between(&before, &workspace.counts());
@@ -1122,8 +1139,7 @@ impl<const D: usize> Run<'_, D> {
                     let cost = &mut stats.steps[index];
                     cost.increments += 1;
                     cost.newton_iterations += counters.newton_iterations;
-                    self.observer.on_increment(
-                        model,
+                    self.report(
                         &IncrementReport {
                             step: &step.name,
                             dynamic: matches!(step.kind, StepKind::Dynamic { .. }),
@@ -1132,6 +1148,7 @@ impl<const D: usize> Run<'_, D> {
                             state: &state,
                             counters: &counters,
                         },
+                        &mut stats.timings.output,
                     )?;
                     consecutive_failures = 0;
                     successes += 1;
@@ -1149,23 +1166,25 @@ impl<const D: usize> Run<'_, D> {
                         successes = 0;
                     }
                     stats.steps[index].wall_time = spent + started.elapsed();
-                    self.offer_checkpoint(progress >= 1.0 - 1e-12, workspace, |workspace| {
-                        Checkpoint {
-                            state: state.clone(),
-                            step: index,
-                            position: Some(StepPosition {
-                                start_load_factor: lambda0,
-                                start_time: t0,
-                                progress,
-                                size,
-                                successes,
-                                increment,
-                                adaptive: adaptive.as_ref().map(AdaptiveRun::memory),
-                            }),
-                            statistics: stats.clone(),
-                            solver: SolverMemory::of(workspace),
-                        }
-                    })?;
+                    let output =
+                        self.offer_checkpoint(progress >= 1.0 - 1e-12, workspace, |workspace| {
+                            Checkpoint {
+                                state: state.clone(),
+                                step: index,
+                                position: Some(StepPosition {
+                                    start_load_factor: lambda0,
+                                    start_time: t0,
+                                    progress,
+                                    size,
+                                    successes,
+                                    increment,
+                                    adaptive: adaptive.as_ref().map(AdaptiveRun::memory),
+                                }),
+                                statistics: stats.clone(),
+                                solver: SolverMemory::of(workspace),
+                            }
+                        })?;
+                    stats.timings.output += output;
                 }
                 Err(cause) => {
                     stats.steps[index].wall_time = spent + started.elapsed();

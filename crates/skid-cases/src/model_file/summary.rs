@@ -47,8 +47,12 @@ pub struct RunCost {
     pub assembly_s: f64,
     /// Of which: factorizations and solves, s.
     pub linear_solve_s: f64,
-    /// Of which: conic solves, s.
+    /// Of `linear_solve_s`: the numeric factorizations of every kind, s.
+    pub factorization_s: f64,
+    /// Of which: the exact Coulomb solves of the reduced contact path, s.
     pub contact_solve_s: f64,
+    /// Of which: history and field output and restart files, s.
+    pub output_s: f64,
     /// The cost of each step reached, in order.
     pub steps: Vec<StepCost>,
 }
@@ -91,7 +95,9 @@ impl From<&RunStatistics> for RunCost {
             wall_time_s: stats.wall_time.as_secs_f64(),
             assembly_s: stats.timings.assembly.as_secs_f64(),
             linear_solve_s: stats.timings.linear_solve.as_secs_f64(),
+            factorization_s: stats.timings.factorization.as_secs_f64(),
             contact_solve_s: stats.timings.contact_solve.as_secs_f64(),
+            output_s: stats.timings.output.as_secs_f64(),
             steps: stats
                 .steps
                 .iter()
@@ -99,9 +105,7 @@ impl From<&RunStatistics> for RunCost {
                     step: s.name.clone(),
                     increments: s.increments,
                     newton_iterations: s.newton_iterations,
-                    factorizations: s.solves.tangent_factorizations
-                        + s.solves.lu_factorizations
-                        + s.solves.preconditioner_factorizations,
+                    factorizations: s.solves.factorizations(),
                     krylov_iterations: s.solves.krylov_iterations,
                     wall_time_s: s.wall_time.as_secs_f64(),
                 })
