@@ -22,6 +22,7 @@
 //! - [`fingerprint`]: the hash that tells whether a file is the one a restart was made with;
 //! - [`sweep`]: parameter sweeps over the fields of a case, model file or deck;
 //! - [`batch`]: running many cases in parallel, sweeps expanded, one shard of them or all;
+//! - [`peak_memory`]: the peak resident memory of this process, and of one piece of work;
 //! - [`check`]: reading and building an input without running it;
 //! - [`reference`]: the JSON Schemas of case and model files and their markdown reference,
 //!   generated from the types;
@@ -42,6 +43,7 @@ pub mod history;
 pub mod model_file;
 pub mod model_spec;
 pub mod newton;
+pub mod peak_memory;
 pub mod reference;
 pub mod restart;
 pub mod runner;

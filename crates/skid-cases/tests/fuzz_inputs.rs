@@ -66,21 +66,6 @@ fn seeds(dirs: &[&str]) -> Vec<(PathBuf, String)> {
     files
 }
 
-/// Resets the peak resident memory of this process to its current resident memory (Linux
-/// `clear_refs` code 5), so that [`peak_memory`] afterwards measures one input, not the
-/// largest of all inputs so far; where it cannot, the peak stays cumulative (stricter).
-fn reset_peak_memory() {
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
-
-/// Peak resident memory of this process, bytes (`VmHWM` of `/proc/self/status`), where known.
-fn peak_memory() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find_map(|l| l.strip_prefix("VmHWM:"))?;
-    let kib: u64 = line.trim().strip_suffix("kB")?.trim().parse().ok()?;
-    Some(kib * 1024)
-}
-
 /// Runs `property` on `cases` inputs of `strategy` (`PROPTEST_CASES`, else [`DEFAULT_CASES`]),
 /// failures kept in `regressions`, and checks time and memory after each input; prints the
 /// count of inputs tried (shrinking included) for `scripts/fuzz.sh`.
@@ -103,12 +88,13 @@ fn fuzz<S: Strategy>(
     let mut runner = TestRunner::new(config);
     let result = runner.run(&strategy, |input| {
         tried.fetch_add(1, Ordering::Relaxed);
-        reset_peak_memory();
+        // where the peak cannot be reset it stays the largest so far (stricter)
+        skid_cases::peak_memory::reset();
         let start = Instant::now();
         property(input)?;
         let elapsed = start.elapsed();
         prop_assert!(elapsed < TIME_LIMIT, "took {elapsed:?}");
-        if let Some(peak) = peak_memory() {
+        if let Some(peak) = skid_cases::peak_memory::read() {
             prop_assert!(peak < MEMORY_LIMIT, "peak memory {peak} B");
         }
         Ok(())

@@ -19,8 +19,9 @@
 //!
 //! A run shorter than [`REPEAT_BELOW_S`] is run once more as a warm-up and then `repeats`
 //! times, and its wall time is the median (the solver's own wall time, without process start
-//! or output of the report). The record keeps every measured time and the split of the median
-//! run into assembly, linear solves and contact solves.
+//! or output of the report). The record keeps every measured time, the split of the median
+//! run into assembly, linear solves (of which factorizations), contact solves and output, its
+//! factorizations, and the largest peak resident memory of the level's runs.
 
 use std::path::{Path, PathBuf};
 
@@ -28,12 +29,16 @@ use serde::{Deserialize, Serialize};
 
 use crate::{ReportError, e_slide, load_run};
 use skid_cases::atomic::write_atomic;
+use skid_cases::peak_memory;
 use skid_cases::runner::run_case_with;
 use skid_cases::schema::{AdaptiveSpec, Case, ContactSolveSpec, StepSpec};
 use skid_cases::validate::CaseError;
 
 /// Runs shorter than this (s) are repeated and their median taken.
 pub const REPEAT_BELOW_S: f64 = 2.0;
+
+/// Bytes per MB of [`BenchRecord::peak_memory_mb`] (MiB, as `scripts/scaling.py` counts).
+const MB: f64 = 1_048_576.0;
 
 /// File name of the bench records in the output directory.
 pub const BENCH_JSON: &str = "bench.json";
@@ -179,12 +184,27 @@ pub struct BenchRecord {
     pub assembly_s: f64,
     /// Of the median run: factorizations and solves, s.
     pub linear_solve_s: f64,
+    /// Of the median run: of `linear_solve_s`, the numeric factorizations, s (absent in
+    /// records written before it was kept).
+    #[serde(default)]
+    pub factorization_s: Option<f64>,
     /// Of the median run: conic and dense Coulomb solves, s.
     pub contact_solve_s: f64,
+    /// Of the median run: history and field output, s (absent in older records).
+    #[serde(default)]
+    pub output_s: Option<f64>,
+    /// The largest peak resident memory of the level's runs, MB: the bench process's, reset
+    /// before each run (see [`skid_cases::peak_memory::during`]), so it includes the process's
+    /// own baseline; absent where the peak cannot be reset (outside Linux) and in older records.
+    #[serde(default)]
+    pub peak_memory_mb: Option<f64>,
     /// Converged increments.
     pub increments: usize,
     /// Newton iterations.
     pub newton_iterations: usize,
+    /// Numeric factorizations of every kind (absent in older records).
+    #[serde(default)]
+    pub factorizations: Option<usize>,
     /// Increments the global contact solve handed to the reduced one.
     pub contact_fallbacks: usize,
     /// Stop time, s.
@@ -326,13 +346,20 @@ pub fn run_bench(
                     .join(label)
                     .join(k.to_string());
                 // no restart files: the wall times are the solver's
-                let mut summary = run_case_with(&level, source, &dir, 0)?;
+                let mut peak: Option<u64> = None;
+                let mut run = || {
+                    let (summary, bytes) =
+                        peak_memory::during(|| run_case_with(&level, source, &dir, 0));
+                    peak = peak.max(bytes);
+                    summary
+                };
+                let mut summary = run()?;
                 let mut times = vec![summary.cost.wall_time_s];
                 if summary.cost.wall_time_s < REPEAT_BELOW_S {
                     times.clear();
                     let mut timed = Vec::new();
                     for _ in 0..settings.repeats {
-                        let s = run_case_with(&level, source, &dir, 0)?;
+                        let s = run()?;
                         times.push(s.cost.wall_time_s);
                         timed.push(s);
                     }
@@ -355,9 +382,17 @@ pub fn run_bench(
                     wall_times_s: times,
                     assembly_s: summary.cost.assembly_s,
                     linear_solve_s: summary.cost.linear_solve_s,
+                    factorization_s: Some(summary.cost.factorization_s),
                     contact_solve_s: summary.cost.contact_solve_s,
+                    output_s: Some(summary.cost.output_s),
+                    peak_memory_mb: peak.map(|bytes| bytes as f64 / MB),
                     increments: summary.cost.increments,
                     newton_iterations: summary.cost.newton_iterations,
+                    factorizations: Some(
+                        summary.cost.tangent_factorizations
+                            + summary.cost.lu_factorizations
+                            + summary.cost.preconditioner_factorizations,
+                    ),
                     contact_fallbacks: summary.cost.contact_fallbacks,
                     t_stop: summary.t_stop,
                     deceleration: summary.deceleration,
@@ -471,7 +506,11 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
          Errors against the reference: the deceleration (relative), e_slide (max |omega - \
          omega_ref| / omega0 over t <= 0.9 t_stop) and t_stop (relative; the pad vibration \
          left at the stop moves it by up to 1 %, DRUM.md 2.2, so differences inside that band \
-         are not discretisation errors).\n\n",
+         are not discretisation errors). The time split is the median run's (the factorizations \
+         are a part of the linear solves; output: the history written at every increment); \
+         peak memory is the largest peak resident memory of the level's runs, the bench \
+         process's with its peak reset before each run, so it includes the process's own \
+         baseline.\n\n",
     );
     let _ = writeln!(
         md,
@@ -479,14 +518,15 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
         crate::plot::WORK_PRECISION_SVG
     );
     md.push_str(
-        "| case | method | dt [s] | status | wall [s] | runs | assembly / linear / contact [s] | increments | Newton iterations | fallbacks | deceleration [rad/s^2] | deceleration error [%] | e_slide [%] | t_stop [s] | t_stop difference [%] |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| case | method | dt [s] | status | wall [s] | runs | assembly / linear (factorization) / contact / output [s] | peak memory [MB] | increments | Newton iterations | factorizations | fallbacks | deceleration [rad/s^2] | deceleration error [%] | e_slide [%] | t_stop [s] | t_stop difference [%] |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
+    let seconds = |t: Option<f64>| t.map_or_else(|| "n/a".into(), |t| format!("{t:.3}"));
     for r in records {
         let reference = if r.reference { " (reference)" } else { "" };
         let _ = writeln!(
             md,
-            "| {} | {} | {}{reference} | {} | {:.4} | {} | {:.3} / {:.3} / {:.3} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {}{reference} | {} | {:.4} | {} | {:.3} / {:.3} ({}) / {:.3} / {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.case,
             r.method,
             show(Some(r.dt)),
@@ -495,9 +535,15 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
             r.wall_times_s.len(),
             r.assembly_s,
             r.linear_solve_s,
+            seconds(r.factorization_s),
             r.contact_solve_s,
+            seconds(r.output_s),
+            r.peak_memory_mb
+                .map_or_else(|| "n/a".into(), |mb| format!("{mb:.0}")),
             r.increments,
             r.newton_iterations,
+            r.factorizations
+                .map_or_else(|| "n/a".into(), |f| f.to_string()),
             r.contact_fallbacks,
             show(r.deceleration),
             percent(r.deceleration_error),
@@ -723,9 +769,13 @@ mod tests {
             wall_times_s: vec![wall],
             assembly_s: 0.0,
             linear_solve_s: 0.0,
+            factorization_s: None,
             contact_solve_s: 0.0,
+            output_s: None,
+            peak_memory_mb: None,
             increments: 1,
             newton_iterations: 1,
+            factorizations: None,
             contact_fallbacks: 0,
             t_stop: Some(0.1),
             deceleration: Some(600.0),
@@ -814,6 +864,22 @@ mod tests {
         assert_eq!(fine.deceleration_error, Some(0.0));
         assert!(coarse.deceleration_error.is_some_and(|e| e > 0.0));
         assert!(coarse.wall_times_s.len() == 3 && coarse.wall_time_s > 0.0);
+        for r in &records {
+            // the split is of the median run, whose wall time it cannot exceed
+            let factorization = r.factorization_s.expect("factorization time");
+            let output = r.output_s.expect("output time");
+            assert!(
+                factorization > 0.0 && factorization <= r.linear_solve_s,
+                "{r:?}"
+            );
+            let parts = r.assembly_s + r.linear_solve_s + r.contact_solve_s + output;
+            assert!(output > 0.0 && parts <= r.wall_time_s, "{r:?}");
+            assert!(r.factorizations.is_some_and(|f| f >= 1), "{r:?}");
+            if cfg!(target_os = "linux") {
+                // the bench process's code and data alone take more than a megabyte
+                assert!(r.peak_memory_mb.is_some_and(|mb| mb > 1.0), "{r:?}");
+            }
+        }
         write_bench_report(&records, dir.path()).expect("report");
         let md = std::fs::read_to_string(dir.path().join(BENCH_MD)).expect("bench.md");
         // a row per level in the table, and one for the method in the error-target section
