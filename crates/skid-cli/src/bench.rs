@@ -25,16 +25,17 @@ pub fn run(cases: &[PathBuf], settings: &BenchSettings, out: &Path) -> ExitCode 
         }
     }
     let terminal = std::io::stderr().is_terminal();
-    let total = loaded.len() * settings.levels * settings.methods.len();
+    let total = loaded.len() * (settings.levels + settings.meshes) * settings.methods.len();
     let mut done = 0;
     let progress = |r: &skid_report::bench::BenchRecord| {
         done += 1;
         if terminal {
             eprintln!(
-                "[{done}/{total}] {} {} dt {:.3e}: {} in {:.3} s ({} runs)",
+                "[{done}/{total}] {} {} dt {:.3e}, pad {}: {} in {:.3} s ({} runs)",
                 r.case,
                 r.method,
                 r.dt,
+                r.pad_mesh.as_deref().unwrap_or("?"),
                 r.status,
                 r.wall_time_s,
                 r.wall_times_s.len()

@@ -150,8 +150,9 @@ enum Command {
         out: Option<PathBuf>,
     },
     /// Cost against error: each case at a ladder of time steps (coarser than the case, the
-    /// case, then finer) with each contact solve, errors against the finest level; writes
-    /// <out>/bench.json, <out>/bench.md and <out>/work-precision.svg.
+    /// case, then finer) and, with --meshes, of pad meshes, with each contact solve, errors
+    /// against the finest level of each ladder; writes <out>/bench.json, <out>/bench.md and
+    /// <out>/work-precision.svg (with --meshes also <out>/work-precision-mesh.svg).
     Bench {
         /// Case files (JSON).
         #[arg(required = true)]
@@ -180,6 +181,11 @@ enum Command {
         /// one (case, quasi-static) where that is listed before it.
         #[arg(long, value_delimiter = ',', default_value = "reduced,global")]
         methods: Vec<String>,
+        /// Pad-mesh levels per case and method, at the case's own time step (0: none, at most
+        /// 4): the case's pad, then each level with twice the last's elements in every
+        /// direction; errors against the finest.
+        #[arg(long, default_value_t = 0)]
+        meshes: usize,
     },
     /// Check case files, model files, decks and sweep files without running them: each (each
     /// run of a sweep) is read, validated and built into its model (mesh, bodies, contact
@@ -293,6 +299,7 @@ fn main() -> ExitCode {
             coarser,
             repeats,
             methods,
+            meshes,
         } => {
             let mut solves = Vec::new();
             for method in &methods {
@@ -310,6 +317,7 @@ fn main() -> ExitCode {
                 coarser,
                 repeats,
                 methods: solves,
+                meshes,
             };
             bench::run(&cases, &settings, &out)
         }

@@ -40,6 +40,34 @@ pub const REPEAT_BELOW_S: f64 = 2.0;
 /// Bytes per MB of [`BenchRecord::peak_memory_mb`] (MiB, as `scripts/scaling.py` counts).
 const MB: f64 = 1_048_576.0;
 
+/// Ratio of the element counts of successive pad-mesh levels, in every direction.
+pub const MESH_RATIO: usize = 2;
+
+/// Most pad-mesh levels of a bench: the fourth 3D level has 512 times the elements of the
+/// case's pad (70,000 equations from the 10 x 1 x 1 benchmark pad).
+pub const MAX_MESH_LEVELS: usize = 4;
+
+/// Which resolution a ladder of levels refines.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Ladder {
+    /// The time step of the dynamic steps, on the case's pad.
+    #[default]
+    TimeStep,
+    /// The pad mesh, at the case's own time step.
+    PadMesh,
+}
+
+impl Ladder {
+    /// How the report names it.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::TimeStep => "time step",
+            Self::PadMesh => "pad mesh",
+        }
+    }
+}
+
 /// File name of the bench records in the output directory.
 pub const BENCH_JSON: &str = "bench.json";
 
@@ -57,6 +85,10 @@ pub struct BenchSettings {
     pub repeats: usize,
     /// The methods to compare.
     pub methods: Vec<BenchMethod>,
+    /// Pad-mesh levels per case and method at the case's own time step (0: none): the case's
+    /// pad, then each level's element counts [`MESH_RATIO`] times the last's in every
+    /// direction, the finest being the reference (at most [`MAX_MESH_LEVELS`]).
+    pub meshes: usize,
 }
 
 impl Default for BenchSettings {
@@ -67,6 +99,7 @@ impl Default for BenchSettings {
             coarser: 2,
             repeats: 5,
             methods: vec![BenchMethod::Reduced, BenchMethod::Global],
+            meshes: 0,
         }
     }
 }
@@ -174,6 +207,15 @@ pub struct BenchRecord {
     /// `dt` over the case's own time step (absent in records written before it was kept).
     #[serde(default)]
     pub dt_factor: Option<f64>,
+    /// The ladder the level belongs to (time step in older records).
+    #[serde(default)]
+    pub ladder: Ladder,
+    /// The pad's elements, `circumferential x radial [x axial]` (absent in older records).
+    #[serde(default)]
+    pub pad_mesh: Option<String>,
+    /// The model's equations (absent in older records).
+    #[serde(default)]
+    pub equations: Option<usize>,
     /// `"completed"` or `"failed"`.
     pub status: String,
     /// Median wall time, s.
@@ -278,6 +320,19 @@ pub fn level_case(case: &Case, factor: f64, method: BenchMethod) -> Case {
     case
 }
 
+/// The case with its pad's element counts multiplied by `factor` in every direction (the
+/// axial one in 3D only).
+pub fn mesh_case(case: &Case, factor: usize) -> Case {
+    let mut case = case.clone();
+    let elements = &mut case.pad.elements;
+    elements.circumferential *= factor;
+    elements.radial *= factor;
+    if case.dimension == 3 {
+        elements.axial *= factor;
+    }
+    case
+}
+
 /// The median of `values` (the mean of the middle two for an even count); `NaN` if empty.
 pub fn median(values: &[f64]) -> f64 {
     let mut sorted = values.to_vec();
@@ -297,8 +352,9 @@ fn base_dt(case: &Case) -> Option<f64> {
         .reduce(f64::min)
 }
 
-/// Runs the ladder of every case (`(case, source file)`) into `out/runs/<case>/<method>/<k>`,
-/// calling `progress` with a line per level, and writes `out/bench.json`.
+/// Runs the ladders of every case (`(case, source file)`) into `out/runs/<case>/<method>/<k>`
+/// (the pad-mesh ladder's levels into `.../mesh-<k>`), calling `progress` with a line per
+/// level, and writes `out/bench.json`.
 ///
 /// # Errors
 /// [`BenchError`] for bad settings, a case that cannot be built or outputs that cannot be
@@ -323,6 +379,14 @@ pub fn run_bench(
             "expected at least one repeat and one contact solve".into(),
         ));
     }
+    if settings.meshes > MAX_MESH_LEVELS {
+        return Err(BenchError::Settings(format!(
+            "expected at most {MAX_MESH_LEVELS} pad-mesh levels (each has {} times the \
+             elements of the last in 3D), got {}",
+            MESH_RATIO.pow(3),
+            settings.meshes
+        )));
+    }
     let mut records = Vec::new();
     for (case, source) in cases {
         let Some(dt) = base_dt(case) else {
@@ -334,96 +398,57 @@ pub fn run_bench(
         let mut finest: Vec<(BenchMethod, PathBuf, BenchRecord)> = Vec::new();
         for &method in &settings.methods {
             let label = method.label();
+            let dir = out.join("runs").join(&case.name).join(label);
             let mut runs = Vec::new();
             for k in 0..settings.levels {
                 let exponent = i32::try_from(settings.coarser).unwrap_or(i32::MAX)
                     - i32::try_from(k).unwrap_or(i32::MAX);
                 let factor = settings.ratio.powi(exponent);
                 let level = level_case(case, factor, method);
-                let dir = out
-                    .join("runs")
-                    .join(&case.name)
-                    .join(label)
-                    .join(k.to_string());
-                // no restart files: the wall times are the solver's
-                let mut peak: Option<u64> = None;
-                let mut run = || {
-                    let (summary, bytes) =
-                        peak_memory::during(|| run_case_with(&level, source, &dir, 0));
-                    peak = peak.max(bytes);
-                    summary
-                };
-                let mut summary = run()?;
-                let mut times = vec![summary.cost.wall_time_s];
-                if summary.cost.wall_time_s < REPEAT_BELOW_S {
-                    times.clear();
-                    let mut timed = Vec::new();
-                    for _ in 0..settings.repeats {
-                        let s = run()?;
-                        times.push(s.cost.wall_time_s);
-                        timed.push(s);
-                    }
-                    let middle = median(&times);
-                    if let Some(closest) = timed.into_iter().min_by(|a, b| {
-                        (a.cost.wall_time_s - middle)
-                            .abs()
-                            .total_cmp(&(b.cost.wall_time_s - middle).abs())
-                    }) {
-                        summary = closest;
-                    }
-                }
-                let record = BenchRecord {
-                    case: case.name.clone(),
-                    method: label.into(),
-                    dt: dt * factor,
-                    dt_factor: Some(factor),
-                    status: summary.status.clone(),
-                    wall_time_s: median(&times),
-                    wall_times_s: times,
-                    assembly_s: summary.cost.assembly_s,
-                    linear_solve_s: summary.cost.linear_solve_s,
-                    factorization_s: Some(summary.cost.factorization_s),
-                    contact_solve_s: summary.cost.contact_solve_s,
-                    output_s: Some(summary.cost.output_s),
-                    peak_memory_mb: peak.map(|bytes| bytes as f64 / MB),
-                    increments: summary.cost.increments,
-                    newton_iterations: summary.cost.newton_iterations,
-                    factorizations: Some(
-                        summary.cost.tangent_factorizations
-                            + summary.cost.lu_factorizations
-                            + summary.cost.preconditioner_factorizations,
-                    ),
-                    contact_fallbacks: summary.cost.contact_fallbacks,
-                    t_stop: summary.t_stop,
-                    deceleration: summary.deceleration,
-                    deceleration_error: None,
-                    e_slide: None,
-                    t_stop_difference: None,
-                    reference: settings.levels > 1 && k + 1 == settings.levels,
-                };
+                let mut record = run_level(&level, source, &dir.join(k.to_string()), settings)?;
+                record.method = label.into();
+                record.dt = dt * factor;
+                record.dt_factor = Some(factor);
+                record.reference = settings.levels > 1 && k + 1 == settings.levels;
                 progress(&record);
-                runs.push((record, dir));
+                runs.push((record, dir.join(k.to_string())));
             }
-            if settings.levels == 1 {
-                // no ladder: nothing to measure against
-                records.extend(runs.into_iter().map(|(r, _)| r));
-                continue;
-            }
-            let counterpart = method
-                .fixed_counterpart()
-                .and_then(|c| finest.iter().find(|(m, _, _)| *m == c));
-            if let Some((_, dir, record)) = counterpart {
-                for (r, _) in &mut runs {
-                    r.reference = false;
+            if settings.levels > 1 {
+                let counterpart = method
+                    .fixed_counterpart()
+                    .and_then(|c| finest.iter().find(|(m, _, _)| *m == c));
+                if let Some((_, dir, record)) = counterpart {
+                    for (r, _) in &mut runs {
+                        r.reference = false;
+                    }
+                    measure_against(&mut runs, record, dir)?;
+                } else if let Some((record, dir)) = runs.last().cloned() {
+                    measure_against(&mut runs, &record, &dir)?;
                 }
-                measure_against(&mut runs, record, dir)?;
-            } else if let Some((record, dir)) = runs.last().cloned() {
-                measure_against(&mut runs, &record, &dir)?;
-            }
-            if let Some((record, dir)) = runs.last() {
-                finest.push((method, dir.clone(), record.clone()));
+                if let Some((record, dir)) = runs.last() {
+                    finest.push((method, dir.clone(), record.clone()));
+                }
             }
             records.extend(runs.into_iter().map(|(r, _)| r));
+            let mut meshes = Vec::new();
+            for k in 0..settings.meshes {
+                let level = mesh_case(&level_case(case, 1.0, method), MESH_RATIO.pow(k as u32));
+                let level_dir = dir.join(format!("mesh-{k}"));
+                let mut record = run_level(&level, source, &level_dir, settings)?;
+                record.method = label.into();
+                record.dt = dt;
+                record.dt_factor = Some(1.0);
+                record.ladder = Ladder::PadMesh;
+                record.reference = settings.meshes > 1 && k + 1 == settings.meshes;
+                progress(&record);
+                meshes.push((record, level_dir));
+            }
+            if settings.meshes > 1
+                && let Some((record, dir)) = meshes.last().cloned()
+            {
+                measure_against(&mut meshes, &record, &dir)?;
+            }
+            records.extend(meshes.into_iter().map(|(r, _)| r));
         }
     }
     let path = out.join(BENCH_JSON);
@@ -432,6 +457,87 @@ pub fn run_bench(
         .and_then(|()| write_atomic(&path, &text))
         .map_err(|source| BenchError::Write { path, source })?;
     Ok(records)
+}
+
+/// Runs `level` into `dir` as the bench times it (no restart files, so that the wall times
+/// are the solver's; a run shorter than [`REPEAT_BELOW_S`] once as a warm-up and then
+/// `settings.repeats` times, the median's run reported), with the peak resident memory of
+/// each run; returns its record as a time-step level of the case's own step, without errors.
+///
+/// # Errors
+/// [`BenchError::Case`] if the case cannot be run.
+fn run_level(
+    level: &Case,
+    source: &Path,
+    dir: &Path,
+    settings: &BenchSettings,
+) -> Result<BenchRecord, BenchError> {
+    let mut peak: Option<u64> = None;
+    let mut run = || {
+        let (summary, bytes) = peak_memory::during(|| run_case_with(level, source, dir, 0));
+        peak = peak.max(bytes);
+        summary
+    };
+    let mut summary = run()?;
+    let mut times = vec![summary.cost.wall_time_s];
+    if summary.cost.wall_time_s < REPEAT_BELOW_S {
+        times.clear();
+        let mut timed = Vec::new();
+        for _ in 0..settings.repeats {
+            let s = run()?;
+            times.push(s.cost.wall_time_s);
+            timed.push(s);
+        }
+        let middle = median(&times);
+        if let Some(closest) = timed.into_iter().min_by(|a, b| {
+            (a.cost.wall_time_s - middle)
+                .abs()
+                .total_cmp(&(b.cost.wall_time_s - middle).abs())
+        }) {
+            summary = closest;
+        }
+    }
+    let cost = &summary.cost;
+    let elements = &level.pad.elements;
+    Ok(BenchRecord {
+        case: level.name.clone(),
+        method: String::new(),
+        dt: base_dt(level).unwrap_or(f64::NAN),
+        dt_factor: Some(1.0),
+        ladder: Ladder::TimeStep,
+        pad_mesh: Some(if level.dimension == 3 {
+            format!(
+                "{} x {} x {}",
+                elements.circumferential, elements.radial, elements.axial
+            )
+        } else {
+            format!("{} x {}", elements.circumferential, elements.radial)
+        }),
+        equations: Some(cost.equations),
+        status: summary.status.clone(),
+        wall_time_s: median(&times),
+        wall_times_s: times,
+        assembly_s: cost.assembly_s,
+        linear_solve_s: cost.linear_solve_s,
+        factorization_s: Some(cost.factorization_s),
+        contact_solve_s: cost.contact_solve_s,
+        output_s: Some(cost.output_s),
+        peak_memory_mb: peak.map(|bytes| bytes as f64 / MB),
+        increments: cost.increments,
+        newton_iterations: cost.newton_iterations,
+        factorizations: Some(
+            cost.tangent_factorizations
+                + cost.lu_factorizations
+                + cost.preconditioner_factorizations,
+        ),
+        contact_fallbacks: cost.contact_fallbacks,
+        t_stop: summary.t_stop,
+        deceleration: summary.deceleration,
+        deceleration_error: None,
+        e_slide: None,
+        t_stop_difference: None,
+        reference: false,
+    })
 }
 
 /// Fills the errors of every level against the reference run (its record and directory).
@@ -460,8 +566,9 @@ fn measure_against(
 /// File name of the bench report in the output directory.
 pub const BENCH_MD: &str = "bench.md";
 
-/// Writes `bench.md` (the table of every level) and `work-precision.svg` (the deceleration
-/// error and e_slide against the median wall time, one curve each per case and contact solve)
+/// Writes `bench.md` (the table of every level), `work-precision.svg` (the deceleration
+/// error and e_slide of the time-step ladders against the median wall time, one curve each per
+/// case and method) and, if there are pad-mesh ladders, `work-precision-mesh.svg` (theirs)
 /// into `out`.
 ///
 /// # Errors
@@ -469,29 +576,42 @@ pub const BENCH_MD: &str = "bench.md";
 pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), BenchError> {
     use crate::format::{percent, show};
     use std::fmt::Write as _;
-    let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
-    for r in records.iter().filter(|r| !r.reference) {
-        for (quantity, error) in [
-            ("deceleration", r.deceleration_error),
-            ("e_slide", r.e_slide),
-        ] {
-            let label = format!("{} ({}): {quantity}", r.case, r.method);
-            let point = (r.wall_time_s, error.unwrap_or(f64::NAN));
-            match series.iter_mut().find(|(l, _)| *l == label) {
-                Some((_, points)) => points.push(point),
-                None => series.push((label, vec![point])),
+    // one plot per ladder: the time steps' (always written) and the pad meshes' (if run)
+    let plots = [
+        (Ladder::TimeStep, crate::plot::WORK_PRECISION_SVG),
+        (Ladder::PadMesh, crate::plot::WORK_PRECISION_MESH_SVG),
+    ];
+    for (ladder, file) in plots {
+        let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+        for r in records
+            .iter()
+            .filter(|r| !r.reference && r.ladder == ladder)
+        {
+            for (quantity, error) in [
+                ("deceleration", r.deceleration_error),
+                ("e_slide", r.e_slide),
+            ] {
+                let label = format!("{} ({}): {quantity}", r.case, r.method);
+                let point = (r.wall_time_s, error.unwrap_or(f64::NAN));
+                match series.iter_mut().find(|(l, _)| *l == label) {
+                    Some((_, points)) => points.push(point),
+                    None => series.push((label, vec![point])),
+                }
             }
         }
+        if ladder == Ladder::PadMesh && series.is_empty() {
+            continue;
+        }
+        crate::plot::plot_log_log(
+            &format!("Work-precision: {}", ladder.label()),
+            &series,
+            (
+                "median wall time [s]",
+                "error against the finest level (deceleration: relative; e_slide)",
+            ),
+            &out.join(file),
+        )?;
     }
-    crate::plot::plot_log_log(
-        "Work-precision",
-        &series,
-        (
-            "median wall time [s]",
-            "error against the finest level (deceleration: relative; e_slide)",
-        ),
-        &out.join(crate::plot::WORK_PRECISION_SVG),
-    )?;
     let mut md = String::from("# Work against error (`skid bench`)\n\n");
     md.push_str(
         "Each case at a ladder of time steps (every dynamic step's dt scaled alike) with each \
@@ -499,9 +619,11 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
          `global`: the contact solves on the case as it is; `adaptive`: the case with adaptive \
          increments, dt being the first one and the tolerance 1e-6 times the square of the \
          level's dt ratio to the case's; `quasi-static`: the pad without inertia, global \
-         solve; `quasi-static-adaptive`: the same with adaptive increments); the finest level \
-         of a case and method is its reference, and the adaptive methods are measured against \
-         the finest `case` and `quasi-static` levels where the bench runs them. Wall time: the \
+         solve; `quasi-static-adaptive`: the same with adaptive increments), and, where asked, \
+         at a ladder of pad meshes at its own time step (each level with twice the elements of \
+         the last in every direction); the finest level of a case, method and ladder is its \
+         reference, and the adaptive methods' time steps are measured against the finest \
+         `case` and `quasi-static` levels where the bench runs them. Wall time: the \
          solver's, median of the timed runs (runs under 2 s: one warm-up, then the repeats). \
          Errors against the reference: the deceleration (relative), e_slide (max |omega - \
          omega_ref| / omega0 over t <= 0.9 t_stop) and t_stop (relative; the pad vibration \
@@ -514,22 +636,41 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
     );
     let _ = writeln!(
         md,
-        "![deceleration error and e_slide against wall time]({})\n",
+        "![deceleration error and e_slide against wall time, time-step ladders]({})\n",
         crate::plot::WORK_PRECISION_SVG
     );
+    if records.iter().any(|r| r.ladder == Ladder::PadMesh) {
+        let _ = writeln!(
+            md,
+            "![deceleration error and e_slide against wall time, pad-mesh ladders]({})\n",
+            crate::plot::WORK_PRECISION_MESH_SVG
+        );
+    }
     md.push_str(
-        "| case | method | dt [s] | status | wall [s] | runs | assembly / linear (factorization) / contact / output [s] | peak memory [MB] | increments | Newton iterations | factorizations | fallbacks | deceleration [rad/s^2] | deceleration error [%] | e_slide [%] | t_stop [s] | t_stop difference [%] |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| case | method | ladder | dt [s] | pad mesh | equations | status | wall [s] | runs | assembly / linear (factorization) / contact / output [s] | peak memory [MB] | increments | Newton iterations | factorizations | fallbacks | deceleration [rad/s^2] | deceleration error [%] | e_slide [%] | t_stop [s] | t_stop difference [%] |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let seconds = |t: Option<f64>| t.map_or_else(|| "n/a".into(), |t| format!("{t:.3}"));
     for r in records {
-        let reference = if r.reference { " (reference)" } else { "" };
+        // the reference is marked at what its ladder refines
+        let marked = |ladder: Ladder| {
+            if r.reference && r.ladder == ladder {
+                " (reference)"
+            } else {
+                ""
+            }
+        };
         let _ = writeln!(
             md,
-            "| {} | {} | {}{reference} | {} | {:.4} | {} | {:.3} / {:.3} ({}) / {:.3} / {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {}{} | {}{} | {} | {} | {:.4} | {} | {:.3} / {:.3} ({}) / {:.3} / {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.case,
             r.method,
+            r.ladder.label(),
             show(Some(r.dt)),
+            marked(Ladder::TimeStep),
+            r.pad_mesh.as_deref().unwrap_or("n/a"),
+            marked(Ladder::PadMesh),
+            r.equations.map_or_else(|| "n/a".into(), |n| n.to_string()),
             r.status,
             r.wall_time_s,
             r.wall_times_s.len(),
@@ -602,17 +743,30 @@ fn within_target(records: &[BenchRecord]) -> String {
         "\n## The cheapest level within the error target\n\nFor each case and method, the \
          level of least wall time whose deceleration is within {} % and whose e_slide is at \
          most {} % of its reference (the method's finest level, or the fixed-step one it is \
-         measured against); the fastest of a case in bold. The quasi-static methods answer a \
-         model without the pad's inertia: what that changes is in the last section.\n\n\
-         | case | method | dt [s] | wall [s] | deceleration error [%] | e_slide [%] |\n\
+         measured against); the fastest of a case in bold. A pad-mesh ladder's levels are \
+         measured against its finest mesh, its fastest in bold apart from the time steps'. The \
+         quasi-static methods answer a model without the pad's inertia: what that changes is in \
+         the last section.\n\n\
+         | case | method | level (dt [s] or pad mesh) | wall [s] | deceleration error [%] | e_slide [%] |\n\
          |---|---|---|---|---|---|\n",
         plain(100.0 * TARGET_DECELERATION_ERROR),
         plain(100.0 * TARGET_E_SLIDE)
     );
     let mut cases: Vec<&str> = records.iter().map(|r| r.case.as_str()).collect();
     cases.dedup();
-    for case in cases {
-        let of_case: Vec<&BenchRecord> = records.iter().filter(|r| r.case == case).collect();
+    let ladders = [Ladder::TimeStep, Ladder::PadMesh];
+    for (case, ladder) in cases
+        .into_iter()
+        .flat_map(|case| ladders.map(|ladder| (case, ladder)))
+    {
+        let of_case: Vec<&BenchRecord> = records
+            .iter()
+            .filter(|r| r.case == case && r.ladder == ladder)
+            .collect();
+        if !of_case.iter().any(|r| r.deceleration_error.is_some()) {
+            // a ladder of one level, measured against nothing
+            continue;
+        }
         let fastest = of_case
             .iter()
             .filter(|r| meets_target(r))
@@ -632,19 +786,26 @@ fn within_target(records: &[BenchRecord]) -> String {
                     .min_by(|a, b| target_ratio(a).total_cmp(&target_ratio(b)))
                     .map(|r| (r, "none within the target; most accurate: "))
             });
+            let name = match ladder {
+                Ladder::TimeStep => method.to_string(),
+                Ladder::PadMesh => format!("{method}, pad mesh"),
+            };
             let line = match shown {
                 Some((r, note)) => {
                     let fastest = meets_target(r) && r.wall_time_s == fastest;
                     let bold = if fastest { "**" } else { "" };
+                    let level = match ladder {
+                        Ladder::TimeStep => show(Some(r.dt)),
+                        Ladder::PadMesh => r.pad_mesh.clone().unwrap_or_else(|| "n/a".into()),
+                    };
                     format!(
-                        "| {case} | {method} | {note}{} | {bold}{:.4}{bold} | {} | {} |",
-                        show(Some(r.dt)),
+                        "| {case} | {name} | {note}{level} | {bold}{:.4}{bold} | {} | {} |",
                         r.wall_time_s,
                         percent(r.deceleration_error),
                         percent(r.e_slide)
                     )
                 }
-                None => format!("| {case} | {method} | no completed level with an error | | | |"),
+                None => format!("| {case} | {name} | no completed level with an error | | | |"),
             };
             let _ = writeln!(md, "{line}");
         }
@@ -659,7 +820,9 @@ fn own_time_step(records: &[BenchRecord]) -> String {
     use std::fmt::Write as _;
     let own: Vec<&BenchRecord> = records
         .iter()
-        .filter(|r| r.dt_factor.is_some_and(|f| (f - 1.0).abs() < 1e-12))
+        .filter(|r| {
+            r.ladder == Ladder::TimeStep && r.dt_factor.is_some_and(|f| (f - 1.0).abs() < 1e-12)
+        })
         .collect();
     if own.is_empty() {
         return String::new();
@@ -708,9 +871,12 @@ fn model_change(records: &[BenchRecord]) -> String {
     use crate::format::percent;
     use std::fmt::Write as _;
     let reference = |case: &str, method: BenchMethod| {
-        records
-            .iter()
-            .find(|r| r.reference && r.case == case && r.method == method.label())
+        records.iter().find(|r| {
+            r.reference
+                && r.ladder == Ladder::TimeStep
+                && r.case == case
+                && r.method == method.label()
+        })
     };
     let mut md = String::new();
     let mut cases: Vec<&str> = records.iter().map(|r| r.case.as_str()).collect();
@@ -764,6 +930,9 @@ mod tests {
             method: method.into(),
             dt,
             dt_factor: None,
+            ladder: Ladder::TimeStep,
+            pad_mesh: None,
+            equations: None,
             status: "completed".into(),
             wall_time_s: wall,
             wall_times_s: vec![wall],
@@ -849,6 +1018,7 @@ mod tests {
             coarser: 1,
             repeats: 3,
             methods: vec![BenchMethod::Reduced],
+            meshes: 0,
         };
         let mut lines = 0;
         let records =
@@ -893,6 +1063,12 @@ mod tests {
             .expect("error-target section");
         assert_eq!((rows(table), rows(target)), (2, 1), "{md}");
         assert!(dir.path().join(crate::plot::WORK_PRECISION_SVG).is_file());
+        // no pad-mesh ladder, no plot of one
+        assert!(
+            !dir.path()
+                .join(crate::plot::WORK_PRECISION_MESH_SVG)
+                .exists()
+        );
         let written: Vec<BenchRecord> = serde_json::from_str(
             &std::fs::read_to_string(dir.path().join(BENCH_JSON)).expect("bench.json"),
         )
@@ -934,6 +1110,7 @@ mod tests {
             coarser: 1,
             repeats: 1,
             methods: vec![BenchMethod::Case, BenchMethod::Adaptive],
+            meshes: 0,
         };
         let records = run_bench(&[(case, file)], &settings, dir.path(), |_| ()).expect("bench");
         let of = |method: BenchMethod| -> Vec<&BenchRecord> {
@@ -976,6 +1153,7 @@ mod tests {
             coarser: 0,
             repeats: 3,
             methods: vec![BenchMethod::parse("case").expect("method")],
+            meshes: 0,
         };
         let records = run_bench(&cases, &settings, dir.path(), |_| ()).expect("bench");
         assert_eq!(records.len(), 2);
@@ -1012,5 +1190,88 @@ mod tests {
             "t_stop_difference":null,"reference":true}]"#;
         let old: Vec<BenchRecord> = serde_json::from_str(old).expect("old record");
         assert!(own_time_step(&old).is_empty());
+    }
+
+    /// A pad-mesh ladder: the case's pad, then twice its elements in every direction (the
+    /// axial one in 3D only), at the case's time step; the finer is the reference with zero
+    /// error, the case's pad has an error of its own, and neither counts in the total of the
+    /// cases at their own time step or in the time steps' rows of the error target.
+    #[test]
+    fn pad_mesh_ladder_refines_the_pad_and_measures_against_its_finest() {
+        let (case, file) = short_2d_case();
+        let mut three = case.clone();
+        three.dimension = 3;
+        assert_eq!(mesh_case(&three, 2).pad.elements.axial, 2);
+        assert_eq!(
+            mesh_case(&case, 2).pad.elements.axial,
+            case.pad.elements.axial
+        );
+        let dir = tempfile::tempdir().expect("tempdir");
+        let settings = BenchSettings {
+            levels: 1,
+            ratio: 2.0,
+            coarser: 0,
+            repeats: 1,
+            methods: vec![BenchMethod::Reduced],
+            meshes: 2,
+        };
+        let records = run_bench(
+            &[(case.clone(), file.clone())],
+            &settings,
+            dir.path(),
+            |_| (),
+        )
+        .expect("bench");
+        assert_eq!(records.len(), 3);
+        let (own, coarse, fine) = (&records[0], &records[1], &records[2]);
+        assert_eq!(own.ladder, Ladder::TimeStep);
+        assert!([coarse, fine].iter().all(|r| r.ladder == Ladder::PadMesh));
+        let elements = &case.pad.elements;
+        let mesh = |factor: usize| {
+            format!(
+                "{} x {}",
+                elements.circumferential * factor,
+                elements.radial * factor
+            )
+        };
+        assert_eq!(coarse.pad_mesh.as_deref(), Some(mesh(1).as_str()));
+        assert_eq!(fine.pad_mesh.as_deref(), Some(mesh(2).as_str()));
+        assert!(coarse.equations < fine.equations, "{coarse:?} {fine:?}");
+        assert!(fine.reference && !coarse.reference && !own.reference);
+        // (10 ms of spin-down: the drum does not stop, so there is no e_slide)
+        assert_eq!(fine.deceleration_error, Some(0.0));
+        assert!(coarse.deceleration_error.is_some_and(|e| e > 0.0));
+        assert!(own.deceleration_error.is_none());
+        assert!(records.iter().all(|r| (r.dt - 1e-4).abs() < 1e-15));
+        write_bench_report(&records, dir.path()).expect("report");
+        let md = std::fs::read_to_string(dir.path().join(BENCH_MD)).expect("bench.md");
+        assert!(md.contains("| **total of 1 cases** |"), "{md}");
+        assert!(
+            dir.path()
+                .join(crate::plot::WORK_PRECISION_MESH_SVG)
+                .is_file()
+        );
+        let target = md
+            .split_once("## The cheapest level within the error target")
+            .expect("error-target section")
+            .1;
+        let rows: Vec<&str> = target
+            .lines()
+            .filter(|l| l.starts_with("| 2d-analytic |"))
+            .collect();
+        assert_eq!(rows.len(), 1, "{md}");
+        assert!(
+            rows[0].starts_with("| 2d-analytic | reduced, pad mesh |"),
+            "{md}"
+        );
+        // more levels than the bench allows
+        let many = BenchSettings {
+            meshes: MAX_MESH_LEVELS + 1,
+            ..settings
+        };
+        assert!(matches!(
+            run_bench(&[(case, file)], &many, dir.path(), |_| ()),
+            Err(BenchError::Settings(_))
+        ));
     }
 }

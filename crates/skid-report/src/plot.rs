@@ -295,8 +295,11 @@ pub fn plot_newton(histories: &[(String, Vec<f64>)], path: &Path) -> Result<(), 
     })
 }
 
-/// File name of the work-precision plot of `skid bench`.
+/// File name of the work-precision plot of `skid bench`'s time-step ladders.
 pub const WORK_PRECISION_SVG: &str = "work-precision.svg";
+
+/// File name of the work-precision plot of `skid bench`'s pad-mesh ladders.
+pub const WORK_PRECISION_MESH_SVG: &str = "work-precision-mesh.svg";
 
 /// The range of the positive finite `values`, widened by a factor 2 each way, for a log axis.
 fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
