@@ -235,9 +235,12 @@ pub struct BenchRecord {
     /// Of the median run: history and field output, s (absent in older records).
     #[serde(default)]
     pub output_s: Option<f64>,
-    /// The largest peak resident memory of the level's runs, MB: the bench process's, reset
-    /// before each run (see [`skid_cases::peak_memory::during`]), so it includes the process's
-    /// own baseline; absent where the peak cannot be reset (outside Linux) and in older records.
+    /// The largest peak resident memory of the level's runs, MB: the bench process's, its peak
+    /// reset before each run (see [`skid_cases::peak_memory::during`]). That is the run's
+    /// memory plus what the process held when it started: its own baseline and what its
+    /// allocator kept of earlier, larger levels, so it is an upper bound, exact for a level
+    /// larger than all before it. Absent where the peak cannot be reset (outside Linux) and in
+    /// older records.
     #[serde(default)]
     pub peak_memory_mb: Option<f64>,
     /// Converged increments.
@@ -631,8 +634,10 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
          are not discretisation errors). The time split is the median run's (the factorizations \
          are a part of the linear solves; output: the history written at every increment); \
          peak memory is the largest peak resident memory of the level's runs, the bench \
-         process's with its peak reset before each run, so it includes the process's own \
-         baseline.\n\n",
+         process's with its peak reset before each run: an upper bound, since it includes the \
+         process's own baseline and what its allocator kept of earlier, larger levels (exact \
+         for a level larger than all before it; `scripts/scaling.py` measures each run in its \
+         own process).\n\n",
     );
     let _ = writeln!(
         md,
@@ -647,7 +652,7 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
         );
     }
     md.push_str(
-        "| case | method | ladder | dt [s] | pad mesh | equations | status | wall [s] | runs | assembly / linear (factorization) / contact / output [s] | peak memory [MB] | increments | Newton iterations | factorizations | fallbacks | deceleration [rad/s^2] | deceleration error [%] | e_slide [%] | t_stop [s] | t_stop difference [%] |\n\
+        "| case | method | ladder | dt [s] | pad mesh | equations | status | wall [s] | runs | assembly / linear (factorization) / contact / output [s] | peak memory, at most [MB] | increments | Newton iterations | factorizations | fallbacks | deceleration [rad/s^2] | deceleration error [%] | e_slide [%] | t_stop [s] | t_stop difference [%] |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let seconds = |t: Option<f64>| t.map_or_else(|| "n/a".into(), |t| format!("{t:.3}"));
