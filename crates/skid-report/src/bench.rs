@@ -528,11 +528,7 @@ fn run_level(
         peak_memory_mb: peak.map(|bytes| bytes as f64 / MB),
         increments: cost.increments,
         newton_iterations: cost.newton_iterations,
-        factorizations: Some(
-            cost.tangent_factorizations
-                + cost.lu_factorizations
-                + cost.preconditioner_factorizations,
-        ),
+        factorizations: Some(cost.factorizations()),
         contact_fallbacks: cost.contact_fallbacks,
         t_stop: summary.t_stop,
         deceleration: summary.deceleration,

@@ -74,6 +74,13 @@ pub struct StepCost {
     pub wall_time_s: f64,
 }
 
+impl RunCost {
+    /// Factorizations of every kind.
+    pub fn factorizations(&self) -> usize {
+        self.tangent_factorizations + self.lu_factorizations + self.preconditioner_factorizations
+    }
+}
+
 impl From<&RunStatistics> for RunCost {
     fn from(stats: &RunStatistics) -> Self {
         Self {
