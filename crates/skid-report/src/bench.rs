@@ -400,21 +400,24 @@ pub fn run_bench(
         };
         let mut finest: Vec<(BenchMethod, PathBuf, BenchRecord)> = Vec::new();
         for &method in &settings.methods {
-            let label = method.label();
-            let dir = out.join("runs").join(&case.name).join(label);
+            let dir = out.join("runs").join(&case.name).join(method.label());
             let mut runs = Vec::new();
             for k in 0..settings.levels {
                 let exponent = i32::try_from(settings.coarser).unwrap_or(i32::MAX)
                     - i32::try_from(k).unwrap_or(i32::MAX);
                 let factor = settings.ratio.powi(exponent);
-                let level = level_case(case, factor, method);
-                let mut record = run_level(&level, source, &dir.join(k.to_string()), settings)?;
-                record.method = label.into();
-                record.dt = dt * factor;
-                record.dt_factor = Some(factor);
-                record.reference = settings.levels > 1 && k + 1 == settings.levels;
+                let level = Level {
+                    case: level_case(case, factor, method),
+                    dir: dir.join(k.to_string()),
+                    method,
+                    ladder: Ladder::TimeStep,
+                    dt: dt * factor,
+                    dt_factor: factor,
+                    reference: settings.levels > 1 && k + 1 == settings.levels,
+                };
+                let record = run_level(&level, source, settings)?;
                 progress(&record);
-                runs.push((record, dir.join(k.to_string())));
+                runs.push((record, level.dir));
             }
             if settings.levels > 1 {
                 let counterpart = method
@@ -435,16 +438,18 @@ pub fn run_bench(
             records.extend(runs.into_iter().map(|(r, _)| r));
             let mut meshes = Vec::new();
             for k in 0..settings.meshes {
-                let level = mesh_case(&level_case(case, 1.0, method), MESH_RATIO.pow(k as u32));
-                let level_dir = dir.join(format!("mesh-{k}"));
-                let mut record = run_level(&level, source, &level_dir, settings)?;
-                record.method = label.into();
-                record.dt = dt;
-                record.dt_factor = Some(1.0);
-                record.ladder = Ladder::PadMesh;
-                record.reference = settings.meshes > 1 && k + 1 == settings.meshes;
+                let level = Level {
+                    case: mesh_case(&level_case(case, 1.0, method), MESH_RATIO.pow(k as u32)),
+                    dir: dir.join(format!("mesh-{k}")),
+                    method,
+                    ladder: Ladder::PadMesh,
+                    dt,
+                    dt_factor: 1.0,
+                    reference: settings.meshes > 1 && k + 1 == settings.meshes,
+                };
+                let record = run_level(&level, source, settings)?;
                 progress(&record);
-                meshes.push((record, level_dir));
+                meshes.push((record, level.dir));
             }
             if settings.meshes > 1
                 && let Some((record, dir)) = meshes.last().cloned()
@@ -462,22 +467,40 @@ pub fn run_bench(
     Ok(records)
 }
 
-/// Runs `level` into `dir` as the bench times it (no restart files, so that the wall times
-/// are the solver's; a run shorter than [`REPEAT_BELOW_S`] once as a warm-up and then
+/// A level of a ladder: the case it runs, where, and what its record says of it.
+struct Level {
+    /// The case as the level runs it.
+    case: Case,
+    /// Its run directory.
+    dir: PathBuf,
+    /// The method it is run by.
+    method: BenchMethod,
+    /// The ladder it belongs to.
+    ladder: Ladder,
+    /// Its dynamic time step, s.
+    dt: f64,
+    /// `dt` over the case's own time step.
+    dt_factor: f64,
+    /// Whether it is its ladder's reference.
+    reference: bool,
+}
+
+/// Runs `level` as the bench times it (no restart files, so that the wall times are the
+/// solver's; a run shorter than [`REPEAT_BELOW_S`] once as a warm-up and then
 /// `settings.repeats` times, the median's run reported), with the peak resident memory of
-/// each run; returns its record as a time-step level of the case's own step, without errors.
+/// each run; returns its record, without errors.
 ///
 /// # Errors
 /// [`BenchError::Case`] if the case cannot be run.
 fn run_level(
-    level: &Case,
+    level: &Level,
     source: &Path,
-    dir: &Path,
     settings: &BenchSettings,
 ) -> Result<BenchRecord, BenchError> {
     let mut peak: Option<u64> = None;
     let mut run = || {
-        let (summary, bytes) = peak_memory::during(|| run_case_with(level, source, dir, 0));
+        let (summary, bytes) =
+            peak_memory::during(|| run_case_with(&level.case, source, &level.dir, 0));
         peak = peak.max(bytes);
         summary
     };
@@ -501,14 +524,14 @@ fn run_level(
         }
     }
     let cost = &summary.cost;
-    let elements = &level.pad.elements;
+    let elements = &level.case.pad.elements;
     Ok(BenchRecord {
-        case: level.name.clone(),
-        method: String::new(),
-        dt: base_dt(level).unwrap_or(f64::NAN),
-        dt_factor: Some(1.0),
-        ladder: Ladder::TimeStep,
-        pad_mesh: Some(if level.dimension == 3 {
+        case: level.case.name.clone(),
+        method: level.method.label().into(),
+        dt: level.dt,
+        dt_factor: Some(level.dt_factor),
+        ladder: level.ladder,
+        pad_mesh: Some(if level.case.dimension == 3 {
             format!(
                 "{} x {} x {}",
                 elements.circumferential, elements.radial, elements.axial
@@ -535,7 +558,7 @@ fn run_level(
         deceleration_error: None,
         e_slide: None,
         t_stop_difference: None,
-        reference: false,
+        reference: level.reference,
     })
 }
 
