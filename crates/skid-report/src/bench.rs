@@ -356,7 +356,8 @@ fn base_dt(case: &Case) -> Option<f64> {
 }
 
 /// Runs the ladders of every case (`(case, source file)`) into `out/runs/<case>/<method>/<k>`
-/// (the pad-mesh ladder's levels into `.../mesh-<k>`), calling `progress` with a line per
+/// (the pad-mesh ladder's finer levels into `.../mesh-<k>`; its first is the time-step
+/// ladder's level at the case's own step, the same run), calling `progress` with a line per
 /// level, and writes `out/bench.json`.
 ///
 /// # Errors
@@ -419,6 +420,8 @@ pub fn run_bench(
                 progress(&record);
                 runs.push((record, level.dir));
             }
+            // the case's own level, which is also the first of the pad-mesh ladder
+            let own = runs[settings.coarser].clone();
             if settings.levels > 1 {
                 let counterpart = method
                     .fixed_counterpart()
@@ -438,18 +441,29 @@ pub fn run_bench(
             records.extend(runs.into_iter().map(|(r, _)| r));
             let mut meshes = Vec::new();
             for k in 0..settings.meshes {
-                let level = Level {
-                    case: mesh_case(&level_case(case, 1.0, method), MESH_RATIO.pow(k as u32)),
-                    dir: dir.join(format!("mesh-{k}")),
-                    method,
-                    ladder: Ladder::PadMesh,
-                    dt,
-                    dt_factor: 1.0,
-                    reference: settings.meshes > 1 && k + 1 == settings.meshes,
+                let reference = settings.meshes > 1 && k + 1 == settings.meshes;
+                let (record, dir) = if k == 0 {
+                    let (record, dir) = own.clone();
+                    let record = BenchRecord {
+                        ladder: Ladder::PadMesh,
+                        reference,
+                        ..record
+                    };
+                    (record, dir)
+                } else {
+                    let level = Level {
+                        case: mesh_case(&level_case(case, 1.0, method), MESH_RATIO.pow(k as u32)),
+                        dir: dir.join(format!("mesh-{k}")),
+                        method,
+                        ladder: Ladder::PadMesh,
+                        dt,
+                        dt_factor: 1.0,
+                        reference,
+                    };
+                    (run_level(&level, source, settings)?, level.dir)
                 };
-                let record = run_level(&level, source, settings)?;
                 progress(&record);
-                meshes.push((record, level.dir));
+                meshes.push((record, dir));
             }
             if settings.meshes > 1
                 && let Some((record, dir)) = meshes.last().cloned()
@@ -1217,9 +1231,10 @@ mod tests {
     }
 
     /// A pad-mesh ladder: the case's pad, then twice its elements in every direction (the
-    /// axial one in 3D only), at the case's time step; the finer is the reference with zero
-    /// error, the case's pad has an error of its own, and neither counts in the total of the
-    /// cases at their own time step or in the time steps' rows of the error target.
+    /// axial one in 3D only), at the case's time step, its first level the time-step ladder's
+    /// run at that step; the finer is the reference with zero error, the case's pad has an
+    /// error of its own, and neither counts in the total of the cases at their own time step
+    /// or in the time steps' rows of the error target.
     #[test]
     fn pad_mesh_ladder_refines_the_pad_and_measures_against_its_finest() {
         let (case, file) = short_2d_case();
@@ -1267,6 +1282,8 @@ mod tests {
         assert!(coarse.deceleration_error.is_some_and(|e| e > 0.0));
         assert!(own.deceleration_error.is_none());
         assert!(records.iter().all(|r| (r.dt - 1e-4).abs() < 1e-15));
+        // the case's pad at its own step is one run, shared by both ladders
+        assert_eq!(coarse.wall_times_s, own.wall_times_s);
         write_bench_report(&records, dir.path()).expect("report");
         let md = std::fs::read_to_string(dir.path().join(BENCH_MD)).expect("bench.md");
         assert!(md.contains("| **total of 1 cases** |"), "{md}");
