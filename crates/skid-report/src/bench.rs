@@ -538,21 +538,13 @@ fn run_level(
         }
     }
     let cost = &summary.cost;
-    let elements = &level.case.pad.elements;
     Ok(BenchRecord {
         case: level.case.name.clone(),
         method: level.method.label().into(),
         dt: level.dt,
         dt_factor: Some(level.dt_factor),
         ladder: level.ladder,
-        pad_mesh: Some(if level.case.dimension == 3 {
-            format!(
-                "{} x {} x {}",
-                elements.circumferential, elements.radial, elements.axial
-            )
-        } else {
-            format!("{} x {}", elements.circumferential, elements.radial)
-        }),
+        pad_mesh: Some(crate::convergence::pad_mesh_label(&level.case)),
         equations: Some(cost.equations),
         status: summary.status.clone(),
         wall_time_s: median(&times),

@@ -151,14 +151,20 @@ fn element_length(case: &Case) -> f64 {
     case.pad.length / case.pad.elements.circumferential as f64
 }
 
+/// The pad's element counts, `circumferential x radial [x axial]` (the axial count in 3D).
+pub(crate) fn pad_mesh_label(case: &Case) -> String {
+    let e = &case.pad.elements;
+    if case.dimension == 3 {
+        format!("{} x {} x {}", e.circumferential, e.radial, e.axial)
+    } else {
+        format!("{} x {}", e.circumferential, e.radial)
+    }
+}
+
 /// What a level is: its element counts, or its time steps.
 fn level_label(case: &Case, refinement: Refinement) -> String {
-    let e = &case.pad.elements;
     match refinement {
-        Refinement::Mesh if case.dimension == 3 => {
-            format!("{} x {} x {}", e.circumferential, e.radial, e.axial)
-        }
-        Refinement::Mesh => format!("{} x {}", e.circumferential, e.radial),
+        Refinement::Mesh => pad_mesh_label(case),
         Refinement::TimeStep => time_steps(case)
             .iter()
             .map(|dt| format!("dt {}", Sig(*dt)))
