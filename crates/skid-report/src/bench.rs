@@ -21,7 +21,9 @@
 //! times, and its wall time is the median (the solver's own wall time, without process start
 //! or output of the report). The record keeps every measured time, the split of the median
 //! run into assembly, linear solves (of which factorizations), contact solves and output, its
-//! factorizations, and the largest peak resident memory of the level's runs.
+//! factorizations, and the largest peak resident memory of the level's runs. A case's pad-mesh
+//! levels run after every method's smaller pads, so that no level's peak memory holds what the
+//! allocator kept of a larger one; the records keep each method's ladder order.
 
 use std::path::{Path, PathBuf};
 
@@ -238,9 +240,10 @@ pub struct BenchRecord {
     /// The largest peak resident memory of the level's runs, MB: the bench process's, its peak
     /// reset before each run (see [`skid_cases::peak_memory::during`]). That is the run's
     /// memory plus what the process held when it started: its own baseline and what its
-    /// allocator kept of earlier, larger levels, so it is an upper bound, exact for a level
-    /// larger than all before it. Absent where the peak cannot be reset (outside Linux) and in
-    /// older records.
+    /// allocator kept of earlier levels. A case's levels run in order of pad size (every
+    /// method's pad before any finer one), so what is kept is of levels no larger, and the
+    /// figure is the level's own peak but for that. Absent where the peak cannot be reset
+    /// (outside Linux) and in older records.
     #[serde(default)]
     pub peak_memory_mb: Option<f64>,
     /// Converged increments.
@@ -358,7 +361,8 @@ fn base_dt(case: &Case) -> Option<f64> {
 /// Runs the ladders of every case (`(case, source file)`) into `out/runs/<case>/<method>/<k>`
 /// (the pad-mesh ladder's finer levels into `.../mesh-<k>`; its first is the time-step
 /// ladder's level at the case's own step, the same run), calling `progress` with a line per
-/// level, and writes `out/bench.json`.
+/// level as it runs (a case's finer pads after all its methods' time-step ladders), and writes
+/// `out/bench.json`, each method's ladders in order.
 ///
 /// # Errors
 /// [`BenchError`] for bad settings, a case that cannot be built or outputs that cannot be
@@ -400,6 +404,8 @@ pub fn run_bench(
             )));
         };
         let mut finest: Vec<(BenchMethod, PathBuf, BenchRecord)> = Vec::new();
+        // per method: its run directory, its time-step levels and its pad-mesh levels
+        let mut ladders = Vec::new();
         for &method in &settings.methods {
             let dir = out.join("runs").join(&case.name).join(method.label());
             let mut runs = Vec::new();
@@ -421,7 +427,17 @@ pub fn run_bench(
                 runs.push((record, level.dir));
             }
             // the case's own level, which is also the first of the pad-mesh ladder
-            let own = runs[settings.coarser].clone();
+            let mut meshes = Vec::new();
+            if settings.meshes > 0 {
+                let (record, dir) = runs[settings.coarser].clone();
+                let record = BenchRecord {
+                    ladder: Ladder::PadMesh,
+                    reference: false,
+                    ..record
+                };
+                progress(&record);
+                meshes.push((record, dir));
+            }
             if settings.levels > 1 {
                 let counterpart = method
                     .fixed_counterpart()
@@ -438,33 +454,28 @@ pub fn run_bench(
                     finest.push((method, dir.clone(), record.clone()));
                 }
             }
-            records.extend(runs.into_iter().map(|(r, _)| r));
-            let mut meshes = Vec::new();
-            for k in 0..settings.meshes {
-                let reference = settings.meshes > 1 && k + 1 == settings.meshes;
-                let (record, dir) = if k == 0 {
-                    let (record, dir) = own.clone();
-                    let record = BenchRecord {
-                        ladder: Ladder::PadMesh,
-                        reference,
-                        ..record
-                    };
-                    (record, dir)
-                } else {
-                    let level = Level {
-                        case: mesh_case(&level_case(case, 1.0, method), MESH_RATIO.pow(k as u32)),
-                        dir: dir.join(format!("mesh-{k}")),
-                        method,
-                        ladder: Ladder::PadMesh,
-                        dt,
-                        dt_factor: 1.0,
-                        reference,
-                    };
-                    (run_level(&level, source, settings)?, level.dir)
+            ladders.push((method, dir, runs, meshes));
+        }
+        // The finer pads run after every method's smaller ones, so that no level follows a
+        // larger one: its peak memory then holds no allocator leftovers of a larger pad.
+        for k in 1..settings.meshes {
+            for (method, dir, _, meshes) in &mut ladders {
+                let level = Level {
+                    case: mesh_case(&level_case(case, 1.0, *method), MESH_RATIO.pow(k as u32)),
+                    dir: dir.join(format!("mesh-{k}")),
+                    method: *method,
+                    ladder: Ladder::PadMesh,
+                    dt,
+                    dt_factor: 1.0,
+                    reference: k + 1 == settings.meshes,
                 };
+                let record = run_level(&level, source, settings)?;
                 progress(&record);
-                meshes.push((record, dir));
+                meshes.push((record, level.dir));
             }
+        }
+        for (_, _, runs, mut meshes) in ladders {
+            records.extend(runs.into_iter().map(|(r, _)| r));
             if settings.meshes > 1
                 && let Some((record, dir)) = meshes.last().cloned()
             {
@@ -659,10 +670,10 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
          are not discretisation errors). The time split is the median run's (the factorizations \
          are a part of the linear solves; output: the history written at every increment); \
          peak memory is the largest peak resident memory of the level's runs, the bench \
-         process's with its peak reset before each run: an upper bound, since it includes the \
-         process's own baseline and what its allocator kept of earlier, larger levels (exact \
-         for a level larger than all before it; `scripts/scaling.py` measures each run in its \
-         own process).\n\n",
+         process's with its peak reset before each run, so it includes the process's own \
+         baseline and what its allocator kept of earlier levels, which run in order of pad size \
+         so that none is larger (`scripts/scaling.py` measures each run in its own \
+         process).\n\n",
     );
     let _ = writeln!(
         md,
@@ -1226,7 +1237,8 @@ mod tests {
     /// axial one in 3D only), at the case's time step, its first level the time-step ladder's
     /// run at that step; the finer is the reference with zero error, the case's pad has an
     /// error of its own, and neither counts in the total of the cases at their own time step
-    /// or in the time steps' rows of the error target.
+    /// or in the time steps' rows of the error target. Every method's smaller pad runs before
+    /// any finer one, and the records stay in each method's ladder order.
     #[test]
     fn pad_mesh_ladder_refines_the_pad_and_measures_against_its_finest() {
         let (case, file) = short_2d_case();
@@ -1243,20 +1255,27 @@ mod tests {
             ratio: 2.0,
             coarser: 0,
             repeats: 1,
-            methods: vec![BenchMethod::Reduced],
+            methods: vec![BenchMethod::Reduced, BenchMethod::Global],
             meshes: 2,
         };
+        let mut order = Vec::new();
         let records = run_bench(
             &[(case.clone(), file.clone())],
             &settings,
             dir.path(),
-            |_| (),
+            |r| order.push((r.method.clone(), r.equations)),
         )
         .expect("bench");
-        assert_eq!(records.len(), 3);
-        let (own, coarse, fine) = (&records[0], &records[1], &records[2]);
-        assert_eq!(own.ladder, Ladder::TimeStep);
-        assert!([coarse, fine].iter().all(|r| r.ladder == Ladder::PadMesh));
+        let methods = [
+            "reduced", "reduced", "global", "global", "reduced", "global",
+        ];
+        assert_eq!(
+            order.iter().map(|(m, _)| m.as_str()).collect::<Vec<_>>(),
+            methods,
+            "{order:?}"
+        );
+        assert!(order.windows(2).all(|w| w[0].1 <= w[1].1), "{order:?}");
+        assert_eq!(records.len(), 6);
         let elements = &case.pad.elements;
         let mesh = |factor: usize| {
             format!(
@@ -1265,17 +1284,23 @@ mod tests {
                 elements.radial * factor
             )
         };
-        assert_eq!(coarse.pad_mesh.as_deref(), Some(mesh(1).as_str()));
-        assert_eq!(fine.pad_mesh.as_deref(), Some(mesh(2).as_str()));
-        assert!(coarse.equations < fine.equations, "{coarse:?} {fine:?}");
-        assert!(fine.reference && !coarse.reference && !own.reference);
-        // (10 ms of spin-down: the drum does not stop, so there is no e_slide)
-        assert_eq!(fine.deceleration_error, Some(0.0));
-        assert!(coarse.deceleration_error.is_some_and(|e| e > 0.0));
-        assert!(own.deceleration_error.is_none());
+        for (ladder, method) in records.chunks(3).zip(["reduced", "global"]) {
+            let (own, coarse, fine) = (&ladder[0], &ladder[1], &ladder[2]);
+            assert!(ladder.iter().all(|r| r.method == method), "{ladder:?}");
+            assert_eq!(own.ladder, Ladder::TimeStep);
+            assert!([coarse, fine].iter().all(|r| r.ladder == Ladder::PadMesh));
+            assert_eq!(coarse.pad_mesh.as_deref(), Some(mesh(1).as_str()));
+            assert_eq!(fine.pad_mesh.as_deref(), Some(mesh(2).as_str()));
+            assert!(coarse.equations < fine.equations, "{coarse:?} {fine:?}");
+            assert!(fine.reference && !coarse.reference && !own.reference);
+            // (10 ms of spin-down: the drum does not stop, so there is no e_slide)
+            assert_eq!(fine.deceleration_error, Some(0.0));
+            assert!(coarse.deceleration_error.is_some_and(|e| e > 0.0));
+            assert!(own.deceleration_error.is_none());
+            // the case's pad at its own step is one run, shared by both ladders
+            assert_eq!(coarse.wall_times_s, own.wall_times_s);
+        }
         assert!(records.iter().all(|r| (r.dt - 1e-4).abs() < 1e-15));
-        // the case's pad at its own step is one run, shared by both ladders
-        assert_eq!(coarse.wall_times_s, own.wall_times_s);
         write_bench_report(&records, dir.path()).expect("report");
         let md = std::fs::read_to_string(dir.path().join(BENCH_MD)).expect("bench.md");
         assert!(md.contains("| **total of 1 cases** |"), "{md}");
@@ -1292,9 +1317,13 @@ mod tests {
             .lines()
             .filter(|l| l.starts_with("| 2d-analytic |"))
             .collect();
-        assert_eq!(rows.len(), 1, "{md}");
+        assert_eq!(rows.len(), 2, "{md}");
         assert!(
             rows[0].starts_with("| 2d-analytic | reduced, pad mesh |"),
+            "{md}"
+        );
+        assert!(
+            rows[1].starts_with("| 2d-analytic | global, pad mesh |"),
             "{md}"
         );
         // more levels than the bench allows
