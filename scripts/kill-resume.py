@@ -26,7 +26,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SKID = os.path.join(ROOT, "target", "release", "skid")
 TIMING_KEYS = ("wall_time_s", "assembly_s", "linear_solve_s", "factorization_s",
-               "contact_solve_s", "output_s")
+               "contact_solve_s", "output_s", "peak_memory_mb")
 
 
 def results(directory):

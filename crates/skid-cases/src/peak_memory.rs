@@ -2,6 +2,9 @@
 //! reset (`clear_refs` code 5), so that a process running one thing after another can measure
 //! each. Elsewhere neither is known.
 
+/// Bytes per MiB, the unit of the peak memory in `summary.json` and the bench's records.
+pub const MIB: f64 = 1_048_576.0;
+
 /// Resets the peak resident memory of this process to its current resident memory; `false`
 /// where that is not possible (the peak then stays the largest since the process started).
 pub fn reset() -> bool {
@@ -17,16 +20,6 @@ pub fn read() -> Option<u64> {
     Some(kib * 1024)
 }
 
-/// The peak resident memory of `work` alone where the peak can be reset before it (see
-/// [`reset`]), bytes, with `work`'s result. It includes what the process held when `work`
-/// started, which in a process that ran larger work before may include memory its allocator
-/// kept.
-pub fn during<T>(work: impl FnOnce() -> T) -> (T, Option<u64>) {
-    let resettable = reset();
-    let result = work();
-    (result, read().filter(|_| resettable))
-}
-
 #[cfg(all(test, target_os = "linux"))]
 mod tests {
     use super::*;
@@ -34,23 +27,19 @@ mod tests {
     const MIB: u64 = 1 << 20;
 
     #[test]
-    fn the_peak_of_work_counts_its_memory_and_a_reset_forgets_it() {
+    fn the_peak_after_a_reset_counts_new_memory_and_a_reset_forgets_it() {
         let size = 256 * MIB;
-        let (sum, peak) = during(|| {
-            // every page written, so that it is resident
-            let block = vec![1u8; usize::try_from(size).expect("fits")];
-            block
-                .iter()
-                .step_by(4096)
-                .map(|&b| u64::from(b))
-                .sum::<u64>()
-        });
+        assert!(reset(), "Linux resets the peak");
+        // every page written, so that it is resident
+        let block = vec![1u8; usize::try_from(size).expect("fits")];
+        let sum: u64 = block.iter().step_by(4096).map(|&b| u64::from(b)).sum();
         assert_eq!(sum, size / 4096);
-        let peak = peak.expect("Linux reports the peak and resets it");
+        let peak = read().expect("Linux reports the peak");
         assert!(peak >= size, "peak {peak} B below the {size} B written");
         // the block is freed (an allocation this large is returned to the system at once)
-        let (_, after) = during(|| ());
-        let after = after.expect("known");
+        drop(block);
+        assert!(reset());
+        let after = read().expect("known");
         assert!(
             after < peak - size / 2,
             "the reset kept the earlier peak: {after} B after {peak} B"

@@ -1,8 +1,10 @@
 //! `skid bench`: the cost of each case beside its error over a ladder of time steps and the
 //! contact solves (see `skid_report::bench`).
 //!
+//! Every run is a `skid run` in a process of its own (see `skid_report::bench::Isolation`).
+//!
 //! Exit codes: 0 every run completed; 1 some run stopped early; 2 a case file or the settings
-//! are invalid; 3 results could not be written or read back.
+//! are invalid; 3 results could not be written or read back, or a run's process failed.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -50,7 +52,7 @@ pub fn run(cases: &[PathBuf], settings: &BenchSettings, out: &Path) -> ExitCode 
             eprintln!("skid: {e}");
             return ExitCode::from(match e {
                 BenchError::Settings(_) | BenchError::Case(_) => 2,
-                BenchError::Report(_) | BenchError::Write { .. } => 3,
+                BenchError::Report(_) | BenchError::Write { .. } | BenchError::Process { .. } => 3,
             });
         }
     };

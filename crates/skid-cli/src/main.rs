@@ -17,7 +17,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use skid_cases::reference::Format;
 use skid_report::ReportSources;
-use skid_report::bench::{BenchMethod, BenchSettings};
+use skid_report::bench::{BenchMethod, BenchSettings, Isolation};
 
 #[derive(Parser)]
 #[command(
@@ -151,8 +151,9 @@ enum Command {
     },
     /// Cost against error: each case at a ladder of time steps (coarser than the case, the
     /// case, then finer) and, with --meshes, of pad meshes, with each contact solve, errors
-    /// against the finest level of each ladder; writes <out>/bench.json, <out>/bench.md and
-    /// <out>/work-precision.svg (with --meshes also <out>/work-precision-mesh.svg).
+    /// against the finest level of each ladder, every run a `skid run` in a process of its own;
+    /// writes <out>/bench.json, <out>/bench.md and <out>/work-precision.svg (with --meshes also
+    /// <out>/work-precision-mesh.svg).
     Bench {
         /// Case files (JSON).
         #[arg(required = true)]
@@ -311,6 +312,14 @@ fn main() -> ExitCode {
                     }
                 }
             }
+            // every run in a process of its own (see `Isolation::Process`)
+            let skid = match std::env::current_exe() {
+                Ok(skid) => skid,
+                Err(e) => {
+                    eprintln!("skid: cannot find the skid executable for the bench's runs: {e}");
+                    return ExitCode::from(3);
+                }
+            };
             let settings = BenchSettings {
                 levels,
                 ratio,
@@ -318,6 +327,10 @@ fn main() -> ExitCode {
                 repeats,
                 methods: solves,
                 meshes,
+                isolation: Isolation::Process {
+                    skid,
+                    threads: cli.threads,
+                },
             };
             bench::run(&cases, &settings, &out)
         }

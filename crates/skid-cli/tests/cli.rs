@@ -184,3 +184,60 @@ fn bench_rejects_an_unknown_method_and_a_ladder_without_the_case_time_step() {
     );
     assert!(!dir.path().join("bench.json").exists());
 }
+
+/// `skid bench` runs every run in a process of its own: the level's case file is written beside
+/// its run, the record's answer is the one `skid run` gives for that file, bit for bit, and on
+/// Linux the record has the peak memory of that process.
+#[test]
+fn bench_runs_each_level_in_a_process_of_its_own() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let text = std::fs::read_to_string(CASE).expect("case");
+    let mut case: serde_json::Value = serde_json::from_str(&text).expect("json");
+    case["steps"][1]["duration"] = serde_json::json!(0.005);
+    let short = dir.path().join("short.json");
+    std::fs::write(&short, case.to_string()).expect("write");
+    let bench = dir.path().join("bench");
+    let out = skid()
+        .arg("bench")
+        .arg(&short)
+        .args(["--levels", "1", "--coarser", "0", "--repeats", "1"])
+        .args(["--methods", "reduced", "--out"])
+        .arg(&bench)
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let records: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(bench.join("bench.json")).expect("bench.json"),
+    )
+    .expect("json");
+    let record = &records[0];
+    assert_eq!(records.as_array().map(Vec::len), Some(1));
+    let level = bench.join("runs/2d-analytic/reduced/0.json");
+    assert!(level.is_file(), "the level's case file");
+    let alone = dir.path().join("alone");
+    let out = skid()
+        .arg("run")
+        .arg(&level)
+        .arg("--out")
+        .arg(&alone)
+        .args(["--restart-every", "0"])
+        .output()
+        .expect("runs");
+    assert!(out.status.success());
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).expect("summary");
+    for key in ["deceleration", "t_stop", "increments", "newton_iterations"] {
+        assert_eq!(record[key], summary[key], "{key}");
+    }
+    assert!(record["deceleration"].is_f64());
+    if cfg!(target_os = "linux") {
+        let peak = record["peak_memory_mb"]
+            .as_f64()
+            .expect("peak memory on Linux");
+        assert!(peak > 1.0, "{peak} MB");
+        assert!(summary["peak_memory_mb"].as_f64().is_some_and(|p| p > 1.0));
+    }
+}

@@ -21,16 +21,18 @@
 //! times, and its wall time is the median (the solver's own wall time, without process start
 //! or output of the report). The record keeps every measured time, the split of the median
 //! run into assembly, linear solves (of which factorizations), contact solves and output, its
-//! factorizations, and the largest peak resident memory of the level's runs. A case's pad-mesh
-//! levels run after every method's smaller pads, so that no level's peak memory holds what the
-//! allocator kept of a larger one; the records keep each method's ladder order.
+//! factorizations, and the largest peak resident memory of the level's runs. Where the runs
+//! share a process ([`Isolation`]), a case's pad-mesh levels run after every method's smaller
+//! pads, so that no level's peak memory holds what the allocator kept of a larger one; the
+//! records keep each method's ladder order.
 
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::{ReportError, e_slide, load_run};
+use crate::{ReportError, e_slide, load_run, read_json};
 use skid_cases::atomic::write_atomic;
+use skid_cases::model_file::summary::RunCost;
 use skid_cases::peak_memory;
 use skid_cases::runner::run_case_with;
 use skid_cases::schema::{AdaptiveSpec, Case, ContactSolveSpec, StepSpec};
@@ -38,9 +40,6 @@ use skid_cases::validate::CaseError;
 
 /// Runs shorter than this (s) are repeated and their median taken.
 pub const REPEAT_BELOW_S: f64 = 2.0;
-
-/// Bytes per MB of [`BenchRecord::peak_memory_mb`] (MiB, as `scripts/scaling.py` counts).
-const MB: f64 = 1_048_576.0;
 
 /// Ratio of the element counts of successive pad-mesh levels, in every direction.
 pub const MESH_RATIO: usize = 2;
@@ -91,6 +90,28 @@ pub struct BenchSettings {
     /// pad, then each level's element counts [`MESH_RATIO`] times the last's in every
     /// direction, the finest being the reference (at most [`MAX_MESH_LEVELS`]).
     pub meshes: usize,
+    /// Which process runs each run.
+    pub isolation: Isolation,
+}
+
+/// Which process runs each run of a level.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum Isolation {
+    /// The bench's own, one run after another: a run's wall time and peak memory then depend
+    /// a little on what earlier runs left in the process's allocator (see
+    /// [`BenchRecord::peak_memory_mb`]).
+    #[default]
+    InProcess,
+    /// A process of its own for every run, `skid --threads <threads> run <level>.json --out
+    /// <level> --restart-every 0` with the `skid` executable given, so that no run sees what
+    /// another left: its wall time is the solver's own (from its `summary.json`, without the
+    /// process start) and its peak memory that of a process that ran nothing else.
+    Process {
+        /// The `skid` executable.
+        skid: PathBuf,
+        /// Its `--threads`.
+        threads: usize,
+    },
 }
 
 impl Default for BenchSettings {
@@ -102,6 +123,7 @@ impl Default for BenchSettings {
             repeats: 5,
             methods: vec![BenchMethod::Reduced, BenchMethod::Global],
             meshes: 0,
+            isolation: Isolation::InProcess,
         }
     }
 }
@@ -237,13 +259,12 @@ pub struct BenchRecord {
     /// Of the median run: history and field output, s (absent in older records).
     #[serde(default)]
     pub output_s: Option<f64>,
-    /// The largest peak resident memory of the level's runs, MB: the bench process's, its peak
-    /// reset before each run (see [`skid_cases::peak_memory::during`]). That is the run's
-    /// memory plus what the process held when it started: its own baseline and what its
-    /// allocator kept of earlier levels. A case's levels run in order of pad size (every
-    /// method's pad before any finer one), so what is kept is of levels no larger, and the
-    /// figure is the level's own peak but for that. Absent where the peak cannot be reset
-    /// (outside Linux) and in older records.
+    /// The largest peak resident memory of the level's runs, MB (MiB): each run's
+    /// `peak_memory_mb`, that of the process that ran it. `skid bench` runs each in a process
+    /// of its own ([`Isolation::Process`]), so it is the run's own with the process's baseline
+    /// of a few MB; in the bench's own process ([`Isolation::InProcess`]) the peak is reset
+    /// before each run, and it includes what the allocator kept of earlier levels. Absent
+    /// where it is not known (outside Linux) and in older records.
     #[serde(default)]
     pub peak_memory_mb: Option<f64>,
     /// Converged increments.
@@ -281,6 +302,14 @@ pub enum BenchError {
     /// Settings out of range.
     #[error("bench settings: {0}")]
     Settings(String),
+    /// A run's own process could not be started or ended without its summary.
+    #[error("{case}: {message}")]
+    Process {
+        /// The level's case file.
+        case: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
     /// The records could not be written.
     #[error("cannot write {path}: {source}")]
     Write {
@@ -510,24 +539,108 @@ struct Level {
     reference: bool,
 }
 
-/// Runs `level` as the bench times it (no restart files, so that the wall times are the
-/// solver's; a run shorter than [`REPEAT_BELOW_S`] once as a warm-up and then
-/// `settings.repeats` times, the median's run reported), with the peak resident memory of
-/// each run; returns its record, without errors.
+/// What the bench reads of a run's summary.
+#[derive(Debug, Deserialize)]
+struct RunOutcome {
+    /// `"completed"` or `"failed"`.
+    status: String,
+    /// The drum's stop time, s.
+    t_stop: Option<f64>,
+    /// Its sliding deceleration, rad/s^2.
+    deceleration: Option<f64>,
+    /// The run's cost.
+    #[serde(flatten)]
+    cost: RunCost,
+}
+
+/// Runs `level` once, as `isolation` says, without restart files (so that the wall time is the
+/// solver's).
 ///
 /// # Errors
-/// [`BenchError::Case`] if the case cannot be run.
+/// [`BenchError::Case`] if the case cannot be run in this process, [`BenchError::Process`] if
+/// its own process could not be started or left no summary.
+fn run_once(level: &Level, source: &Path, isolation: &Isolation) -> Result<RunOutcome, BenchError> {
+    match isolation {
+        Isolation::InProcess => {
+            let resettable = peak_memory::reset();
+            let summary = run_case_with(&level.case, source, &level.dir, 0)?;
+            let mut cost = summary.cost;
+            if !resettable {
+                cost.peak_memory_mb = None;
+            }
+            Ok(RunOutcome {
+                status: summary.status,
+                t_stop: summary.t_stop,
+                deceleration: summary.deceleration,
+                cost,
+            })
+        }
+        Isolation::Process { skid, threads } => {
+            let file = level.dir.with_extension("json");
+            let failure = |message: String| BenchError::Process {
+                case: file.clone(),
+                message,
+            };
+            let text = serde_json::to_string_pretty(&level.case).unwrap_or_default();
+            std::fs::create_dir_all(&level.dir)
+                .and_then(|()| write_atomic(&file, &text))
+                .map_err(|source| BenchError::Write {
+                    path: file.clone(),
+                    source,
+                })?;
+            // a summary left by an earlier bench must not pass for this run's
+            let summary = level.dir.join("summary.json");
+            if summary.exists() {
+                std::fs::remove_file(&summary).map_err(|source| BenchError::Write {
+                    path: summary.clone(),
+                    source,
+                })?;
+            }
+            let output = std::process::Command::new(skid)
+                .arg("--threads")
+                .arg(threads.to_string())
+                .arg("run")
+                .arg(&file)
+                .arg("--out")
+                .arg(&level.dir)
+                .args(["--restart-every", "0"])
+                .stdin(std::process::Stdio::null())
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::piped())
+                .output()
+                .map_err(|e| failure(format!("cannot start {}: {e}", skid.display())))?;
+            // exit status 1 is a run that stopped early, with its summary
+            if !matches!(output.status.code(), Some(0 | 1)) {
+                return Err(failure(format!(
+                    "skid run ended with {}: {}",
+                    output.status,
+                    String::from_utf8_lossy(&output.stderr).trim()
+                )));
+            }
+            Ok(read_json(&summary, "a skid run summary")?)
+        }
+    }
+}
+
+/// Runs `level` as the bench times it (a run shorter than [`REPEAT_BELOW_S`] once as a warm-up
+/// and then `settings.repeats` times, the median's run reported), with the largest peak
+/// resident memory of its runs; returns its record, without errors.
+///
+/// # Errors
+/// As [`run_once`].
 fn run_level(
     level: &Level,
     source: &Path,
     settings: &BenchSettings,
 ) -> Result<BenchRecord, BenchError> {
-    let mut peak: Option<u64> = None;
+    let mut peak: Option<f64> = None;
     let mut run = || {
-        let (summary, bytes) =
-            peak_memory::during(|| run_case_with(&level.case, source, &level.dir, 0));
-        peak = peak.max(bytes);
-        summary
+        let outcome = run_once(level, source, &settings.isolation)?;
+        peak = match (peak, outcome.cost.peak_memory_mb) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        };
+        Ok::<_, BenchError>(outcome)
     };
     let mut summary = run()?;
     let mut times = vec![summary.cost.wall_time_s];
@@ -565,7 +678,7 @@ fn run_level(
         factorization_s: Some(cost.factorization_s),
         contact_solve_s: cost.contact_solve_s,
         output_s: Some(cost.output_s),
-        peak_memory_mb: peak.map(|bytes| bytes as f64 / MB),
+        peak_memory_mb: peak,
         increments: cost.increments,
         newton_iterations: cost.newton_iterations,
         factorizations: Some(cost.factorizations()),
@@ -669,11 +782,9 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
          left at the stop moves it by up to 1 %, DRUM.md 2.2, so differences inside that band \
          are not discretisation errors). The time split is the median run's (the factorizations \
          are a part of the linear solves; output: the history written at every increment); \
-         peak memory is the largest peak resident memory of the level's runs, the bench \
-         process's with its peak reset before each run, so it includes the process's own \
-         baseline and what its allocator kept of earlier levels, which run in order of pad size \
-         so that none is larger (`scripts/scaling.py` measures each run in its own \
-         process).\n\n",
+         peak memory is the largest peak resident memory of the level's runs, each that of \
+         the process that ran it (`skid bench` runs every run in a process of its own, whose \
+         baseline of a few MB it includes).\n\n",
     );
     let _ = writeln!(
         md,
@@ -1060,6 +1171,7 @@ mod tests {
             repeats: 3,
             methods: vec![BenchMethod::Reduced],
             meshes: 0,
+            isolation: Isolation::InProcess,
         };
         let mut lines = 0;
         let records =
@@ -1152,6 +1264,7 @@ mod tests {
             repeats: 1,
             methods: vec![BenchMethod::Case, BenchMethod::Adaptive],
             meshes: 0,
+            isolation: Isolation::InProcess,
         };
         let records = run_bench(&[(case, file)], &settings, dir.path(), |_| ()).expect("bench");
         let of = |method: BenchMethod| -> Vec<&BenchRecord> {
@@ -1195,6 +1308,7 @@ mod tests {
             repeats: 3,
             methods: vec![BenchMethod::parse("case").expect("method")],
             meshes: 0,
+            isolation: Isolation::InProcess,
         };
         let records = run_bench(&cases, &settings, dir.path(), |_| ()).expect("bench");
         assert_eq!(records.len(), 2);
@@ -1233,6 +1347,37 @@ mod tests {
         assert!(own_time_step(&old).is_empty());
     }
 
+    /// A run in a process of its own that cannot start is an error naming the level's case
+    /// file, which the bench wrote for it; no records are written.
+    #[test]
+    fn a_run_process_that_cannot_start_is_an_error_naming_the_level() {
+        let (case, file) = short_2d_case();
+        let dir = tempfile::tempdir().expect("tempdir");
+        let settings = BenchSettings {
+            levels: 1,
+            coarser: 0,
+            repeats: 1,
+            methods: vec![BenchMethod::Reduced],
+            isolation: Isolation::Process {
+                skid: dir.path().join("no-such-skid"),
+                threads: 1,
+            },
+            ..BenchSettings::default()
+        };
+        let error =
+            run_bench(&[(case, file)], &settings, dir.path(), |_| ()).expect_err("no executable");
+        let level = dir.path().join("runs/2d-analytic/reduced/0.json");
+        match &error {
+            BenchError::Process { case, message } => {
+                assert_eq!(case, &level);
+                assert!(message.contains("cannot start"), "{message}");
+            }
+            other => panic!("expected a process error, got {other:?}"),
+        }
+        assert!(level.is_file());
+        assert!(!dir.path().join(BENCH_JSON).exists());
+    }
+
     /// A pad-mesh ladder: the case's pad, then twice its elements in every direction (the
     /// axial one in 3D only), at the case's time step, its first level the time-step ladder's
     /// run at that step; the finer is the reference with zero error, the case's pad has an
@@ -1257,6 +1402,7 @@ mod tests {
             repeats: 1,
             methods: vec![BenchMethod::Reduced, BenchMethod::Global],
             meshes: 2,
+            isolation: Isolation::InProcess,
         };
         let mut order = Vec::new();
         let records = run_bench(

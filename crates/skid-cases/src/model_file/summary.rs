@@ -3,13 +3,14 @@
 
 use std::collections::BTreeMap;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use skid_integrator::{Model, RunError, RunStatistics};
 
 use super::history::{BodyState, RunRecord};
+use crate::peak_memory;
 
 /// The cost of a run.
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct RunCost {
     /// Equations (unknowns) of the model.
     pub equations: usize,
@@ -53,12 +54,17 @@ pub struct RunCost {
     pub contact_solve_s: f64,
     /// Of which: history and field output and restart files, s.
     pub output_s: f64,
+    /// The peak resident memory of the process when the run ended, MB (MiB; Linux, else
+    /// `None`): the run's own where the process ran nothing before it, as `skid run` and each
+    /// run of `skid bench`; in `skid batch`, whose jobs share the process, the batch's so far.
+    #[serde(default)]
+    pub peak_memory_mb: Option<f64>,
     /// The cost of each step reached, in order.
     pub steps: Vec<StepCost>,
 }
 
 /// The cost of one step of a run.
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct StepCost {
     /// The step's name.
     pub step: String,
@@ -81,6 +87,8 @@ impl RunCost {
     }
 }
 
+/// The cost in a run's statistics, at the end of the run: the process's peak memory is read
+/// when this is made.
 impl From<&RunStatistics> for RunCost {
     fn from(stats: &RunStatistics) -> Self {
         Self {
@@ -105,6 +113,7 @@ impl From<&RunStatistics> for RunCost {
             factorization_s: stats.timings.factorization.as_secs_f64(),
             contact_solve_s: stats.timings.contact_solve.as_secs_f64(),
             output_s: stats.timings.output.as_secs_f64(),
+            peak_memory_mb: peak_memory::read().map(|bytes| bytes as f64 / peak_memory::MIB),
             steps: stats
                 .steps
                 .iter()

@@ -80,14 +80,15 @@ pub fn entries() -> Vec<Entry> {
 }
 
 /// Keys of `summary.json` (at any depth, the per-step costs included) and `batch.json` that
-/// hold wall times.
-pub const TIMING_KEYS: [&str; 6] = [
+/// hold wall times or the process's peak memory, which vary from run to run.
+pub const TIMING_KEYS: [&str; 7] = [
     "wall_time_s",
     "assembly_s",
     "linear_solve_s",
     "factorization_s",
     "contact_solve_s",
     "output_s",
+    "peak_memory_mb",
 ];
 
 /// `value` without its [`TIMING_KEYS`], at any depth; panics if it held none of them, so that a
