@@ -29,6 +29,15 @@ TIMING_KEYS = ("wall_time_s", "assembly_s", "linear_solve_s", "factorization_s",
                "contact_solve_s", "output_s", "peak_memory_mb")
 
 
+def without_timings(value):
+    """`value` without its TIMING_KEYS at any depth (the per-step costs hold wall times too)."""
+    if isinstance(value, dict):
+        return {k: without_timings(v) for k, v in value.items() if k not in TIMING_KEYS}
+    if isinstance(value, list):
+        return [without_timings(v) for v in value]
+    return value
+
+
 def results(directory):
     """Every output file of a finished run by name; summary.json without its wall times."""
     out = {}
@@ -44,10 +53,7 @@ def results(directory):
             with open(path, "rb") as f:
                 data = f.read()
             if key == "summary.json":
-                summary = json.loads(data)
-                for k in TIMING_KEYS:
-                    summary.pop(k, None)
-                data = json.dumps(summary, sort_keys=True).encode()
+                data = json.dumps(without_timings(json.loads(data)), sort_keys=True).encode()
             out[key] = data
     return out
 
