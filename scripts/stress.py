@@ -72,15 +72,14 @@ TIERS = [
     ("large", 0.05, 3, ((20, 40), (4, 8), (4, 8))),
 ]
 
-# Solver defaults (crates/skid-integrator/src/increment.rs, NewtonSettings): a converged
-# increment has force residual <= FORCE_TOLERANCE and contact residual <= CONTACT_TOLERANCE
-# (the latter relative to the model size). The sweep does not change them.
-FORCE_TOLERANCE = 1e-6
-CONTACT_TOLERANCE = 1e-9
+# A converged increment has force residual <= the solver's force_tolerance and contact residual
+# <= its contact_tolerance (relative to the model size). The sweep does not change them; each
+# run's are read from its input as run (case.json or model.json, `solver`), so that the check
+# follows the solver's defaults.
 
 # Checks of a completed run. The contact law is exact at convergence up to the Newton contact
-# tolerance (1e-9 of the model size) and the Coulomb tolerance (1e-8); the thresholds leave a
-# margin of 1000 and 100 above them, so that a flagged run is wrong, not rounded.
+# tolerance (1e-8 of the model size by default) and the Coulomb tolerance (1e-8); the
+# thresholds leave a margin of 100 above them, so that a flagged run is wrong, not rounded.
 PENETRATION_LIMIT = 1e-6      # deepest penetration, relative to the scene's length scale
 SEPARATION_LIMIT = 1e-6       # largest gap at a contact at the cone's boundary, same scale
 CONE_RELATIVE = 1e-6          # |friction force| <= mu N (1 + this) + CONE_ABSOLUTE max N
@@ -335,8 +334,20 @@ def cone_check(rows, pairs, problems, measures):
     measures["cone_excess"] = worst
 
 
-def newton_check(rows, problems, measures):
-    """The last convergence check of every increment meets the Newton tolerances."""
+def solver_tolerances(run_dir):
+    """(force, contact) tolerances of the run's input as run (case.json or model.json)."""
+    for name in ("case.json", "model.json"):
+        path = run_dir / name
+        if path.is_file():
+            solver = json.loads(path.read_text()).get("solver", {})
+            return solver["force_tolerance"], solver["contact_tolerance"]
+    raise ValueError("no case.json or model.json (the input as run) in the run's directory")
+
+
+def newton_check(rows, tolerances, problems, measures):
+    """The last convergence check of every increment meets the Newton tolerances
+    `(force, contact)`."""
+    force_tolerance, contact_tolerance = tolerances
     worst_f = worst_c = 0.0
     for k, r in enumerate(rows):
         last = k + 1 == len(rows) or rows[k + 1]["iteration"] <= r["iteration"]
@@ -344,12 +355,12 @@ def newton_check(rows, problems, measures):
             continue
         worst_f = max(worst_f, r["force_residual"])
         worst_c = max(worst_c, r["contact_residual"])
-        if r["force_residual"] > FORCE_TOLERANCE or r["contact_residual"] > CONTACT_TOLERANCE:
+        if r["force_residual"] > force_tolerance or r["contact_residual"] > contact_tolerance:
             problems.append(
                 f"newton.csv: step {r['step']} increment {r['increment']:.0f} accepted with "
                 f"force residual {r['force_residual']:.3g}, contact residual "
-                f"{r['contact_residual']:.3g} (tolerances {FORCE_TOLERANCE}, "
-                f"{CONTACT_TOLERANCE})")
+                f"{r['contact_residual']:.3g} (tolerances {force_tolerance}, "
+                f"{contact_tolerance})")
             break
     measures["newton_force_residual"] = worst_f
     measures["newton_contact_residual"] = worst_c
@@ -401,7 +412,12 @@ def check_completed(run, run_dir):
         problems.append(f"history.csv: the dynamic step covers {covered:.7g} s of "
                         f"{p['duration']:.7g} s")
 
-    newton_check(newton, problems, measures)
+    try:
+        tolerances = solver_tolerances(run_dir)
+    except (OSError, ValueError, KeyError) as e:
+        problems.append(f"input as run: {e}")
+        return problems, measures
+    newton_check(newton, tolerances, problems, measures)
 
     length = 0.2 if run["kind"] == "drum" else BLOCK_LENGTH
     if run["kind"] == "drum":
@@ -646,8 +662,8 @@ def write_report(records, args, total_wall, results):
         "total_wall_s": round(total_wall, 1),
         "counts": counts,
         "thresholds": {
-            "force_tolerance": FORCE_TOLERANCE,
-            "contact_tolerance": CONTACT_TOLERANCE,
+            "newton_tolerances": "each run's solver.force_tolerance and "
+                                 "solver.contact_tolerance, as run",
             "penetration_relative": PENETRATION_LIMIT,
             "sliding_separation_relative": SEPARATION_LIMIT,
             "cone_relative": CONE_RELATIVE,
@@ -681,12 +697,12 @@ def write_report(records, args, total_wall, results):
     md += ["Checks of a completed run (a run failing one is *silently wrong*):",
            "- every number in summary.json, history.csv and newton.csv is finite, and the "
            "dynamic step's increments add up to its duration (relative 1e-5);",
-           f"- every accepted increment's last Newton check (newton.csv) is within the solver's "
-           f"tolerances (force {FORCE_TOLERANCE:g}, contact {CONTACT_TOLERANCE:g} of the model "
-           "size);",
+           "- every accepted increment's last Newton check (newton.csv) is within the solver's "
+           "tolerances as run (case.json or model.json: `solver.force_tolerance`, "
+           "`solver.contact_tolerance` of the model size; by default 1e-6 and 1e-8);",
            f"- contact law: deepest penetration and largest gap of a sliding contact at most "
            f"{PENETRATION_LIMIT:g} of the length scale (drum radius; block size 0.02 m), i.e. "
-           "1000 times the Newton contact tolerance; on every history row and pair, "
+           "100 times the default Newton contact tolerance; on every history row and pair, "
            f"|friction| <= mu N (1 + {CONE_RELATIVE:g}) + {CONE_ABSOLUTE:g} max N and "
            f"N >= -{CONE_ABSOLUTE:g} max N (100 times the Coulomb tolerance 1e-8);",
            f"- energy: `energy_balance_residual_j` (summary.json: the ledger's residual with "
