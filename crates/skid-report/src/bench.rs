@@ -553,72 +553,108 @@ struct RunOutcome {
     cost: RunCost,
 }
 
-/// Runs `level` once, as `isolation` says, without restart files (so that the wall time is the
-/// solver's).
-///
-/// # Errors
-/// [`BenchError::Case`] if the case cannot be run in this process, [`BenchError::Process`] if
-/// its own process could not be started or left no summary.
-fn run_once(level: &Level, source: &Path, isolation: &Isolation) -> Result<RunOutcome, BenchError> {
-    match isolation {
-        Isolation::InProcess => {
+/// How each run of a level starts.
+enum Start<'a> {
+    /// In this process.
+    Here,
+    /// As `skid run` of the level's case file `file`, in a process of its own.
+    Child {
+        /// The `skid` executable.
+        skid: &'a Path,
+        /// Its `--threads`.
+        threads: usize,
+        /// The level's case file.
+        file: PathBuf,
+    },
+}
+
+impl<'a> Start<'a> {
+    /// How `level`'s runs start under `isolation`; for a process of their own, the level's case
+    /// is written beside its run directory (`<dir>.json`) once for all of them.
+    ///
+    /// # Errors
+    /// [`BenchError::Write`] if the case file cannot be written.
+    fn prepare(level: &Level, isolation: &'a Isolation) -> Result<Self, BenchError> {
+        let Isolation::Process { skid, threads } = isolation else {
+            return Ok(Self::Here);
+        };
+        let file = level.dir.with_extension("json");
+        let written = serde_json::to_string_pretty(&level.case)
+            .map_err(std::io::Error::other)
+            .and_then(|text| {
+                std::fs::create_dir_all(&level.dir)?;
+                write_atomic(&file, &text)
+            });
+        written.map_err(|source| BenchError::Write {
+            path: file.clone(),
+            source,
+        })?;
+        Ok(Self::Child {
+            skid,
+            threads: *threads,
+            file,
+        })
+    }
+
+    /// Runs `level` once without restart files (so that the wall time is the solver's).
+    ///
+    /// # Errors
+    /// [`BenchError::Case`] if the case cannot be run in this process, [`BenchError::Process`]
+    /// if its own process could not be started or failed without a summary.
+    fn run(&self, level: &Level, source: &Path) -> Result<RunOutcome, BenchError> {
+        let Self::Child {
+            skid,
+            threads,
+            file,
+        } = self
+        else {
             let resettable = peak_memory::reset();
             let summary = run_case_with(&level.case, source, &level.dir, 0)?;
             let mut cost = summary.cost;
             if !resettable {
                 cost.peak_memory_mb = None;
             }
-            Ok(RunOutcome {
+            return Ok(RunOutcome {
                 status: summary.status,
                 t_stop: summary.t_stop,
                 deceleration: summary.deceleration,
                 cost,
-            })
+            });
+        };
+        let failure = |message: String| BenchError::Process {
+            case: file.clone(),
+            message,
+        };
+        // a summary left by an earlier run must not pass for this one's
+        let summary = level.dir.join("summary.json");
+        if summary.exists() {
+            std::fs::remove_file(&summary).map_err(|source| BenchError::Write {
+                path: summary.clone(),
+                source,
+            })?;
         }
-        Isolation::Process { skid, threads } => {
-            let file = level.dir.with_extension("json");
-            let failure = |message: String| BenchError::Process {
-                case: file.clone(),
-                message,
-            };
-            let text = serde_json::to_string_pretty(&level.case).unwrap_or_default();
-            std::fs::create_dir_all(&level.dir)
-                .and_then(|()| write_atomic(&file, &text))
-                .map_err(|source| BenchError::Write {
-                    path: file.clone(),
-                    source,
-                })?;
-            // a summary left by an earlier bench must not pass for this run's
-            let summary = level.dir.join("summary.json");
-            if summary.exists() {
-                std::fs::remove_file(&summary).map_err(|source| BenchError::Write {
-                    path: summary.clone(),
-                    source,
-                })?;
-            }
-            let output = std::process::Command::new(skid)
-                .arg("--threads")
-                .arg(threads.to_string())
-                .arg("run")
-                .arg(&file)
-                .arg("--out")
-                .arg(&level.dir)
-                .args(["--restart-every", "0"])
-                .stdin(std::process::Stdio::null())
-                .stdout(std::process::Stdio::null())
-                .stderr(std::process::Stdio::piped())
-                .output()
-                .map_err(|e| failure(format!("cannot start {}: {e}", skid.display())))?;
-            // exit status 1 is a run that stopped early, with its summary
-            if !matches!(output.status.code(), Some(0 | 1)) {
-                return Err(failure(format!(
-                    "skid run ended with {}: {}",
-                    output.status,
-                    String::from_utf8_lossy(&output.stderr).trim()
-                )));
-            }
-            Ok(read_json(&summary, "a skid run summary")?)
+        let output = std::process::Command::new(skid)
+            .arg("--threads")
+            .arg(threads.to_string())
+            .arg("run")
+            .arg(file)
+            .arg("--out")
+            .arg(&level.dir)
+            .args(["--restart-every", "0"])
+            .stdin(std::process::Stdio::null())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .output()
+            .map_err(|e| failure(format!("cannot start {}: {e}", skid.display())))?;
+        // exit status 1 is a run that stopped early, with its summary
+        if !matches!(output.status.code(), Some(0 | 1)) {
+            return Err(failure(format!(
+                "skid run ended with {}: {}",
+                output.status,
+                String::from_utf8_lossy(&output.stderr).trim()
+            )));
         }
+        Ok(read_json(&summary, "a skid run summary")?)
     }
 }
 
@@ -627,15 +663,16 @@ fn run_once(level: &Level, source: &Path, isolation: &Isolation) -> Result<RunOu
 /// resident memory of its runs; returns its record, without errors.
 ///
 /// # Errors
-/// As [`run_once`].
+/// As [`Start::prepare`] and [`Start::run`].
 fn run_level(
     level: &Level,
     source: &Path,
     settings: &BenchSettings,
 ) -> Result<BenchRecord, BenchError> {
+    let start = Start::prepare(level, &settings.isolation)?;
     let mut peak: Option<f64> = None;
     let mut run = || {
-        let outcome = run_once(level, source, &settings.isolation)?;
+        let outcome = start.run(level, source)?;
         peak = match (peak, outcome.cost.peak_memory_mb) {
             (Some(a), Some(b)) => Some(a.max(b)),
             (a, b) => a.or(b),
