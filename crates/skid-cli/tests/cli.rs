@@ -1,12 +1,9 @@
 //! The `skid` binary: exit codes, messages and output files.
 
-use std::process::Command;
-
 use skid_cases::csv_out::CsvTable;
 
-fn skid() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_skid"))
-}
+mod common;
+use common::{skid, succeeds};
 
 const CASE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -16,16 +13,11 @@ const CASE: &str = concat!(
 #[test]
 fn run_writes_history_and_summary_and_prints_one_json_line() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let out = skid()
-        .args(["run", CASE, "--out"])
-        .arg(dir.path())
-        .args(["--set", "steps[1].duration=0.005"])
-        .output()
-        .expect("runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let out = succeeds(
+        skid()
+            .args(["run", CASE, "--out"])
+            .arg(dir.path())
+            .args(["--set", "steps[1].duration=0.005"]),
     );
     let stdout = String::from_utf8(out.stdout).expect("utf8");
     assert_eq!(stdout.lines().count(), 1);
@@ -197,18 +189,13 @@ fn bench_runs_each_level_in_a_process_of_its_own() {
     let short = dir.path().join("short.json");
     std::fs::write(&short, case.to_string()).expect("write");
     let bench = dir.path().join("bench");
-    let out = skid()
-        .arg("bench")
-        .arg(&short)
-        .args(["--levels", "1", "--coarser", "0", "--repeats", "1"])
-        .args(["--methods", "reduced", "--out"])
-        .arg(&bench)
-        .output()
-        .expect("runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    succeeds(
+        skid()
+            .arg("bench")
+            .arg(&short)
+            .args(["--levels", "1", "--coarser", "0", "--repeats", "1"])
+            .args(["--methods", "reduced", "--out"])
+            .arg(&bench),
     );
     let records: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(bench.join("bench.json")).expect("bench.json"),
@@ -219,15 +206,14 @@ fn bench_runs_each_level_in_a_process_of_its_own() {
     let level = bench.join("runs/2d-analytic/reduced/0.json");
     assert!(level.is_file(), "the level's case file");
     let alone = dir.path().join("alone");
-    let out = skid()
-        .arg("run")
-        .arg(&level)
-        .arg("--out")
-        .arg(&alone)
-        .args(["--restart-every", "0"])
-        .output()
-        .expect("runs");
-    assert!(out.status.success());
+    let out = succeeds(
+        skid()
+            .arg("run")
+            .arg(&level)
+            .arg("--out")
+            .arg(&alone)
+            .args(["--restart-every", "0"]),
+    );
     let summary: serde_json::Value = serde_json::from_slice(&out.stdout).expect("summary");
     for key in ["deceleration", "t_stop", "increments", "newton_iterations"] {
         assert_eq!(record[key], summary[key], "{key}");

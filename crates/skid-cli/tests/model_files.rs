@@ -2,11 +2,8 @@
 //! error exits with status 2 naming the file and the field, and `skid batch` says a model file is
 //! not a case file.
 
-use std::process::Command;
-
-fn skid() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_skid"))
-}
+mod common;
+use common::{skid, succeeds};
 
 const CASE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -17,30 +14,16 @@ const CASE: &str = concat!(
 fn a_converted_case_runs_as_a_model_file() {
     let dir = tempfile::tempdir().expect("tempdir");
     let model = dir.path().join("model.json");
-    let out = skid()
-        .args(["convert", CASE, "-o"])
-        .arg(&model)
-        .output()
-        .expect("converts");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeds(skid().args(["convert", CASE, "-o"]).arg(&model));
     let text = std::fs::read_to_string(&model).expect("model file");
     assert!(text.contains("\"skid_model\": 1"), "{}", &text[..200]);
-    let out = skid()
-        .arg("run")
-        .arg(&model)
-        .arg("--out")
-        .arg(dir.path().join("run"))
-        .args(["--set", "steps[1].duration=0.002"])
-        .output()
-        .expect("runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let out = succeeds(
+        skid()
+            .arg("run")
+            .arg(&model)
+            .arg("--out")
+            .arg(dir.path().join("run"))
+            .args(["--set", "steps[1].duration=0.002"]),
     );
     let summary: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one line of JSON");
     assert_eq!(summary["model"], "2d-analytic");

@@ -4,13 +4,24 @@
 #![allow(dead_code)] // Each test file uses its part.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Output};
 
 use serde_json::Value;
 
 /// The `skid` binary of this build.
 pub fn skid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_skid"))
+}
+
+/// Runs `command` and returns its output; panics with its standard error unless it succeeded.
+pub fn succeeds(command: &mut Command) -> Output {
+    let out = command.output().expect("skid starts");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
 }
 
 /// A file under the repository's `cases/`.
