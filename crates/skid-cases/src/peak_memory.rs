@@ -24,11 +24,10 @@ pub fn read() -> Option<u64> {
 mod tests {
     use super::*;
 
-    const MIB: u64 = 1 << 20;
-
     #[test]
     fn the_peak_after_a_reset_counts_new_memory_and_a_reset_forgets_it() {
-        let size = 256 * MIB;
+        // 256 MiB, in bytes
+        let size: u64 = 256 << 20;
         assert!(reset(), "Linux resets the peak");
         // every page written, so that it is resident
         let block = vec![1u8; usize::try_from(size).expect("fits")];
