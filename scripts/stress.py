@@ -275,7 +275,7 @@ def read_csv(path):
     return rows[0], rows[1:]
 
 
-def numbers(header, rows, name, problems, text_columns=("step",)):
+def numbers(header, rows, name, problems, text_columns=("step", "status")):
     """The numeric columns of a CSV as floats; non-finite or unreadable cells are problems."""
     out = []
     bad = 0
@@ -349,6 +349,8 @@ def newton_check(rows, tolerances, problems, measures):
     `(force, contact)`."""
     force_tolerance, contact_tolerance = tolerances
     worst_f = worst_c = 0.0
+    # the checks of failed attempts (status "rejected: ...") precede their cutback
+    rows = [r for r in rows if r.get("status", "converged") == "converged"]
     for k, r in enumerate(rows):
         last = k + 1 == len(rows) or rows[k + 1]["iteration"] <= r["iteration"]
         if not last:

@@ -6,14 +6,17 @@
 //! update), `force_residual` (`max_i |R_i - (H^T r)_i|` scaled by the largest force in play)
 //! and `contact_residual` (largest difference between the actual and the linearised gaps and
 //! slips, over the model size): the two measures the increment's convergence test compares with
-//! its tolerances ([`skid_integrator::increment`]). `time` has 10 significant digits, `size` and
+//! its tolerances ([`skid_integrator::increment`]), and `status`: `converged` for the checks of
+//! an increment that converged, or, for those of a failed attempt (before its cutback),
+//! `rejected: ` and the kind of failure ([`skid_integrator::IncrementFailure::kind`]); an attempt
+//! that failed before its first check has no rows. `time` has 10 significant digits, `size` and
 //! the residuals 7. Written through [`PartialCsv`], which quotes a step name holding a comma, a
 //! quote or a line break.
 
 use std::path::Path;
 
 use skid_integrator::Model;
-use skid_integrator::stepper::{IncrementReport, Observer};
+use skid_integrator::stepper::{IncrementReport, Observer, RejectionReport};
 
 use crate::append_file::FileMark;
 use crate::csv_out::PartialCsv;
@@ -22,7 +25,7 @@ use crate::csv_out::PartialCsv;
 pub const NEWTON_CSV: &str = "newton.csv";
 
 /// Column names of `newton.csv`.
-pub const COLUMNS: [&str; 7] = [
+pub const COLUMNS: [&str; 8] = [
     "step",
     "increment",
     "time",
@@ -30,7 +33,11 @@ pub const COLUMNS: [&str; 7] = [
     "iteration",
     "force_residual",
     "contact_residual",
+    "status",
 ];
+
+/// `status` of the rows of a converged increment.
+pub const CONVERGED: &str = "converged";
 
 /// Observer writing `newton.csv`.
 pub struct NewtonRecorder {
@@ -76,23 +83,57 @@ impl NewtonRecorder {
     }
 }
 
+impl NewtonRecorder {
+    /// One row per convergence check of `residuals`.
+    fn record(
+        &mut self,
+        (step, increment, time, size): (&str, usize, f64, f64),
+        residuals: &[(f64, f64)],
+        status: &str,
+    ) -> std::io::Result<()> {
+        for (k, (force, contact)) in residuals.iter().enumerate() {
+            self.csv.record([
+                step.to_string(),
+                increment.to_string(),
+                format!("{time:.9e}"),
+                format!("{size:.6e}"),
+                (k + 1).to_string(),
+                format!("{force:.6e}"),
+                format!("{contact:.6e}"),
+                status.to_string(),
+            ])?;
+        }
+        Ok(())
+    }
+}
+
 impl<const D: usize> Observer<D> for NewtonRecorder {
     fn on_increment(
         &mut self,
         _model: &Model<D>,
         report: &IncrementReport<'_>,
     ) -> std::io::Result<()> {
-        for (k, (force, contact)) in report.counters.residuals.iter().enumerate() {
-            self.csv.record([
-                report.step.to_string(),
-                report.increment.to_string(),
-                format!("{:.9e}", report.state.time),
-                format!("{:.6e}", report.size),
-                (k + 1).to_string(),
-                format!("{force:.6e}"),
-                format!("{contact:.6e}"),
-            ])?;
-        }
-        Ok(())
+        self.record(
+            (
+                report.step,
+                report.increment,
+                report.state.time,
+                report.size,
+            ),
+            &report.counters.residuals,
+            CONVERGED,
+        )
+    }
+
+    fn on_rejection(
+        &mut self,
+        _model: &Model<D>,
+        report: &RejectionReport<'_>,
+    ) -> std::io::Result<()> {
+        self.record(
+            (report.step, report.increment, report.time, report.size),
+            &report.rejection.residuals,
+            &format!("rejected: {}", report.rejection.failure.kind()),
+        )
     }
 }

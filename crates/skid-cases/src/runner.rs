@@ -15,7 +15,9 @@
 
 use std::path::{Path, PathBuf};
 
-use skid_integrator::stepper::{Checkpoint, IncrementReport, Observer, RunStatistics, resume, run};
+use skid_integrator::stepper::{
+    Checkpoint, IncrementReport, Observer, RejectionReport, RunStatistics, resume, run,
+};
 use skid_integrator::{Model, RunError, State};
 
 use serde::Serialize;
@@ -686,6 +688,14 @@ impl<const D: usize, H: History<D>> Observer<D> for Observers<'_, H> {
             self.restart.since += 1;
         }
         Ok(())
+    }
+
+    fn on_rejection(
+        &mut self,
+        model: &Model<D>,
+        report: &RejectionReport<'_>,
+    ) -> std::io::Result<()> {
+        self.newton.on_rejection(model, report)
     }
 
     fn wants_checkpoint(&mut self, boundary: bool) -> bool {

@@ -208,15 +208,18 @@ fn large_steps_converge_quadratically() {
     let text = std::fs::read_to_string(&path).expect("newton.csv");
     let table = CsvTable::new(&text, &path).expect("header");
     let column = |name| table.column(name).expect(name);
-    let (step, number, force) = (
+    let (step, number, force, status) = (
         column("step"),
         column("increment"),
         column("force_residual"),
+        column("status"),
     );
     let mut histories: std::collections::BTreeMap<usize, Vec<f64>> = Default::default();
     for row in table {
         let row = row.expect("record");
-        if row.text(step).expect("step") == "spin-down" {
+        if row.text(step).expect("step") == "spin-down"
+            && row.text(status).expect("status") == skid_cases::newton::CONVERGED
+        {
             let increment = row.number(number).expect("increment");
             let residual = row.number(force).expect("force residual");
             histories.entry(increment).or_default().push(residual);

@@ -55,18 +55,23 @@ fn run_writes_history_and_summary_and_prints_one_json_line() {
     }
     assert!(dir.path().join("summary.json").exists());
 
-    // newton.csv: one row per Newton iteration of every converged increment, the residuals
-    // of the last one of each increment within the tolerances.
+    // newton.csv: one row per Newton iteration of every converged increment (and of failed
+    // attempts, marked as rejected), the residuals of the last one of each converged increment
+    // within the tolerances.
     let newton_path = dir.path().join("newton.csv");
     let newton = std::fs::read_to_string(&newton_path).expect("newton.csv");
     let table = CsvTable::new(&newton, &newton_path).expect("header");
     let column = |name| table.column(name).expect(name);
-    let (iteration, force_column, contact_column) = (
+    let (iteration, force_column, contact_column, status) = (
         column("iteration"),
         column("force_residual"),
         column("contact_residual"),
+        column("status"),
     );
-    let rows: Vec<_> = table.map(|row| row.expect("record")).collect();
+    let rows: Vec<_> = table
+        .map(|row| row.expect("record"))
+        .filter(|row| row.text(status).expect("status") == "converged")
+        .collect();
     assert_eq!(
         Some(rows.len() as u64),
         summary["newton_iterations"].as_u64()

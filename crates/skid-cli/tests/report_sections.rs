@@ -132,13 +132,18 @@ fn convergence_series_give_observed_orders_and_newton_rates() {
             1e-3,
         );
     }
-    let newton = "step,increment,time,size,iteration,force_residual,contact_residual\n\
-                  preload,1,0,0.2,1,1e-2,1e-6\n\
-                  spin-down,1,4e-4,4e-4,1,1e-3,1e-7\n\
-                  spin-down,1,4e-4,4e-4,2,1e-6,1e-14\n\
-                  spin-down,2,8e-4,4e-4,1,1e-2,1e-5\n\
-                  spin-down,2,8e-4,4e-4,2,1e-4,1e-9\n\
-                  spin-down,2,8e-4,4e-4,3,1e-8,1e-16\n";
+    // increment 1's failed attempt has more checks than any converged increment: not shown
+    let newton = "step,increment,time,size,iteration,force_residual,contact_residual,status\n\
+                  preload,1,0,0.2,1,1e-2,1e-6,converged\n\
+                  spin-down,1,8e-4,8e-4,1,1e-1,1e-7,rejected: newton not converged\n\
+                  spin-down,1,8e-4,8e-4,2,1e-1,1e-7,rejected: newton not converged\n\
+                  spin-down,1,8e-4,8e-4,3,1e-1,1e-7,rejected: newton not converged\n\
+                  spin-down,1,8e-4,8e-4,4,1e-1,1e-7,rejected: newton not converged\n\
+                  spin-down,1,4e-4,4e-4,1,1e-3,1e-7,converged\n\
+                  spin-down,1,4e-4,4e-4,2,1e-6,1e-14,converged\n\
+                  spin-down,2,8e-4,4e-4,1,1e-2,1e-5,converged\n\
+                  spin-down,2,8e-4,4e-4,2,1e-4,1e-9,converged\n\
+                  spin-down,2,8e-4,4e-4,3,1e-8,1e-16,converged\n";
     std::fs::write(series.join("dt-0.0004/newton.csv"), newton).expect("newton");
     let (code, stdout, stderr, text) = report(&[("--convergence", "study")], tmp.path());
     assert_eq!(code, Some(0), "{stdout}\n{stderr}");

@@ -23,11 +23,15 @@
 //! weighted as the forces are to keep the scheme of second order; tangent
 //! `M/(beta h^2) + (1 + alpha) K_T`, without `dG/dx` (about `gamma h |W|` of the inertia term,
 //! so Newton converges linearly at that rate on such bodies' equations). Static residual:
-//! `R = F(x)` with `F = f_int - lambda f_ext`; tangent `K_T + M/h_s^2`. The mass term of the static tangent only regularises the Newton
-//! step (it keeps a pad that is not yet held by contact from being singular); it is not in the
-//! residual, so the converged state is exactly static. Where the tangent without contact is
-//! indefinite, the mass term of either matrix grows tenfold at a time until it can be factorized
-//! (see [`Assembler::with_mass_shift`]), which again changes only Newton's path.
+//! `R = F(x)` with `F = f_int - lambda f_ext`; tangent `K_T`, the consistent one, where `K_T`
+//! without the contacts holds every motion (tested on the increment's first tangent, see
+//! [`Assembler::is_held`]), so that Newton converges quadratically; otherwise `K_T + M/h_s^2`.
+//! That mass term only regularises the Newton step (it keeps a pad that is not yet held by
+//! contact from being singular, at the price of a linear rate); it is not in the residual, so
+//! the converged state is exactly static. Where the tangent without contact is indefinite, the
+//! mass term of either matrix grows tenfold at a time (from `M/h_s^2` for a static tangent
+//! without one) until it can be factorized (see [`Assembler::with_mass_shift`]), which again
+//! changes only Newton's path.
 //!
 //! Quasi-static equations (a solid declared without inertia, [`crate::model::SolidPart`]) are
 //! in equilibrium at the end of each dynamic increment with the mean contact force
@@ -156,16 +160,27 @@ impl Workspace {
     }
 }
 
+/// An increment that failed: why, and the residuals of its convergence checks (as in
+/// [`IncrementCounters::residuals`]), so that the failed attempt can be read as a converged one
+/// is.
+#[derive(Clone, Debug)]
+pub struct Rejection {
+    /// Why Newton failed.
+    pub failure: IncrementFailure,
+    /// Scaled (force, contact) residuals at each convergence check of the failed attempt.
+    pub residuals: Vec<(f64, f64)>,
+}
+
 /// Solves one increment from `start`. `held[eq]` marks the constrained equations: kept at
 /// their start value, or, for those of `prescribed` (`(equation, value)`), set to the value
 /// there at the increment's end.
 ///
 /// With [`ContactSolve::Global`], an increment that fails is tried once more with
 /// [`ContactSolve::Reduced`] (counted in [`IncrementCounters::contact_fallbacks`]), and the
-/// failure reported is that of the second attempt.
+/// failure reported is that of the second attempt, with its residuals.
 ///
 /// # Errors
-/// An [`IncrementFailure`] saying why Newton failed; the caller cuts back.
+/// A [`Rejection`] saying why Newton failed; the caller cuts back.
 pub fn solve_increment<const D: usize>(
     model: &Model<D>,
     workspace: &mut Workspace,
@@ -174,18 +189,25 @@ pub fn solve_increment<const D: usize>(
     (held, prescribed): (&[bool], &[(usize, f64)]),
     settings: &Settings,
     timings: &mut Timings,
-) -> Result<(State, IncrementCounters), IncrementFailure> {
+) -> Result<(State, IncrementCounters), Rejection> {
     let mut attempt = |method| {
-        solve_increment_with(
+        let mut counters = IncrementCounters::default();
+        match solve_increment_with(
             model,
             workspace,
             start,
             kind,
             (held, prescribed),
             settings,
-            method,
+            (method, &mut counters),
             timings,
-        )
+        ) {
+            Ok(state) => Ok((state, counters)),
+            Err(failure) => Err(Rejection {
+                failure,
+                residuals: counters.residuals,
+            }),
+        }
     };
     match settings.contact_solve {
         ContactSolve::Reduced => attempt(ContactSolve::Reduced),
@@ -196,12 +218,13 @@ pub fn solve_increment<const D: usize>(
                 counters.contact_fallbacks += 1;
                 Ok((state, counters))
             }
-            Err(failure) => Err(failure),
+            Err(rejection) => Err(rejection),
         },
     }
 }
 
-/// [`solve_increment`] with the contact forces of every iteration from `method`.
+/// [`solve_increment`] with the contact forces of every iteration from `method`, counting into
+/// `counters` (which keep the residuals of a failed attempt too).
 #[allow(clippy::too_many_arguments)] // solve_increment's inputs and the method
 fn solve_increment_with<const D: usize>(
     model: &Model<D>,
@@ -210,9 +233,9 @@ fn solve_increment_with<const D: usize>(
     kind: IncrementKind,
     (held, prescribed): (&[bool], &[(usize, f64)]),
     settings: &Settings,
-    method: ContactSolve,
+    (method, counters): (ContactSolve, &mut IncrementCounters),
     timings: &mut Timings,
-) -> Result<(State, IncrementCounters), IncrementFailure> {
+) -> Result<State, IncrementFailure> {
     let Workspace { assembler, global } = workspace;
     let newton = &settings.newton;
     let max_iterations = match method {
@@ -236,7 +259,7 @@ fn solve_increment_with<const D: usize>(
     };
     // The solid's rows of the tangent are `c_K K_T`, the mass term `c_M M` (regularising in a
     // static increment, inertial in a dynamic one).
-    let (k_factor, m_factor, m_term) = match kind {
+    let (k_factor, mut m_factor, m_term) = match kind {
         IncrementKind::Static { regularization, .. } => (1.0, regularization, shift_mass),
         IncrementKind::Dynamic { hht, h, .. } => {
             let k_factor = if model.part().quasi_static {
@@ -249,9 +272,16 @@ fn solve_increment_with<const D: usize>(
     };
     // A quasi-static solid has no mass term in a dynamic tangent; if the tangent is indefinite
     // without the contacts, the shift starts far below the inertia its density would give.
-    let shift_start = match kind {
-        IncrementKind::Dynamic { .. } if model.part().quasi_static => m_factor * QUASI_STATIC_SHIFT,
-        _ => m_factor,
+    // A static increment whose tangent holds every motion without the contacts drops its
+    // regularisation (`m_factor = 0` below, decided on the first tangent), so that Newton
+    // takes the consistent tangent of the residual it solves; the regularisation is then the
+    // first shift of a tangent that turns indefinite.
+    let mut shift = match kind {
+        IncrementKind::Dynamic { .. } if model.part().quasi_static => {
+            let first = m_factor * QUASI_STATIC_SHIFT;
+            (first, first)
+        }
+        _ => (m_factor, m_factor),
     };
     let mut x = match kind {
         IncrementKind::Static { .. } => start.x.clone(),
@@ -268,7 +298,6 @@ fn solve_increment_with<const D: usize>(
         moving[eq] = true;
     }
     assembler.start_mixed_pressures(model, &start.x)?;
-    let mut counters = IncrementCounters::default();
     let mut warm = start.warm_forces.clone();
     // The contact forces of the last step and what the next iterate's contact state is
     // checked against.
@@ -467,7 +496,7 @@ fn solve_increment_with<const D: usize>(
                     moving,
                 };
                 let state = finish(model, start, kind, iterate, &rows, r, warm);
-                return Ok((state, counters));
+                return Ok(state);
             }
             if iteration == max_iterations {
                 return Err(IncrementFailure::NewtonNotConverged {
@@ -524,6 +553,13 @@ fn solve_increment_with<const D: usize>(
             if !tangent_now {
                 assembler.internal(model, &x, Some(k_factor))?;
             }
+            if matches!(kind, IncrementKind::Static { .. }) && counters.newton_iterations == 0 {
+                assembler.hold(held);
+                if assembler.is_held(shift_mass, held)? {
+                    m_factor = 0.0;
+                    shift.0 = 0.0;
+                }
+            }
             assembler.add_diagonal(&(m_term * m_factor));
             assembler.add_contact_curvature(&rows, &warm);
             assembler.hold(held);
@@ -537,7 +573,7 @@ fn solve_increment_with<const D: usize>(
         let dx = if rows.is_empty() {
             let clock = Instant::now();
             let (factor, _) =
-                assembler.with_mass_shift(shift_mass, shift_start, held, |a| a.factorize())?;
+                assembler.with_mass_shift(shift_mass, shift, held, |a| a.factorize())?;
             let dx = factor.solve(&(-&residual));
             timings.linear_solve += clock.elapsed();
             last = Some(LastForces::Linearised {
@@ -574,7 +610,7 @@ fn solve_increment_with<const D: usize>(
                 weights = Some(contact_weights(k, &rows));
             }
             let ((dx, solution, factor), _) =
-                assembler.with_mass_shift(shift_mass, shift_start, held, |a| {
+                assembler.with_mass_shift(shift_mass, shift, held, |a| {
                     contact_step(
                         a,
                         &rows,

@@ -61,6 +61,6 @@ pub use motion::{BodyMotion, MotionTarget, PrescribedMotion};
 pub use settings::Settings;
 pub use state::State;
 pub use stepper::{
-    Adaptive, Checkpoint, IncrementReport, Observer, RunStatistics, StaticIncrements, Step,
-    StepKind, StepStatistics, resume, run,
+    Adaptive, Checkpoint, IncrementReport, Observer, RejectionReport, RunStatistics,
+    StaticIncrements, Step, StepKind, StepStatistics, resume, run,
 };

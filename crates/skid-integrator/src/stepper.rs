@@ -33,7 +33,7 @@ use crate::dof::EquationKind;
 use crate::error::{IncrementFailure, RunError};
 use crate::global_contact::{GlobalContactSolver, GlobalSolverMemory};
 use crate::hht::Hht;
-use crate::increment::{IncrementCounters, IncrementKind, Workspace, solve_increment};
+use crate::increment::{IncrementCounters, IncrementKind, Rejection, Workspace, solve_increment};
 use crate::loads::{LoadInstant, Variation};
 use crate::model::Model;
 use crate::motion::{BodyMotion, body_equation};
@@ -328,6 +328,21 @@ pub struct IncrementReport<'a> {
     pub counters: &'a IncrementCounters,
 }
 
+/// A failed attempt at an increment, answered by a cutback or ending the step.
+#[derive(Clone, Copy, Debug)]
+pub struct RejectionReport<'a> {
+    /// Step name.
+    pub step: &'a str,
+    /// Number the increment would have had within the step.
+    pub increment: usize,
+    /// Time at the end of the attempted increment (the start's in a static step), s.
+    pub time: f64,
+    /// Size of the attempted increment (time, or load-factor fraction for static steps).
+    pub size: f64,
+    /// Why it failed, and the residuals of its convergence checks.
+    pub rejection: &'a Rejection,
+}
+
 /// Receives every converged increment (history and field output).
 pub trait Observer<const D: usize> {
     /// Called once per converged increment, and once for the initial state.
@@ -339,6 +354,20 @@ pub trait Observer<const D: usize> {
         model: &Model<D>,
         report: &IncrementReport<'_>,
     ) -> std::io::Result<()>;
+
+    /// Called once per failed attempt at an increment, before the cutback (or the end of the
+    /// step); the default ignores it.
+    ///
+    /// # Errors
+    /// An I/O error stops the run.
+    fn on_rejection(
+        &mut self,
+        model: &Model<D>,
+        report: &RejectionReport<'_>,
+    ) -> std::io::Result<()> {
+        let _ = (model, report);
+        Ok(())
+    }
 
     /// Whether to receive a [`Checkpoint`] of the run as it stands after the increment just
     /// reported (asked after every [`Self::on_increment`]); `boundary` is true for the initial
@@ -1186,7 +1215,24 @@ impl<const D: usize> Run<'_, D> {
                         })?;
                     stats.timings.output += output;
                 }
-                Err(cause) => {
+                Err(rejection) => {
+                    let clock = Instant::now();
+                    let written = self.observer.on_rejection(
+                        model,
+                        &RejectionReport {
+                            step: &step.name,
+                            increment: increment + 1,
+                            time: match step.kind {
+                                StepKind::Static { .. } => state.time,
+                                StepKind::Dynamic { .. } => t0 + (progress + dp) * span,
+                            },
+                            size: dp * span,
+                            rejection: &rejection,
+                        },
+                    );
+                    stats.timings.output += clock.elapsed();
+                    written?;
+                    let cause = rejection.failure;
                     stats.steps[index].wall_time = spent + started.elapsed();
                     stats.cutbacks += 1;
                     *stats

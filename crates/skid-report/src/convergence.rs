@@ -23,7 +23,7 @@ use super::format::{Sig, percent, show};
 use super::plot::{NEWTON_SVG, plot_newton};
 use super::{ReportError, Run, e_slide, load_runs};
 use skid_cases::csv_out::CsvTable;
-use skid_cases::newton::NEWTON_CSV;
+use skid_cases::newton::{CONVERGED, NEWTON_CSV};
 use skid_cases::schema::{Case, StepSpec};
 
 /// What the levels of a series refine.
@@ -198,8 +198,9 @@ fn refinement(names: &[&str], cases: &[&Case]) -> Result<Refinement, String> {
 }
 
 /// Parses `newton.csv` text ([`CsvTable`]: columns found by name) and keeps the increment of a
-/// dynamic step (named in `dynamic`) with the most Newton iterations, the earliest of equals;
-/// `None` if there is none. `path` is only used in messages.
+/// dynamic step (named in `dynamic`) with the most Newton iterations, the earliest of equals,
+/// among the converged increments (a `status` column, where there is one, says which rows are
+/// theirs); `None` if there is none. `path` is only used in messages.
 ///
 /// # Errors
 /// [`ReportError::Parse`] naming the file, and the line or column at fault.
@@ -216,6 +217,9 @@ pub fn hardest_increment(
         table.column("force_residual")?,
         table.column("contact_residual")?,
     );
+    // the checks of failed attempts are not the increment's (files without the column have
+    // none)
+    let status = table.column("status").ok();
     let mut best: Option<NewtonIncrement> = None;
     let mut current = NewtonIncrement::default();
     let mut flush = |current: &mut NewtonIncrement| {
@@ -232,6 +236,11 @@ pub fn hardest_increment(
         let row = row?;
         let step = row.text(is)?;
         if !dynamic.contains(&step) {
+            continue;
+        }
+        if let Some(status) = status
+            && row.text(status)? != CONVERGED
+        {
             continue;
         }
         let increment = row.number(ii)?;
