@@ -8,6 +8,13 @@ use nalgebra::{DVector, Matrix3, SVector, Vector3};
 
 use crate::error::FemError;
 
+/// Most nodes of an element: `2^D` (the corners of the cell) for D <= 3.
+pub const MAX_NODES: usize = 8;
+
+/// Most displacement components of an element: `D 2^D` for D <= 3. An element stiffness has
+/// at most its square entries.
+pub const MAX_COMPONENTS: usize = 3 * MAX_NODES;
+
 /// Number of corners `2^dim` of the reference cell.
 pub const fn corner_count(dim: usize) -> usize {
     1 << dim

@@ -32,15 +32,28 @@ pub enum FemError {
         /// Admissible range, in words.
         expected: &'static str,
     },
-    /// The deformation gradient has `J = det F <= 0` or non-finite entries, at the element's
-    /// centre or at one of its corners.
+    /// The deformation gradient has `J = det F <= 0` or non-finite entries, at an integration
+    /// point of the element (the centre of a one-point element) or at one of its corners.
     #[error("inverted element: det F = {det_f} {}", inversion_point(*.corner))]
     InvertedElement {
         /// Determinant of the deformation gradient (the volume ratio) where it failed.
         det_f: f64,
-        /// The corner where it failed (its index in the cell corner order), `None` for the
-        /// centre (the integration point).
+        /// The corner where it failed (its index in the cell corner order), `None` for an
+        /// integration point (the centre of a one-point element).
         corner: Option<usize>,
+    },
+    /// The local Newton solve for an element's incompatible-mode parameters (the condensed
+    /// enhanced strains of [`crate::IntegratedSolid`]) did not converge, or its mode stiffness
+    /// `K_aa` is singular (then `residual` is NaN when found at the converged modes).
+    #[error(
+        "incompatible modes not converged: residual {residual:.3e} after {iterations} local \
+         Newton iterations"
+    )]
+    IncompatibleModesNotConverged {
+        /// Euclidean norm of the mode residual `dPi/dalpha` (N) at the last iterate.
+        residual: f64,
+        /// Local Newton iterations done.
+        iterations: usize,
     },
     /// The reference geometry has a non-positive (or non-finite) Jacobian determinant.
     #[error(

@@ -31,6 +31,10 @@ pub trait Hyperelastic: Send + Sync + std::fmt::Debug {
     fn volumetric_pressure(&self, j: f64) -> f64;
     /// `U''(J)`, the derivative of [`Self::volumetric_pressure`].
     fn volumetric_stiffness(&self, j: f64) -> f64;
+    /// The volumetric energy `U(J)` per unit reference volume, with `U(1) = 0`: the part of
+    /// [`Self::strain_energy`] whose derivative is [`Self::volumetric_pressure`], so that
+    /// `W_iso(F) = W(F) - U(det F)` depends on the isochoric deformation only.
+    fn volumetric_energy(&self, j: f64) -> f64;
 
     /// The stress-dependent terms of the tangent with a given pressure `p_m` in place of
     /// `p = U'(J)`: returns `tau_m = tau + J (p_m - p) I` (for the geometric stiffness) and
@@ -288,6 +292,11 @@ impl Hyperelastic for PolynomialN1 {
     fn volumetric_stiffness(&self, _j: f64) -> f64 {
         2.0 / self.d1
     }
+
+    /// `U(J) = (J - 1)^2 / D1`.
+    fn volumetric_energy(&self, j: f64) -> f64 {
+        (j - 1.0).powi(2) / self.d1
+    }
 }
 
 #[cfg(test)]
@@ -409,6 +418,20 @@ mod tests {
                 assert!(err < 1e-6, "G = {g}: {fd} vs {analytic} (err {err})");
             }
         }
+        Ok(())
+    }
+
+    /// `U` is the volumetric part of `W` (`W - U` is unchanged by a dilatation) and `U' = p`.
+    #[test]
+    fn volumetric_energy_is_the_volumetric_part_of_the_strain_energy() -> Result<(), FemError> {
+        let m = benchmark()?;
+        let f = general_f();
+        let iso = |f: &Matrix3<f64>| m.strain_energy(f) - m.volumetric_energy(f.determinant());
+        assert!((iso(&(f * 1.07)) - iso(&f)).abs() < 1e-9 * C10);
+        assert_eq!(m.volumetric_energy(1.0), 0.0);
+        let (j, h) = (1.03, 1e-6);
+        let fd = (m.volumetric_energy(j + h) - m.volumetric_energy(j - h)) / (2.0 * h);
+        assert!((fd - m.volumetric_pressure(j)).abs() < 1e-7 * m.volumetric_pressure(j));
         Ok(())
     }
 

@@ -4,21 +4,19 @@
 //! An evaluation allocates nothing: its results live in fixed arrays sized for the largest
 //! element (3D), and the tangent goes into a buffer of the caller's.
 
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, SMatrix, SVector, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, SVector, Vector3};
 
 use crate::cell::{
-    ReferenceGeometry, corner_count, corners, embed, hourglass_base_vectors, hourglass_mode_axes,
-    jacobian, restrict, shape_gradients,
+    ReferenceGeometry, corner_count, embed, hourglass_base_vectors, hourglass_mode_axes,
 };
 use crate::error::FemError;
-use crate::material::{Hyperelastic, VOIGT_INDEX};
+use crate::kinematics::{
+    CornerGradients, add_pair_stiffness, check_corners, check_inputs, check_parameter,
+    corner_gradients, gradient_of, inverse_jacobian,
+};
+use crate::material::Hyperelastic;
 
-/// Most nodes of an element: `2^D` for D <= 3.
-pub const MAX_NODES: usize = 8;
-
-/// Most displacement components of an element: `D 2^D` for D <= 3. An element stiffness has
-/// at most its square entries.
-pub const MAX_COMPONENTS: usize = 3 * MAX_NODES;
+pub use crate::cell::{MAX_COMPONENTS, MAX_NODES};
 
 /// A reduced-integration solid element: reference volume, mean gradients and hourglass data.
 #[derive(Clone, Debug)]
@@ -37,7 +35,7 @@ pub struct OnePointSolid<const D: usize> {
     /// Per corner of the cell, the reference gradients `grad_X N_I` there that do not vanish
     /// (those of the corner's node and of its D neighbours along the edges), with their node
     /// `I`, for the corner check of [`Self::respond`].
-    corner_gradients: Vec<Vec<(usize, SVector<f64, D>)>>,
+    corner_gradients: CornerGradients<D>,
 }
 
 /// Response of one element at a given displacement. Vectors are node-major (index `a * D + i`)
@@ -45,11 +43,11 @@ pub struct OnePointSolid<const D: usize> {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ElementResponse {
     /// `D * 2^D`, the length of [`Self::force`] and [`Self::volume_ratio_gradient`].
-    components: usize,
+    pub(crate) components: usize,
     /// Internal nodal forces in the first `components` entries.
-    force: [f64; MAX_COMPONENTS],
+    pub(crate) force: [f64; MAX_COMPONENTS],
     /// `dJ/du` in the first `components` entries.
-    volume_ratio_gradient: [f64; MAX_COMPONENTS],
+    pub(crate) volume_ratio_gradient: [f64; MAX_COMPONENTS],
     /// Material strain energy `V0 W(F)`.
     pub strain_energy: f64,
     /// Hourglass stabilisation energy.
@@ -191,15 +189,7 @@ impl<const D: usize> OnePointSolid<D> {
             hourglass_vectors,
             hourglass_stiffness,
             hourglass_matrices,
-            corner_gradients: corners::<D>()
-                .iter()
-                .map(|xi| {
-                    let gradients = reference_gradients(x_ref, xi)?.into_iter().enumerate();
-                    Ok(gradients
-                        .filter(|(_, g)| g.iter().any(|&c| c != 0.0))
-                        .collect())
-                })
-                .collect::<Result<_, FemError>>()?,
+            corner_gradients: corner_gradients(x_ref)?,
         })
     }
 
@@ -280,27 +270,7 @@ impl<const D: usize> OnePointSolid<D> {
     ) -> Result<ElementResponse, FemError> {
         let n = self.node_count();
         let components = D * n;
-        if u.len() != n {
-            return Err(FemError::LengthMismatch {
-                what: "nodal displacements",
-                expected: n,
-                found: u.len(),
-            });
-        }
-        if let Some((_, k)) = &tangent
-            && k.len() != components * components
-        {
-            return Err(FemError::LengthMismatch {
-                what: "element stiffness entries",
-                expected: components * components,
-                found: k.len(),
-            });
-        }
-        if u.iter().any(|v| !v.iter().all(|c| c.is_finite())) {
-            return Err(FemError::NonFinite {
-                what: "nodal displacements",
-            });
-        }
+        check_inputs(u, n, tangent.as_ref().map(|(_, k)| k.len()))?;
         let f = self.deformation_gradient(u);
         let det_f = f.determinant();
         let inverted = FemError::InvertedElement {
@@ -310,15 +280,7 @@ impl<const D: usize> OnePointSolid<D> {
         if !(det_f > 0.0 && f.iter().all(|v| v.is_finite())) {
             return Err(inverted);
         }
-        for (corner, gradients) in self.corner_gradients.iter().enumerate() {
-            let det_f = gradient_of(gradients.iter().map(|(a, g)| (g, &u[*a]))).determinant();
-            if det_f.is_nan() || det_f <= 0.0 {
-                return Err(FemError::InvertedElement {
-                    det_f,
-                    corner: Some(corner),
-                });
-            }
-        }
+        check_corners(&self.corner_gradients, u)?;
         let f_inv_t = f.try_inverse().ok_or(inverted)?.transpose();
         let tau = material.kirchhoff_stress(&f);
         let mut g = [Vector3::zeros(); MAX_NODES];
@@ -372,50 +334,19 @@ impl<const D: usize> OnePointSolid<D> {
 
     /// The tangent of [`Self::respond_with_tangent`] for the spatial gradients `g` from the
     /// volume-scaled stress `tau = V0 tau` and tangent `c = V0 c^tau` (Voigt, tensor
-    /// components): `K_ab,ik = sum_j g_aj (sum_l c_ijkl g_bl) + delta_ik [g_a . (tau g_b)
-    /// + sum_alpha k_{alpha i} gamma_{alpha a} gamma_{alpha b}]`, for `b >= a`, written to both
-    /// `K_ab` and `K_ba = K_ab^T` of the column-major `k` (a block `K_aa` takes the entries of
-    /// its upper triangle for both triangles, so that `k` is exactly symmetric).
+    /// components): the node-pair blocks of [`add_pair_stiffness`] plus the hourglass stiffness
+    /// `delta_ik sum_alpha k_{alpha i} gamma_{alpha a} gamma_{alpha b}`, evaluated for `b >= a`
+    /// and written to both `K_ab` and `K_ba`, so that `k` is exactly symmetric.
     fn stiffness(&self, g: &[Vector3<f64>], tau: &Matrix3<f64>, c: &Matrix6<f64>, k: &mut [f64]) {
         let components = D * g.len();
-        // per node b: c B_b, the Voigt tangent times the Voigt vectors of sym(e_m (x) g_b)
-        // (entries g_bl at the rows of the pairs (m, l)): `[b][R][m] = sum_l c_{R (ml)} g_bl`;
-        // and tau g_b
-        let mut c_b = [[[0.0; 3]; 6]; MAX_NODES];
-        let mut tau_g = [Vector3::zeros(); MAX_NODES];
-        for ((c_b, tau_g_b), g_b) in c_b.iter_mut().zip(&mut tau_g).zip(g) {
-            *tau_g_b = tau * g_b;
-            for (r, row) in c_b.iter_mut().enumerate() {
-                for (m, value) in row.iter_mut().enumerate().take(D) {
-                    *value = (0..D).map(|l| c[(r, VOIGT_INDEX[m][l])] * g_b[l]).sum();
-                }
-            }
-        }
-        for (a, g_a) in g.iter().enumerate() {
-            for (b, (c_b, tau_g_b)) in c_b.iter().zip(&tau_g).enumerate().take(g.len()).skip(a) {
-                let geometric = g_a.dot(tau_g_b);
-                let block = SMatrix::<f64, D, D>::from_fn(|i, m| {
-                    // K_aa is symmetric up to round-off: its upper triangle stands for both
-                    let (i, m) = if a == b && i > m { (m, i) } else { (i, m) };
-                    let material: f64 = (0..D).map(|j| g_a[j] * c_b[VOIGT_INDEX[i][j]][m]).sum();
-                    if i == m {
-                        material + geometric + self.hourglass_matrices[i][a][b]
-                    } else {
-                        material
-                    }
-                });
-                // K_ab: column b D + m holds the block's column m in rows a D..a D + D;
-                // K_ba = K_ab^T: column a D + i holds its row i in rows b D..b D + D
-                for (m, column) in block.column_iter().enumerate() {
-                    let start = (b * D + m) * components + a * D;
-                    for (entry, value) in k[start..start + D].iter_mut().zip(column.iter()) {
-                        *entry = *value;
-                    }
-                }
-                for (i, row) in block.row_iter().enumerate() {
-                    let start = (a * D + i) * components + b * D;
-                    for (entry, value) in k[start..start + D].iter_mut().zip(row.iter()) {
-                        *entry = *value;
+        k.fill(0.0);
+        add_pair_stiffness::<D>(g, tau, c, k);
+        for (i, h) in self.hourglass_matrices.iter().enumerate() {
+            for (a, h_a) in h.iter().enumerate().take(g.len()) {
+                for (b, h_ab) in h_a.iter().enumerate().take(g.len()).skip(a) {
+                    k[(b * D + i) * components + a * D + i] += h_ab;
+                    if a != b {
+                        k[(a * D + i) * components + b * D + i] += h_ab;
                     }
                 }
             }
@@ -426,65 +357,6 @@ impl<const D: usize> OnePointSolid<D> {
     pub fn lumped_node_mass(&self, density: f64) -> f64 {
         density * self.volume / self.node_count() as f64
     }
-}
-
-/// `value` if it is finite and `admissible`, else [`FemError::InvalidParameter`].
-fn check_parameter(
-    name: &'static str,
-    value: f64,
-    admissible: bool,
-    expected: &'static str,
-) -> Result<f64, FemError> {
-    if admissible && value.is_finite() {
-        Ok(value)
-    } else {
-        Err(FemError::InvalidParameter {
-            name,
-            value,
-            expected,
-        })
-    }
-}
-
-/// `F = I + sum_I u_I (x) g_I` for the shape-function gradients `g_I` at one point, embedded in
-/// 3D, from the pairs `(g_I, u_I)` (a node whose gradient vanishes adds nothing and may be left
-/// out).
-fn gradient_of<'a, const D: usize>(
-    terms: impl Iterator<Item = (&'a SVector<f64, D>, &'a SVector<f64, D>)>,
-) -> Matrix3<f64> {
-    terms.fold(Matrix3::identity(), |f, (g, u)| {
-        f + embed(u) * embed(g).transpose()
-    })
-}
-
-/// The inverse reference Jacobian at `xi`, `J^-1 = d xi / dX`.
-///
-/// # Errors
-/// [`FemError::DegenerateElement`] if the Jacobian is singular.
-fn inverse_jacobian<const D: usize>(
-    x_ref: &[SVector<f64, D>],
-    xi: &SVector<f64, D>,
-) -> Result<Matrix3<f64>, FemError> {
-    let j = jacobian(x_ref, xi);
-    j.try_inverse().ok_or(FemError::DegenerateElement {
-        det_j: j.determinant(),
-    })
-}
-
-/// `grad_X N_I = J^-T grad_xi N_I` at `xi`: then `det F` there, with [`gradient_of`], is
-/// `det J(xi; X + u) / det J(xi; X)`.
-///
-/// # Errors
-/// [`FemError::DegenerateElement`] if the Jacobian is singular.
-fn reference_gradients<const D: usize>(
-    x_ref: &[SVector<f64, D>],
-    xi: &SVector<f64, D>,
-) -> Result<Vec<SVector<f64, D>>, FemError> {
-    let inverse_t = inverse_jacobian(x_ref, xi)?.transpose();
-    Ok(shape_gradients::<D>(xi)
-        .iter()
-        .map(|dn| restrict(&(inverse_t * embed(dn))))
-        .collect())
 }
 
 /// `g_m = grad_X xi_m` at the cell centre: the rows of the inverse reference Jacobian there.
