@@ -10,6 +10,7 @@ use std::collections::BTreeMap;
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
+use skid_fem::element::Formulation;
 
 use crate::schema::{
     AdaptiveSpec, MaterialSpec, OutputSpec, SolverSpec, default_alpha, default_regularization_time,
@@ -133,29 +134,90 @@ pub struct SetMaterialSpec {
     pub density: f64,
 }
 
-/// Element types of a deformable part.
+/// Element types of a deformable part: bilinear quads (plane strain, 2D) and trilinear hexes
+/// (3D), in the formulations of [`Formulation`].
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, JsonSchema, PartialEq, Eq)]
 pub enum ElementType {
     /// 4-node plane-strain quadrilateral, one-point integration with hourglass control (2D).
     #[serde(rename = "CPE4R")]
     Cpe4r,
+    /// 4-node plane-strain quadrilateral, full (2 x 2) integration (2D).
+    #[serde(rename = "CPE4")]
+    Cpe4,
+    /// 4-node plane-strain quadrilateral, full integration, constant-pressure hybrid (2D).
+    #[serde(rename = "CPE4H")]
+    Cpe4h,
+    /// 4-node plane-strain quadrilateral, full integration with incompatible modes (2D).
+    #[serde(rename = "CPE4I")]
+    Cpe4i,
     /// 8-node hexahedron, one-point integration with hourglass control (3D).
     #[serde(rename = "C3D8R")]
     C3d8r,
+    /// 8-node hexahedron, full (2 x 2 x 2) integration (3D).
+    #[serde(rename = "C3D8")]
+    C3d8,
+    /// 8-node hexahedron, full integration, constant-pressure hybrid (3D).
+    #[serde(rename = "C3D8H")]
+    C3d8h,
+    /// 8-node hexahedron, full integration with incompatible modes (3D).
+    #[serde(rename = "C3D8I")]
+    C3d8i,
 }
 
 impl ElementType {
+    /// Every element type.
+    pub const ALL: [Self; 8] = [
+        Self::Cpe4r,
+        Self::Cpe4,
+        Self::Cpe4h,
+        Self::Cpe4i,
+        Self::C3d8r,
+        Self::C3d8,
+        Self::C3d8h,
+        Self::C3d8i,
+    ];
+
     /// Dimension the element lives in.
     pub fn dimension(self) -> usize {
         match self {
-            Self::Cpe4r => 2,
-            Self::C3d8r => 3,
+            Self::Cpe4r | Self::Cpe4 | Self::Cpe4h | Self::Cpe4i => 2,
+            Self::C3d8r | Self::C3d8 | Self::C3d8h | Self::C3d8i => 3,
         }
     }
 
-    /// The element type of a part's solid elements in dimension `dim`.
+    /// The element's formulation.
+    pub fn formulation(self) -> Formulation {
+        match self {
+            Self::Cpe4r | Self::C3d8r => Formulation::Reduced,
+            Self::Cpe4 | Self::C3d8 => Formulation::Full,
+            Self::Cpe4h | Self::C3d8h => Formulation::Hybrid,
+            Self::Cpe4i | Self::C3d8i => Formulation::Incompatible,
+        }
+    }
+
+    /// The element type of `formulation` in dimension `dim` (2D for `dim = 2`, 3D otherwise).
+    pub fn of(formulation: Formulation, dim: usize) -> Self {
+        match (formulation, dim == 2) {
+            (Formulation::Reduced, true) => Self::Cpe4r,
+            (Formulation::Full, true) => Self::Cpe4,
+            (Formulation::Hybrid, true) => Self::Cpe4h,
+            (Formulation::Incompatible, true) => Self::Cpe4i,
+            (Formulation::Reduced, false) => Self::C3d8r,
+            (Formulation::Full, false) => Self::C3d8,
+            (Formulation::Hybrid, false) => Self::C3d8h,
+            (Formulation::Incompatible, false) => Self::C3d8i,
+        }
+    }
+
+    /// The element type of a part's solid elements in dimension `dim` (the one-point
+    /// element, skid's default).
     pub fn solid(dim: usize) -> Self {
-        if dim == 2 { Self::Cpe4r } else { Self::C3d8r }
+        Self::of(Formulation::Reduced, dim)
+    }
+
+    /// The Abaqus name, `CPE4R` ... `C3D8I`.
+    pub fn name(self) -> &'static str {
+        self.formulation().abaqus_name(self.dimension())
     }
 }
 

@@ -15,8 +15,8 @@ use nalgebra::{DVector, SVector, Vector3};
 
 use crate::dof::DofMap;
 use crate::error::ModelError;
+use skid_fem::element::SolidElement;
 use skid_fem::rigid::{RigidBody, Rotation};
-use skid_fem::solid::OnePointSolid;
 
 /// A piecewise-linear function of the step time given by points `(t_k, a_k)` with increasing
 /// `t_k`: `a(t) = a_k + (a_{k+1} - a_k) (t - t_k) / (t_{k+1} - t_k)` on `[t_k, t_{k+1}]`, held
@@ -184,8 +184,9 @@ pub struct ConcentratedLoad<const D: usize> {
 }
 
 /// A uniform body-force acceleration at factor 1: the force `m_i g` on every lumped mass
-/// `m_i = sum_e rho V_e / 2^D` of the loaded elements' nodes (`V_e` counts the plane-strain
-/// thickness in 2D), and, for the whole model, `M_b g` on every rigid body's point mass.
+/// `m_i = sum_e m_{e,i}` of the loaded elements' nodes (`m_{e,i}`: element e's lumped mass at
+/// node i, [`SolidElement::lumped_node_masses`], the plane-strain thickness included in 2D),
+/// and, for the whole model, `M_b g` on every rigid body's point mass.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GravityLoad<const D: usize> {
     /// Acceleration `g`, m/s^2.
@@ -248,7 +249,7 @@ pub struct DeadLoad {
 pub(crate) struct Scene<'a, const D: usize> {
     pub dofs: &'a DofMap<D>,
     pub bodies: &'a [RigidBody<D>],
-    pub elements: &'a [OnePointSolid<D>],
+    pub elements: &'a [SolidElement<D>],
     pub connectivity: &'a [Vec<usize>],
     /// Mass density of each element, kg/m^3.
     pub densities: &'a [f64],
@@ -380,8 +381,8 @@ impl<const D: usize> GravityLoad<D> {
                     scene.elements.len()
                 ));
             };
-            let m = element.lumped_node_mass(scene.densities[e]);
-            for &n in &scene.connectivity[e] {
+            let masses = element.lumped_node_masses(scene.densities[e]);
+            for (&n, m) in scene.connectivity[e].iter().zip(masses) {
                 add(scene.dofs.node(n), m);
             }
         }

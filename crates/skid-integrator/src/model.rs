@@ -6,10 +6,10 @@ use nalgebra::{DVector, SVector, Vector3};
 use skid_contact::kinematics::RotatingFrame;
 use skid_contact::surface::RigidSurface;
 use skid_fem::cell::embed;
+use skid_fem::element::{Formulation, SolidElement};
 use skid_fem::material::Hyperelastic;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::{RigidBody, Rotation};
-use skid_fem::solid::OnePointSolid;
 
 use crate::dof::{DofMap, EquationOwner};
 use crate::error::ModelError;
@@ -40,8 +40,11 @@ pub struct SolidPart<const D: usize> {
     pub element_sections: Vec<usize>,
     /// Out-of-plane thickness in 2D (plane strain), m; 1 in 3D.
     pub thickness: f64,
-    /// Factor on the hourglass stabilisation stiffness (1 = default).
+    /// Factor on the hourglass stabilisation stiffness of the one-point elements (1 = default).
     pub hourglass_scale: f64,
+    /// Formulation of each element; empty when every element is the one-point
+    /// [`Formulation::Reduced`].
+    pub element_formulations: Vec<Formulation>,
     /// Whether the solid is quasi-static: its nodes carry no inertia, so in a dynamic step they
     /// are in equilibrium with the mean contact forces of each increment (see
     /// [`crate::increment`]). The densities then serve only the regularisation of static
@@ -67,6 +70,12 @@ impl<const D: usize> SolidPart<D> {
     /// The mass density of element `e`, kg/m^3.
     pub fn density(&self, e: usize) -> f64 {
         self.section(e).density
+    }
+
+    /// The formulation of element `e` ([`Formulation::Reduced`] for an element beyond
+    /// `element_formulations`, which [`Model::new`] refuses unless that list is empty).
+    pub fn formulation(&self, e: usize) -> Formulation {
+        (self.element_formulations.get(e).copied()).unwrap_or(Formulation::Reduced)
     }
 }
 
@@ -103,7 +112,7 @@ pub struct Model<const D: usize> {
     pressures: Vec<PressureLoad>,
     dead_loads: Vec<DeadLoad>,
     contacts: Vec<ContactPair>,
-    elements: Vec<OnePointSolid<D>>,
+    elements: Vec<SolidElement<D>>,
     dofs: DofMap<D>,
     mass: DVector<f64>,
     regularization_mass: DVector<f64>,
@@ -170,6 +179,13 @@ impl<const D: usize> Model<D> {
             return invalid(format!(
                 "element {e}: section {k} does not exist ({} sections)",
                 part.sections.len()
+            ));
+        }
+        let formulations = part.element_formulations.len();
+        if formulations != 0 && formulations != part.mesh.elements.len() {
+            return invalid(format!(
+                "{formulations} element formulations for {} elements",
+                part.mesh.elements.len()
             ));
         }
         if !(part.thickness.is_finite() && part.thickness > 0.0) {
@@ -266,8 +282,10 @@ impl<const D: usize> Model<D> {
         for (e, conn) in part.mesh.elements.iter().enumerate() {
             let mu0 = part.material(e).initial_shear_modulus();
             let x: Vec<SVector<f64, D>> = conn.iter().map(|&n| part.mesh.nodes[n]).collect();
-            let element = OnePointSolid::new(&x, part.thickness, mu0, part.hourglass_scale)
-                .map_err(|err| ModelError::Invalid(format!("element {e}: {err}")))?;
+            let formulation = part.formulation(e);
+            let element =
+                SolidElement::new(formulation, &x, part.thickness, mu0, part.hourglass_scale)
+                    .map_err(|err| ModelError::Invalid(format!("element {e}: {err}")))?;
             elements.push(element);
         }
 
@@ -278,8 +296,8 @@ impl<const D: usize> Model<D> {
 
         let mut solid_mass = DVector::zeros(dofs.len());
         for (e, (element, conn)) in elements.iter().zip(&part.mesh.elements).enumerate() {
-            let m = element.lumped_node_mass(part.density(e));
-            for &n in conn {
+            let masses = element.lumped_node_masses(part.density(e));
+            for (&n, m) in conn.iter().zip(masses) {
                 for eq in dofs.node(n).iter().flatten() {
                     solid_mass[*eq] += m;
                 }
@@ -545,7 +563,7 @@ impl<const D: usize> Model<D> {
         &self.contacts
     }
     /// Precomputed elements (same order as the mesh's elements).
-    pub fn elements(&self) -> &[OnePointSolid<D>] {
+    pub fn elements(&self) -> &[SolidElement<D>] {
         &self.elements
     }
     /// Equation numbering.

@@ -34,6 +34,7 @@ pub(crate) fn pad_block<const D: usize>(
         element_sections: Vec::new(),
         thickness: 0.1,
         hourglass_scale: 1.0,
+        element_formulations: Vec::new(),
         quasi_static: false,
         fixed: vec![],
     }

@@ -60,6 +60,7 @@ fn top_with(loads: Loads<3>, axes: Rotation3<f64>) -> Model<3> {
         element_sections: Vec::new(),
         thickness: 1.0,
         hourglass_scale: 1.0,
+        element_formulations: Vec::new(),
         quasi_static: false,
         fixed,
     };

@@ -48,6 +48,7 @@ fn tip_deflection(k_over_mu: f64) -> f64 {
         element_sections: Vec::new(),
         thickness: THICKNESS,
         hourglass_scale: 1.0,
+        element_formulations: Vec::new(),
         quasi_static: false,
         fixed: vec![],
     };

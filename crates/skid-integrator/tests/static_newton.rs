@@ -6,12 +6,14 @@
 //! from the top either by consistent nodal forces of a uniform pressure or by a prescribed
 //! vertical displacement of every top node. Its answer is homogeneous: stretch `lambda` along
 //! the load, a free lateral stretch `lambda_l` at which the lateral stress vanishes, and (plane
-//! strain) `lambda_3 = 1`. Checked on 1 x 1, 2 x 2 and 4 x 4 (x 4) meshes: every increment
+//! strain) `lambda_3 = 1`. Checked for every element formulation on 1 x 1, 2 x 2 and 4 x 4
+//! (x 4) meshes: every increment
 //! converges to a force residual of 1e-10 within 5 Newton iterations, each iteration at least
 //! squares the residual until round-off, and the lateral displacement of every node is the
 //! closed form's.
 
 use nalgebra::{Matrix3, SVector, Vector3};
+use skid_fem::element::Formulation;
 use skid_fem::material::{Hyperelastic, PolynomialN1};
 use skid_fem::mesh::SolidMesh;
 use skid_integrator::increment::IncrementCounters;
@@ -31,6 +33,13 @@ const DENSITY: f64 = 1000.0;
 const STRAIN: f64 = 0.01;
 const TOLERANCE: f64 = 1e-10;
 const MAX_ITERATIONS: usize = 5;
+/// Every element formulation: CPE4R/C3D8R, CPE4/C3D8, CPE4H/C3D8H, CPE4I/C3D8I.
+const FORMULATIONS: [Formulation; 4] = [
+    Formulation::Reduced,
+    Formulation::Full,
+    Formulation::Hybrid,
+    Formulation::Incompatible,
+];
 
 /// How the top is loaded.
 #[derive(Clone, Copy, Debug)]
@@ -90,8 +99,9 @@ fn homogeneous<const D: usize>(lambda: f64) -> (f64, f64) {
     (lateral, sigma(lateral)[(D - 1, D - 1)])
 }
 
-/// The block of `n^D` elements on rollers, loaded as `loading` says; in 2D 1 m thick.
-fn roller_block<const D: usize>(n: usize, loading: Loading) -> Model<D> {
+/// The block of `n^D` elements of `formulation` on rollers, loaded as `loading` says; in 2D
+/// 1 m thick.
+fn roller_block<const D: usize>(n: usize, loading: Loading, formulation: Formulation) -> Model<D> {
     let mesh = SolidMesh::<D>::structured_block(
         SVector::<f64, D>::zeros(),
         SVector::<f64, D>::repeat(1.0),
@@ -168,6 +178,7 @@ fn roller_block<const D: usize>(n: usize, loading: Loading) -> Model<D> {
         element_sections: Vec::new(),
         thickness: 1.0,
         hourglass_scale: 1.0,
+        element_formulations: vec![formulation; n.pow(D as u32)],
         quasi_static: false,
         fixed,
     };
@@ -182,8 +193,8 @@ fn roller_block<const D: usize>(n: usize, loading: Loading) -> Model<D> {
 }
 
 /// Runs the compression in 4 increments and checks convergence and the closed form.
-fn check<const D: usize>(n: usize, loading: Loading) {
-    let model = roller_block::<D>(n, loading);
+fn check<const D: usize>(n: usize, loading: Loading, formulation: Formulation) {
+    let model = roller_block::<D>(n, loading, formulation);
     let steps = [Step {
         name: "compress".into(),
         kind: StepKind::Static {
@@ -197,7 +208,8 @@ fn check<const D: usize>(n: usize, loading: Loading) {
     settings.cutback.max_cutbacks = 0;
     let mut record = Record::default();
     let (_, result) = run(&model, &steps, &settings, &mut record);
-    let case = format!("{D}D {n}^{D} elements, {loading:?} loading");
+    let name = formulation.abaqus_name(D);
+    let case = format!("{name}, {n}^{D} elements, {loading:?} loading");
     let state = result.unwrap_or_else(|e| panic!("{case}: {e}"));
     assert_eq!(record.counters.len(), 4, "{case}: no cutback");
     for (i, counters) in record.counters.iter().enumerate() {
@@ -241,16 +253,20 @@ fn check<const D: usize>(n: usize, loading: Loading) {
 
 #[test]
 fn plane_strain_compression_on_rollers_converges_quadratically() {
-    for n in [1, 2, 4] {
-        check::<2>(n, Loading::Force);
-        check::<2>(n, Loading::Displacement);
+    for formulation in FORMULATIONS {
+        for n in [1, 2, 4] {
+            check::<2>(n, Loading::Force, formulation);
+            check::<2>(n, Loading::Displacement, formulation);
+        }
     }
 }
 
 #[test]
 fn three_dimensional_compression_on_rollers_converges_quadratically() {
-    for n in [1, 2, 4] {
-        check::<3>(n, Loading::Force);
-        check::<3>(n, Loading::Displacement);
+    for formulation in FORMULATIONS {
+        for n in [1, 2, 4] {
+            check::<3>(n, Loading::Force, formulation);
+            check::<3>(n, Loading::Displacement, formulation);
+        }
     }
 }

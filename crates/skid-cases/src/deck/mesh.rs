@@ -3,16 +3,19 @@
 
 use std::collections::{BTreeMap, HashMap};
 
+use skid_fem::element::Formulation;
+
 use super::fields::{allow_parameters, at_most, field, flag, key, label, line_error, real, valued};
 use super::keywords::{Block, DeckError, Location};
 
 /// Element types of the keyword subset.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ElementKind {
-    /// Plane-strain quadrilateral, one-point integration (the deformable part in 2D).
-    Cpe4r,
-    /// Hexahedron, one-point integration (the deformable part in 3D).
-    C3d8r,
+    /// Plane-strain quadrilateral of a formulation (the deformable part in 2D: CPE4R, CPE4,
+    /// CPE4H, CPE4I).
+    Quad(Formulation),
+    /// Hexahedron of a formulation (the deformable part in 3D: C3D8R, C3D8, C3D8H, C3D8I).
+    Hex(Formulation),
     /// Two-node rigid line (2D).
     R2d2,
     /// Three-node rigid triangle (3D).
@@ -35,8 +38,14 @@ impl ElementKind {
     /// The kind named by `*ELEMENT, TYPE=`, or why it is not read.
     fn parse(name: &str) -> Result<Self, String> {
         Ok(match name.to_ascii_uppercase().as_str() {
-            "CPE4R" => Self::Cpe4r,
-            "C3D8R" => Self::C3d8r,
+            "CPE4R" => Self::Quad(Formulation::Reduced),
+            "CPE4" => Self::Quad(Formulation::Full),
+            "CPE4H" => Self::Quad(Formulation::Hybrid),
+            "CPE4I" => Self::Quad(Formulation::Incompatible),
+            "C3D8R" => Self::Hex(Formulation::Reduced),
+            "C3D8" => Self::Hex(Formulation::Full),
+            "C3D8H" => Self::Hex(Formulation::Hybrid),
+            "C3D8I" => Self::Hex(Formulation::Incompatible),
             "R2D2" => Self::R2d2,
             "R3D3" => Self::R3d3,
             "R3D4" => Self::R3d4,
@@ -45,16 +54,11 @@ impl ElementKind {
             "C3D4" => Self::C3d4,
             "MASS" => Self::Mass,
             "ROTARYI" => Self::RotaryI,
-            "CPE4" | "C3D8" => {
-                return Err(format!(
-                    "TYPE={name}: full integration is not implemented; skid's deformable \
-                     elements are the one-point CPE4R and C3D8R with hourglass control"
-                ));
-            }
             other => {
                 return Err(format!(
-                    "TYPE={other} is outside the element subset (CPE4R, C3D8R, R2D2, R3D3, \
-                     R3D4, M3D4R, S4R, C3D4, MASS, ROTARYI)"
+                    "TYPE={other} is outside the element subset (CPE4R, CPE4, CPE4H, CPE4I, \
+                     C3D8R, C3D8, C3D8H, C3D8I, R2D2, R3D3, R3D4, M3D4R, S4R, C3D4, MASS, \
+                     ROTARYI)"
                 ));
             }
         })
@@ -63,9 +67,9 @@ impl ElementKind {
     /// Number of nodes of one element.
     pub fn node_count(self) -> usize {
         match self {
-            Self::Cpe4r | Self::R3d4 | Self::M3d4r | Self::S4r | Self::C3d4 => 4,
+            Self::Quad(_) | Self::R3d4 | Self::M3d4r | Self::S4r | Self::C3d4 => 4,
             Self::R3d3 => 3,
-            Self::C3d8r => 8,
+            Self::Hex(_) => 8,
             Self::R2d2 => 2,
             Self::Mass | Self::RotaryI => 1,
         }
@@ -73,15 +77,15 @@ impl ElementKind {
 
     /// Whether the element belongs to the deformable part.
     pub fn is_solid(self) -> bool {
-        matches!(self, Self::Cpe4r | Self::C3d8r)
+        matches!(self, Self::Quad(_) | Self::Hex(_))
     }
 
     /// Corners of face `S<k>` (k from 1), listed outward (2D: the edge direction turned
     /// clockwise points out; 3D: counter-clockwise seen from outside), as positions in the
     /// element's node list; `None` for an element without numbered faces.
     pub fn face(self, k: usize) -> Option<&'static [usize]> {
-        const CPE4R: [&[usize]; 4] = [&[0, 1], &[1, 2], &[2, 3], &[3, 0]];
-        const C3D8R: [&[usize]; 6] = [
+        const QUAD: [&[usize]; 4] = [&[0, 1], &[1, 2], &[2, 3], &[3, 0]];
+        const HEX: [&[usize]; 6] = [
             &[0, 3, 2, 1],
             &[4, 5, 6, 7],
             &[0, 1, 5, 4],
@@ -91,8 +95,8 @@ impl ElementKind {
         ];
         const C3D4: [&[usize]; 4] = [&[0, 2, 1], &[0, 1, 3], &[1, 2, 3], &[2, 0, 3]];
         let table: &[&[usize]] = match self {
-            Self::Cpe4r => &CPE4R,
-            Self::C3d8r => &C3D8R,
+            Self::Quad(_) => &QUAD,
+            Self::Hex(_) => &HEX,
             Self::C3d4 => &C3D4,
             _ => return None,
         };
@@ -102,8 +106,8 @@ impl ElementKind {
     /// Number of numbered faces.
     pub fn face_count(self) -> usize {
         match self {
-            Self::Cpe4r | Self::C3d4 => 4,
-            Self::C3d8r => 6,
+            Self::Quad(_) | Self::C3d4 => 4,
+            Self::Hex(_) => 6,
             _ => 0,
         }
     }

@@ -18,6 +18,7 @@ use std::fmt::Write as _;
 
 use nalgebra::Vector3;
 use skid_contact::surface::AnalyticCylinder;
+use skid_fem::element::Formulation;
 use skid_fem::tetra::TetMesh;
 
 use super::mesh::ElementKind;
@@ -98,24 +99,25 @@ pub fn write_deck(
     for (i, x) in part.nodes.iter().enumerate() {
         let _ = writeln!(out, "{}, {}", i + 1, list(x.iter().map(|v| num(*v))));
     }
-    let kind = if dim == 2 { "CPE4R" } else { "C3D8R" };
+    // one *ELEMENT block per element block, labels running on from block to block; with
+    // materials by element set, the part's own section holds the other elements only
     let mut elements = Vec::new();
     for block in &part.elements {
-        elements.extend(block.connectivity.iter().cloned());
-    }
-    // With materials by element set, the part's own section holds the other elements only.
-    if part.materials.is_empty() {
-        let _ = writeln!(out, "*ELEMENT, TYPE={kind}, ELSET={}", part.name);
-    } else {
-        let _ = writeln!(out, "*ELEMENT, TYPE={kind}");
-    }
-    for (e, nodes) in elements.iter().enumerate() {
-        let _ = writeln!(
-            out,
-            "{}, {}",
-            e + 1,
-            list(nodes.iter().map(|n| (n + 1).to_string()))
-        );
+        let kind = block.kind.name();
+        if part.materials.is_empty() {
+            let _ = writeln!(out, "*ELEMENT, TYPE={kind}, ELSET={}", part.name);
+        } else {
+            let _ = writeln!(out, "*ELEMENT, TYPE={kind}");
+        }
+        for nodes in &block.connectivity {
+            elements.push(nodes.clone());
+            let _ = writeln!(
+                out,
+                "{}, {}",
+                elements.len(),
+                list(nodes.iter().map(|n| (n + 1).to_string()))
+            );
+        }
     }
     for (name, nodes) in &part.node_sets {
         let _ = writeln!(out, "*NSET, NSET={name}");
@@ -126,9 +128,9 @@ pub fn write_deck(
         label_lines(&mut out, elements.iter().map(|e| e + 1));
     }
     let solid = if dim == 2 {
-        ElementKind::Cpe4r
+        ElementKind::Quad(Formulation::Reduced)
     } else {
-        ElementKind::C3d8r
+        ElementKind::Hex(Formulation::Reduced)
     };
     let mut face_of: HashMap<Vec<usize>, (usize, usize)> = HashMap::new();
     for (e, nodes) in elements.iter().enumerate() {

@@ -11,6 +11,7 @@ use skid_contact::revolution::RigidRevolution;
 use skid_contact::surface::{AnalyticCylinder, RigidSurface};
 use skid_contact::triangles::{CylinderChart, SurfaceChart, TriangulatedSurface};
 use skid_fem::cell::{embed, face_corners};
+use skid_fem::element::Formulation;
 use skid_fem::material::{Hyperelastic, PolynomialN1};
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::{RigidBody, Rotation};
@@ -298,6 +299,7 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         element_sections,
         thickness: section.thickness,
         hourglass_scale: section.hourglass_scale,
+        element_formulations: element_formulations(spec),
         quasi_static: section.quasi_static,
         fixed: fixed_nodes,
     };
@@ -428,6 +430,22 @@ fn check_field_file_names(spec: &ModelSpec) -> Result<(), SpecError> {
         }
     }
     Ok(())
+}
+
+/// The formulation of each element of the part, block by block as [`part_mesh`] numbers them;
+/// empty when every element is the one-point default.
+fn element_formulations(spec: &ModelSpec) -> Vec<Formulation> {
+    let blocks = &spec.part.elements;
+    if blocks
+        .iter()
+        .all(|b| b.kind.formulation() == Formulation::Reduced)
+    {
+        return Vec::new();
+    }
+    blocks
+        .iter()
+        .flat_map(|b| std::iter::repeat_n(b.kind.formulation(), b.connectivity.len()))
+        .collect()
 }
 
 /// The part's mesh: nodes, elements of every block, sorted node sets, checked surfaces.

@@ -48,6 +48,7 @@ pub fn block_part(
         element_sections: Vec::new(),
         thickness,
         hourglass_scale: 1.0,
+        element_formulations: Vec::new(),
         quasi_static,
         fixed: vec![],
     }

@@ -20,20 +20,21 @@ pub(super) fn part_numbering(defs: &Definitions, deck: &Location) -> Result<Part
     let Some(first) = elements.first() else {
         return Err(error(
             deck,
-            "the deck has no deformable elements (CPE4R or C3D8R): skid needs one deformable part",
+            "the deck has no deformable elements (CPE4R, CPE4, CPE4H, CPE4I, C3D8R, C3D8, C3D8H \
+             or C3D8I): skid needs one deformable part",
         ));
     };
-    let kind = defs.mesh.elements[first].kind;
-    if let Some(other) = elements
-        .iter()
-        .find(|e| defs.mesh.elements[*e].kind != kind)
-    {
+    let dimension_of = |e: &u64| match defs.mesh.elements[e].kind {
+        ElementKind::Quad(_) => 2,
+        _ => 3,
+    };
+    let dimension = dimension_of(first);
+    if let Some(other) = elements.iter().find(|e| dimension_of(e) != dimension) {
         return Err(error(
             &defs.mesh.elements[other].location,
-            "*ELEMENT: CPE4R and C3D8R elements cannot share a model (2D or 3D)",
+            "*ELEMENT: quads (CPE4*) and hexahedra (C3D8*) cannot share a model (2D or 3D)",
         ));
     }
-    let dimension = if kind == ElementKind::Cpe4r { 2 } else { 3 };
     let used: BTreeSet<u64> = elements
         .iter()
         .flat_map(|e| defs.mesh.elements[e].nodes.iter().copied())
@@ -141,17 +142,24 @@ pub(super) fn part_spec(
     for (label, &i) in &part.number {
         nodes[i] = defs.mesh.nodes[label][..dim].to_vec();
     }
-    let connectivity = part
-        .elements
-        .iter()
-        .map(|e| {
-            defs.mesh.elements[e]
-                .nodes
-                .iter()
-                .map(|n| part.number[n])
-                .collect()
-        })
-        .collect();
+    // one block per run of consecutive elements of one formulation, so that the blocks keep the
+    // part's element order
+    let mut blocks: Vec<ElementBlockSpec> = Vec::new();
+    for e in &part.elements {
+        let element = &defs.mesh.elements[e];
+        let kind = match element.kind {
+            ElementKind::Quad(f) | ElementKind::Hex(f) => ElementType::of(f, dim),
+            _ => ElementType::solid(dim),
+        };
+        let corners = element.nodes.iter().map(|n| part.number[n]).collect();
+        match blocks.last_mut() {
+            Some(block) if block.kind == kind => block.connectivity.push(corners),
+            _ => blocks.push(ElementBlockSpec {
+                kind,
+                connectivity: vec![corners],
+            }),
+        }
+    }
     let mut node_sets = BTreeMap::new();
     for set in defs.mesh.node_sets.values() {
         if !set.labels.is_empty() && set.labels.iter().all(|n| part.number.contains_key(n)) {
@@ -177,10 +185,7 @@ pub(super) fn part_spec(
     Ok(PartSpec {
         name: first.elset.clone(),
         nodes,
-        elements: vec![ElementBlockSpec {
-            kind: ElementType::solid(dim),
-            connectivity,
-        }],
+        elements: blocks,
         node_sets,
         surfaces,
         materials,
