@@ -125,7 +125,7 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
             .map(|p| p.iter().copied().collect())
             .collect(),
         elements: vec![ElementBlockSpec {
-            kind: ElementType::solid(D),
+            kind: ElementType::of(pad.formulation.formulation(), D),
             connectivity: mesh.elements,
         }],
         node_sets: mesh.node_sets,

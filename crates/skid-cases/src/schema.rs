@@ -10,6 +10,7 @@
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
+use skid_fem::element::Formulation;
 use skid_integrator::settings::ContactSolve;
 
 /// Index of the drum among the rigid bodies of a drum case's model.
@@ -136,14 +137,46 @@ pub struct PadSpec {
     pub density: f64,
     /// Hyperelastic material.
     pub material: MaterialSpec,
-    /// Factor on the hourglass stabilisation stiffness.
+    /// Factor on the hourglass stabilisation stiffness (of the one-point element).
     #[serde(default = "one")]
     pub hourglass_scale: f64,
+    /// The pad's element formulation: `reduced` (one-point with hourglass control: CPE4R /
+    /// C3D8R, the default), `full` (CPE4 / C3D8), `hybrid` (CPE4H / C3D8H) or `incompatible`
+    /// (CPE4I / C3D8I).
+    #[serde(default)]
+    pub formulation: PadFormulation,
     /// The pad has no inertia: in the spin-down it is in equilibrium with the mean contact
     /// force of each increment (`density` then only regularises the static Newton steps). The
     /// back plate tied to it must then be massless too.
     #[serde(default)]
     pub quasi_static: bool,
+}
+
+/// The element formulation of a pad, in either dimension.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, JsonSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum PadFormulation {
+    /// One-point integration with hourglass control (CPE4R / C3D8R).
+    #[default]
+    Reduced,
+    /// Full integration, displacement formulation (CPE4 / C3D8).
+    Full,
+    /// Full integration, constant-pressure hybrid (CPE4H / C3D8H).
+    Hybrid,
+    /// Full integration with incompatible modes (CPE4I / C3D8I).
+    Incompatible,
+}
+
+impl PadFormulation {
+    /// The element kernels' formulation.
+    pub fn formulation(self) -> Formulation {
+        match self {
+            Self::Reduced => Formulation::Reduced,
+            Self::Full => Formulation::Full,
+            Self::Hybrid => Formulation::Hybrid,
+            Self::Incompatible => Formulation::Incompatible,
+        }
+    }
 }
 
 /// The serde default of factors and thicknesses: 1.

@@ -355,3 +355,14 @@ fn adaptive_increments_land_on_the_stop_with_the_fixed_steps_answer() {
     });
     assert!(landed, "no increment ends at the stop {t_stop}");
 }
+
+/// The pad of fully integrated elements (CPE4, CPE4H, CPE4I) spins the drum down as the
+/// one-point pad does: the benchmark's band, all the energy into friction.
+#[test]
+fn every_pad_element_formulation_gives_the_benchmark_spin_down() {
+    for formulation in ["full", "hybrid", "incompatible"] {
+        let (s, _dir) = run(&[&format!("pad.formulation=\"{formulation}\"")]);
+        assert_benchmark_spin_down(&s);
+        assert_all_energy_goes_into_friction(&s);
+    }
+}
