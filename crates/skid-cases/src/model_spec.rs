@@ -250,6 +250,12 @@ pub struct SectionSpec {
     /// each increment; rigid bodies tied to it must then be massless.
     #[serde(default)]
     pub quasi_static: bool,
+    /// The lumped mass of the contact nodes (every slave node of a contact pair) moved to the
+    /// other nodes of their elements: the contact nodes are then in equilibrium at the end of
+    /// each dynamic increment, and their contact forces do not ring as the time step shrinks
+    /// (the total mass is kept). Every element needs a node that is not a contact node.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub massless_contact_nodes: bool,
 }
 
 /// A rigid body: a reference node with a point mass and a rotary inertia, and optionally a

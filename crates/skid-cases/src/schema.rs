@@ -150,6 +150,10 @@ pub struct PadSpec {
     /// back plate tied to it must then be massless too.
     #[serde(default)]
     pub quasi_static: bool,
+    /// The lumped mass of the pad's contact nodes moved to the other nodes of their elements
+    /// (see the model file's `part.section.massless_contact_nodes`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub massless_contact_nodes: bool,
 }
 
 /// The element formulation of a pad, in either dimension.

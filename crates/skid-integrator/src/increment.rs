@@ -39,6 +39,14 @@
 //! their rows are `R = F(x) / (2 beta)`, tangent `K_T / (2 beta)`, so that `R - H^T r = 0` says
 //! `F = H^T p` and action equals reaction. Their rate is the mean one, `v = (x - x_n)/h`,
 //! `a = 0`. The regularisation and the mass shift use the solid's density all the same.
+//!
+//! Contact nodes whose mass was moved off them ([`Model::with_massless_contact_nodes`]) are
+//! such equations too, inside a solid with inertia. Their rows `F / (2 beta)` meet the
+//! solid's HHT rows through the stiffness, so a dynamic increment multiplies the rows of the
+//! solid and of the bodies tied to it by `c = 1 / (2 beta (1 + alpha))`: every one of them
+//! then takes the stiffness as `K / (2 beta)` and the tangent stays symmetric, while the
+//! other bodies' rows (a drum's, which meets the solid only through contact) keep theirs.
+//! Scaling a row does not move its root; the force residual is measured on the unscaled rows.
 
 use std::time::{Duration, Instant};
 
@@ -259,15 +267,33 @@ fn solve_increment_with<const D: usize>(
     };
     // The solid's rows of the tangent are `c_K K_T`, the mass term `c_M M` (regularising in a
     // static increment, inertial in a dynamic one).
+    // With the contact nodes' mass moved off them, a dynamic increment multiplies the rows of
+    // the solid and its tied bodies by `c = 1 / (2 beta (1 + alpha))`, so that the stiffness
+    // enters them as `K / (2 beta)`, as it enters the contact nodes' equilibrium rows: the
+    // tangent stays symmetric (see the module documentation).
+    let row_scale = match (kind, model.solid_rows()) {
+        (IncrementKind::Dynamic { hht, .. }, Some(rows)) => {
+            Some((hht.quasi_static_factor() / (1.0 + hht.alpha), rows))
+        }
+        _ => None,
+    };
+    let scaled_mass;
+    let inertia_mass = match row_scale {
+        Some((c, rows)) => {
+            scaled_mass = DVector::from_fn(n, |i, _| if rows[i] { c * mass[i] } else { mass[i] });
+            &scaled_mass
+        }
+        None => mass,
+    };
     let (k_factor, mut m_factor, m_term) = match kind {
         IncrementKind::Static { regularization, .. } => (1.0, regularization, shift_mass),
         IncrementKind::Dynamic { hht, h, .. } => {
-            let k_factor = if model.part().quasi_static {
+            let k_factor = if model.part().quasi_static || row_scale.is_some() {
                 hht.quasi_static_factor()
             } else {
                 1.0 + hht.alpha
             };
-            (k_factor, hht.mass_factor(h), mass)
+            (k_factor, hht.mass_factor(h), inertia_mass)
         }
     };
     // A quasi-static solid has no mass term in a dynamic tangent; if the tangent is indefinite
@@ -378,6 +404,11 @@ fn solve_increment_with<const D: usize>(
             IncrementKind::Static { .. } => net.clone(),
             IncrementKind::Dynamic { hht, .. } => {
                 let mut r = &inertia + &net * (1.0 + hht.alpha) - &start.net_force * hht.alpha;
+                if let Some((c, rows)) = row_scale {
+                    for (eq, _) in rows.iter().enumerate().filter(|(_, s)| **s) {
+                        r[eq] *= c;
+                    }
+                }
                 for (eq, _) in quasi_static.iter().enumerate().filter(|(_, q)| **q) {
                     r[eq] = net[eq] * hht.quasi_static_factor();
                 }
@@ -409,7 +440,17 @@ fn solve_increment_with<const D: usize>(
         if let Some(forces) = &last {
             let r = forces.r();
             let contact_force = rows.transpose_times(r, n);
-            let full = &residual - &contact_force;
+            // in force units: the scaled rows of the solid divided by their factor again
+            let mut full = &residual - &contact_force;
+            if let Some((c, rows)) = row_scale {
+                for (eq, _) in rows
+                    .iter()
+                    .enumerate()
+                    .filter(|(eq, s)| **s && !quasi_static[*eq])
+                {
+                    full[eq] /= c;
+                }
+            }
             // The inertia of a dynamic increment is `M (x - x_pred) / (beta h^2)` plus terms
             // of the start: the round-off of `x` reaches the residual amplified by
             // `1 / (beta h^2)`, which on a very short increment exceeds the force tolerance

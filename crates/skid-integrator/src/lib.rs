@@ -45,6 +45,7 @@ pub mod ordering;
 pub mod orientation;
 pub mod quasi_definite;
 pub mod settings;
+pub mod solid_mass;
 pub mod sparse;
 pub mod state;
 pub mod stepper;

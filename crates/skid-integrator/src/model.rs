@@ -2,6 +2,8 @@
 //! [`crate::loads`]) and node-to-rigid-surface contact pairs. A [`Model`] is checked once when built and is immutable
 //! during a run.
 
+use std::collections::BTreeSet;
+
 use nalgebra::{DVector, SVector, Vector3};
 use skid_contact::kinematics::RotatingFrame;
 use skid_contact::surface::RigidSurface;
@@ -16,6 +18,7 @@ use crate::error::ModelError;
 use crate::loads::{DeadLoad, Loads, PressureLoad, Scene};
 use crate::motion::{MotionTarget, PrescribedMotion, body_equation};
 use crate::orientation::{self, Orientation};
+use crate::solid_mass::{MassSource, lumped_mass, redistributed_mass};
 
 /// A material and its mass density, shared by a group of elements.
 #[derive(Debug)]
@@ -117,6 +120,9 @@ pub struct Model<const D: usize> {
     mass: DVector<f64>,
     regularization_mass: DVector<f64>,
     quasi_static: Vec<bool>,
+    /// With the contact nodes' mass moved off them ([`Model::with_massless_contact_nodes`]):
+    /// whether each equation is one of the solid's or of a body tied to it.
+    solid_rows: Option<Vec<bool>>,
     length_scale: f64,
     /// Initial velocities of the solid's nodes, `(node, velocity)`.
     node_velocities: Vec<(usize, SVector<f64, D>)>,
@@ -294,15 +300,13 @@ impl<const D: usize> Model<D> {
         let rotations: Vec<usize> = bodies.iter().map(|b| b.rotation.unknowns()).collect();
         let dofs = DofMap::new(n_nodes, &tied_to, &fixed, &free_translations, &rotations);
 
-        let mut solid_mass = DVector::zeros(dofs.len());
-        for (e, (element, conn)) in elements.iter().zip(&part.mesh.elements).enumerate() {
-            let masses = element.lumped_node_masses(part.density(e));
-            for (&n, m) in conn.iter().zip(masses) {
-                for eq in dofs.node(n).iter().flatten() {
-                    solid_mass[*eq] += m;
-                }
-            }
-        }
+        let densities: Vec<f64> = (0..elements.len()).map(|e| part.density(e)).collect();
+        let solid = MassSource {
+            elements: &elements,
+            connectivity: &part.mesh.elements,
+            densities: &densities,
+        };
+        let solid_mass = lumped_mass(&solid, &dofs);
         let mut body_mass = DVector::zeros(dofs.len());
         for (b, body) in bodies.iter().enumerate() {
             for eq in dofs.body_translation(b).iter().flatten() {
@@ -364,7 +368,6 @@ impl<const D: usize> Model<D> {
         }
         let length_scale = (hi - lo).norm().max(f64::MIN_POSITIVE);
 
-        let densities: Vec<f64> = (0..elements.len()).map(|e| part.density(e)).collect();
         let scene = Scene {
             dofs: &dofs,
             bodies: &bodies,
@@ -393,10 +396,83 @@ impl<const D: usize> Model<D> {
             mass,
             regularization_mass,
             quasi_static,
+            solid_rows: None,
             length_scale,
             node_velocities: Vec::new(),
             prescribed: Vec::new(),
         })
+    }
+
+    /// The model with the lumped mass of the solid's contact nodes moved to the other nodes of
+    /// their elements (see [`crate::solid_mass`]): the contact nodes' equations are then
+    /// without inertia, in equilibrium at the end of each dynamic increment, so that their
+    /// contact forces do not ring as the time step shrinks. Nothing changes for a quasi-static
+    /// solid or a model without contact.
+    ///
+    /// # Errors
+    /// [`ModelError::Invalid`] for a contact node tied to a rigid body, an element whose nodes
+    /// are all contact nodes, or a contact surface carried by a body tied to the solid (its
+    /// equations would mix the solid's rows, scaled in a dynamic increment, with contact
+    /// impulses).
+    pub fn with_massless_contact_nodes(mut self) -> Result<Self, ModelError> {
+        if self.part.quasi_static || self.contacts.is_empty() {
+            return Ok(self);
+        }
+        if let Some(pair) =
+            (self.contacts.iter()).find(|p| self.ties.iter().any(|t| t.body == p.body))
+        {
+            return invalid(format!(
+                "contact pair '{}': its surface's body '{}' is tied to the solid, so the \
+                 contact nodes' mass cannot be moved off them",
+                pair.name, self.bodies[pair.body].name
+            ));
+        }
+        let contact: BTreeSet<usize> = (self.contacts.iter())
+            .flat_map(|p| p.nodes.iter().copied())
+            .collect();
+        if let Some((node, tie)) = (self.ties.iter())
+            .find_map(|t| t.nodes.iter().find(|n| contact.contains(n)).map(|n| (n, t)))
+        {
+            return invalid(format!(
+                "contact node {node} is tied to rigid body '{}': its mass cannot be moved off it",
+                self.bodies[tie.body].name
+            ));
+        }
+        let densities: Vec<f64> = (0..self.elements.len())
+            .map(|e| self.part.density(e))
+            .collect();
+        let solid = MassSource {
+            elements: &self.elements,
+            connectivity: &self.part.mesh.elements,
+            densities: &densities,
+        };
+        let (redistributed, contact_equations) = redistributed_mass(&solid, &self.dofs, &contact)?;
+        let lumped = lumped_mass(&solid, &self.dofs);
+        self.mass += redistributed - lumped;
+        for &eq in &contact_equations {
+            self.mass[eq] = 0.0;
+            self.quasi_static[eq] = true;
+        }
+        let mut rows = vec![false; self.dofs.len()];
+        for node in 0..self.part.mesh.nodes.len() {
+            for eq in self.dofs.node(node).iter().flatten() {
+                rows[*eq] = true;
+            }
+        }
+        for tie in &self.ties {
+            for eq in self.dofs.body_equations(tie.body) {
+                rows[eq] = true;
+            }
+        }
+        self.solid_rows = Some(rows);
+        Ok(self)
+    }
+
+    /// With the contact nodes' mass moved off them: whether each equation is one of the
+    /// solid's or of a body tied to it (the rows a dynamic increment scales, see
+    /// [`crate::increment`]); `None` otherwise.
+    pub fn solid_rows(&self) -> Option<&[bool]> {
+        self.solid_rows.as_deref()
     }
 
     /// The model with these initial velocities of the solid's nodes, `(node, velocity)`, added
@@ -581,8 +657,9 @@ impl<const D: usize> Model<D> {
     pub fn regularization_mass(&self) -> &DVector<f64> {
         &self.regularization_mass
     }
-    /// Whether each equation belongs to a quasi-static solid (no inertia, see
-    /// [`SolidPart::quasi_static`]).
+    /// Whether each equation is without inertia: one of a quasi-static solid's (see
+    /// [`SolidPart::quasi_static`]) or of a contact node whose mass was moved off it (see
+    /// [`Self::with_massless_contact_nodes`]).
     pub fn quasi_static(&self) -> &[bool] {
         &self.quasi_static
     }

@@ -91,8 +91,13 @@ pub fn write_deck(
         "** Model '{}', written by skid: `skid run` reads it.",
         spec.name
     );
-    if part.section.hourglass_scale != 1.0 || part.section.quasi_static {
-        return Err("part.section: hourglass_scale and quasi_static have no keyword".into());
+    let section = &part.section;
+    if section.hourglass_scale != 1.0 || section.quasi_static || section.massless_contact_nodes {
+        return Err(
+            "part.section: hourglass_scale, quasi_static and massless_contact_nodes have no \
+             keyword"
+                .into(),
+        );
     }
     // part
     let _ = writeln!(out, "**\n** deformable part '{}'\n*NODE", part.name);

@@ -307,6 +307,12 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         field: "(model)".into(),
         message: e.to_string(),
     })?;
+    if section.massless_contact_nodes {
+        model = model.with_massless_contact_nodes().map_err(|e| SpecError {
+            field: "part.section.massless_contact_nodes".into(),
+            message: e.to_string(),
+        })?;
+    }
     for (i, initial) in spec.initial_velocities.iter().enumerate() {
         let field = |name: &str| format!("initial_velocities[{i}].{name}");
         let velocity = finite_point::<D>(&field("velocity"), &initial.velocity)?;

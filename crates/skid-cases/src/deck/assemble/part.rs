@@ -196,6 +196,7 @@ pub(super) fn part_spec(
             thickness,
             hourglass_scale: 1.0,
             quasi_static: false,
+            massless_contact_nodes: false,
         },
     })
 }

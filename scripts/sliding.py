@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""The sliding block: frictional sliding that converges as the time step shrinks.
+
+The scene (SI units, plane strain, 0.01 m thick): a hyperelastic block 0.02 m wide and
+0.005 m high (n x n CPE4R elements, neo-Hookean C10 = 0.552 MPa, C01 = 0.138 MPa, Poisson's
+ratio 0; 1 g) on a fixed rigid flat, Coulomb friction mu. Its top face is tied to a massless
+plate (rotation held) pressed down by N = 20 N (ramped over 0-10 ms) and pulled sideways by
+F = 2 mu N (ramped over 15-25 ms, then held to 40 ms). While every contact slides, momentum
+balance fixes the block's acceleration at (F - mu N) / m exactly; it is measured as the slope
+of the plate's velocity over 27-40 ms, beside the scatter (standard deviation over mean) of
+the contact normal force there.
+
+Written with --write: cases/verification/2d-block-sliding.json (n = 4, mu = 0.3, the contact
+nodes' mass moved off them, dt 1e-5 s), which the validation report checks with the other
+Coulomb scenes. Run without it: the ladder of time steps 4e-5 to 2.5e-6 s, meshes 4 x 4 and
+8 x 8, mu 0.1, 0.3 and 1, each with the lumped mass and with massless contact nodes
+(`part.section.massless_contact_nodes`), into validation/sliding.md, with its checks (massless
+contact nodes, mu <= 0.3: acceleration within 0.2 % and normal-force scatter under 2 % at
+every step and mesh); exit status 1 if one fails.
+
+Usage: scripts/sliding.py [--write] [--skid PATH] [--out FILE]
+"""
+
+import argparse
+import csv
+import json
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+BASE = ROOT / "cases/verification/2d-block-pushed-on-flat.json"
+SCENE = ROOT / "cases/verification/2d-block-sliding.json"
+NORMAL = 20.0
+MASS = 0.001
+WIDTH, HEIGHT = 0.02, 0.005
+STEPS = [4e-5, 2e-5, 1e-5, 5e-6, 2.5e-6]
+MESHES = [4, 8]
+MUS = [0.1, 0.3, 1.0]
+WINDOW = (0.027, 0.040)
+
+
+def scene(n, mu, dt, massless):
+    """The sliding block of n x n elements as a model file (a dict)."""
+    s = json.loads(BASE.read_text())
+    nodes = [
+        [-WIDTH / 2 + WIDTH * i / n, HEIGHT * j / n] for j in range(n + 1) for i in range(n + 1)
+    ]
+    row = n + 1
+    connectivity = [
+        [j * row + i, j * row + i + 1, (j + 1) * row + i + 1, (j + 1) * row + i]
+        for j in range(n)
+        for i in range(n)
+    ]
+    part = s["part"]
+    part["nodes"] = nodes
+    part["elements"] = [{"type": "CPE4R", "connectivity": connectivity}]
+    part["node_sets"] = {"bottom": list(range(row)), "top": [n * row + i for i in range(row)]}
+    if massless:
+        part["section"]["massless_contact_nodes"] = True
+    s["loads"][1]["force"] = [2.0 * mu * NORMAL, 0.0]
+    s["contact"][0]["mu"] = mu
+    s["steps"][0]["dt"] = dt
+    s["name"] = "2d-block-sliding"
+    s["description"] = (
+        f"Verification (2D): the pushed block's scene with {n} x {n} elements, mu = {mu}, "
+        f"pulled by F = 2 mu N = {2 * mu * NORMAL:g} N once pressed by N = {NORMAL:g} N, its "
+        "contact nodes without mass (part.section.massless_contact_nodes, their lumped mass "
+        "moved to the nodes above them). While every contact slides the block accelerates at "
+        f"(F - mu N) / m = {(mu * NORMAL) / MASS:g} m/s^2 and the friction resultant is mu N; "
+        "the contact normal force stays steady at any time step (scripts/sliding.py measures "
+        "the ladder 4e-5 to 2.5e-6 s)."
+    )
+    return s
+
+
+def measure(run, mu):
+    """(acceleration error, normal-force scatter) of a run directory over the window."""
+    rows = list(csv.DictReader(open(run / "history.csv")))
+    t = [float(r["time"]) for r in rows]
+    sel = [i for i, ti in enumerate(t) if WINDOW[0] <= ti <= WINDOW[1]]
+    ts = [t[i] for i in sel]
+    vs = [float(rows[i]["plate.v_x"]) for i in sel]
+    ns = [float(rows[i]["block-ground.normal_force"]) for i in sel]
+    tm, vm = statistics.mean(ts), statistics.mean(vs)
+    slope = sum((a - tm) * (b - vm) for a, b in zip(ts, vs)) / sum((a - tm) ** 2 for a in ts)
+    exact = mu * NORMAL / MASS
+    return slope / exact - 1.0, statistics.pstdev(ns) / statistics.mean(ns)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--write", action="store_true")
+    parser.add_argument("--skid", default=str(ROOT / "target/release/skid"))
+    parser.add_argument("--out", default=str(ROOT / "validation/sliding.md"))
+    args = parser.parse_args()
+    if args.write:
+        SCENE.write_text(json.dumps(scene(4, 0.3, 1e-5, True), indent=2) + "\n")
+        print(f"wrote {SCENE}")
+        return
+    if not Path(args.skid).exists():
+        subprocess.run(["cargo", "build", "--release", "-p", "skid-cli"], cwd=ROOT, check=True)
+    lines = [
+        "# The sliding block: acceleration and normal force against the time step",
+        "",
+        "Written by `scripts/sliding.py` (see its header for the scene). Each cell: error of the",
+        "acceleration against momentum balance, and the scatter of the contact normal force,",
+        f"over {WINDOW[0] * 1e3:g}-{WINDOW[1] * 1e3:g} ms.",
+        "",
+        "| mesh | mu | contact nodes | " + " | ".join(f"dt {dt:g} s" for dt in STEPS) + " |",
+        "|---|---|---|" + "---|" * len(STEPS),
+    ]
+    checks = []
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        for n in MESHES:
+            for mu in MUS:
+                for massless in (False, True):
+                    cells = []
+                    for dt in STEPS:
+                        path = work / "scene.json"
+                        path.write_text(json.dumps(scene(n, mu, dt, massless)))
+                        out = work / f"run-{n}-{mu}-{dt}-{massless}"
+                        run = subprocess.run(
+                            [args.skid, "run", str(path), "--out", str(out)],
+                            capture_output=True,
+                            text=True,
+                        )
+                        if run.returncode != 0:
+                            cells.append("failed")
+                            ok = False
+                        else:
+                            error, scatter = measure(out, mu)
+                            cells.append(f"{100 * error:+.3f} %, {100 * scatter:.2f} %")
+                            ok = abs(error) < 0.002 and scatter < 0.02
+                        if massless and mu <= 0.3:
+                            checks.append((f"{n} x {n}, mu {mu}, dt {dt:g}: massless contact nodes", ok))
+                        print(f"{n} x {n} mu {mu} massless {massless} dt {dt:g}: {cells[-1]}", file=sys.stderr)
+                    kind = "massless" if massless else "lumped"
+                    lines.append(f"| {n} x {n} | {mu} | {kind} | " + " | ".join(cells) + " |")
+    lines += ["", "## Checks", ""]
+    lines += [f"- {'pass' if ok else 'FAIL'}: {what}" for what, ok in checks]
+    lines.append("")
+    Path(args.out).write_text("\n".join(lines))
+    print(f"wrote {args.out}")
+    sys.exit(0 if all(ok for _, ok in checks) else 1)
+
+
+if __name__ == "__main__":
+    main()
