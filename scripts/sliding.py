@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """The sliding block: frictional sliding that converges as the time step shrinks.
 
-The scene (SI units, plane strain, 0.01 m thick): a hyperelastic block 0.02 m wide and
-0.005 m high (n x n CPE4R elements, neo-Hookean C10 = 0.552 MPa, C01 = 0.138 MPa, Poisson's
+The scene (SI units; plane strain, 0.01 m thick, or 3D, 0.01 m deep): a hyperelastic block
+0.02 m wide and 0.005 m high (n x n CPE4R elements, or n x n x n/2 C3D8R, neo-Hookean C10 = 0.552 MPa, C01 = 0.138 MPa, Poisson's
 ratio 0; 1 g) on a fixed rigid flat, Coulomb friction mu. Its top face is tied to a massless
 plate (rotation held) pressed down by N = 20 N (ramped over 0-10 ms) and pulled sideways by
 F = 2 mu N (ramped over 15-25 ms, then held to 40 ms). While every contact slides, momentum
@@ -13,7 +13,7 @@ the contact normal force there.
 Written with --write: cases/verification/2d-block-sliding.json (n = 4, mu = 0.3, the contact
 nodes' mass moved off them, dt 1e-5 s), which the validation report checks with the other
 Coulomb scenes. Run without it: the ladder of time steps 4e-5 to 2.5e-6 s, meshes 4 x 4 and
-8 x 8, mu 0.1, 0.3 and 1, each with the lumped mass and with massless contact nodes
+8 x 8 (2D) and 4 x 4 x 2 (3D), mu 0.1, 0.3 and 1, each with the lumped mass and with massless contact nodes
 (`part.section.massless_contact_nodes`), into validation/sliding.md, with its checks (massless
 contact nodes, mu <= 0.3: acceleration within 0.2 % and normal-force scatter under 2 % at
 every step and mesh); exit status 1 if one fails.
@@ -31,41 +31,60 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-BASE = ROOT / "cases/verification/2d-block-pushed-on-flat.json"
+BASE = {d: ROOT / f"cases/verification/{d}d-block-pushed-on-flat.json" for d in (2, 3)}
 SCENE = ROOT / "cases/verification/2d-block-sliding.json"
 NORMAL = 20.0
 MASS = 0.001
 WIDTH, HEIGHT = 0.02, 0.005
 STEPS = [4e-5, 2e-5, 1e-5, 5e-6, 2.5e-6]
-MESHES = [4, 8]
+# (dimension, elements along x and y); along z (3D) half as many
+MESHES = [(2, 4), (2, 8), (3, 4)]
 MUS = [0.1, 0.3, 1.0]
 WINDOW = (0.027, 0.040)
 
 
-def scene(n, mu, dt, massless):
-    """The sliding block of n x n elements as a model file (a dict)."""
-    s = json.loads(BASE.read_text())
-    nodes = [
-        [-WIDTH / 2 + WIDTH * i / n, HEIGHT * j / n] for j in range(n + 1) for i in range(n + 1)
-    ]
-    row = n + 1
-    connectivity = [
-        [j * row + i, j * row + i + 1, (j + 1) * row + i + 1, (j + 1) * row + i]
-        for j in range(n)
-        for i in range(n)
-    ]
+def scene(dim, n, mu, dt, massless):
+    """The sliding block of n x n (x n/2 along z in 3D, 0.01 m deep) elements as a model file
+    (a dict)."""
+    s = json.loads(BASE[dim].read_text())
+    nz = max(1, n // 2) if dim == 3 else 0
+    row, layer = n + 1, (n + 1) * (n + 1)
+
+    def label(i, j, k):
+        return i + row * j + layer * k
+
+    nodes = []
+    for k in range(nz + 1):
+        for j in range(n + 1):
+            for i in range(n + 1):
+                x = [-WIDTH / 2 + WIDTH * i / n, HEIGHT * j / n]
+                nodes.append(x + [-0.005 + 0.01 * k / nz] if dim == 3 else x)
+    connectivity = []
+    for k in range(max(nz, 1)):
+        for j in range(n):
+            for i in range(n):
+                quad = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
+                corners = [label(a, b, k) for a, b in quad]
+                if dim == 3:
+                    corners += [label(a, b, k + 1) for a, b in quad]
+                connectivity.append(corners)
+    layers = range(nz + 1) if dim == 3 else [0]
     part = s["part"]
     part["nodes"] = nodes
-    part["elements"] = [{"type": "CPE4R", "connectivity": connectivity}]
-    part["node_sets"] = {"bottom": list(range(row)), "top": [n * row + i for i in range(row)]}
+    kind = "C3D8R" if dim == 3 else "CPE4R"
+    part["elements"] = [{"type": kind, "connectivity": connectivity}]
+    part["node_sets"] = {
+        "bottom": [label(i, 0, k) for k in layers for i in range(n + 1)],
+        "top": [label(i, n, k) for k in layers for i in range(n + 1)],
+    }
     if massless:
         part["section"]["massless_contact_nodes"] = True
-    s["loads"][1]["force"] = [2.0 * mu * NORMAL, 0.0]
+    s["loads"][1]["force"] = [2.0 * mu * NORMAL] + [0.0] * (dim - 1)
     s["contact"][0]["mu"] = mu
     s["steps"][0]["dt"] = dt
-    s["name"] = "2d-block-sliding"
+    s["name"] = f"{dim}d-block-sliding"
     s["description"] = (
-        f"Verification (2D): the pushed block's scene with {n} x {n} elements, mu = {mu}, "
+        f"Verification ({dim}D): the pushed block's scene with {n} x {n} elements, mu = {mu}, "
         f"pulled by F = 2 mu N = {2 * mu * NORMAL:g} N once pressed by N = {NORMAL:g} N, its "
         "contact nodes without mass (part.section.massless_contact_nodes, their lumped mass "
         "moved to the nodes above them). While every contact slides the block accelerates at "
@@ -97,7 +116,7 @@ def main():
     parser.add_argument("--out", default=str(ROOT / "validation/sliding.md"))
     args = parser.parse_args()
     if args.write:
-        SCENE.write_text(json.dumps(scene(4, 0.3, 1e-5, True), indent=2) + "\n")
+        SCENE.write_text(json.dumps(scene(2, 4, 0.3, 1e-5, True), indent=2) + "\n")
         print(f"wrote {SCENE}")
         return
     if not Path(args.skid).exists():
@@ -115,14 +134,15 @@ def main():
     checks = []
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
-        for n in MESHES:
+        for dim, n in MESHES:
+            mesh = f"{n} x {n}" + (f" x {n // 2}" if dim == 3 else "")
             for mu in MUS:
                 for massless in (False, True):
                     cells = []
                     for dt in STEPS:
                         path = work / "scene.json"
-                        path.write_text(json.dumps(scene(n, mu, dt, massless)))
-                        out = work / f"run-{n}-{mu}-{dt}-{massless}"
+                        path.write_text(json.dumps(scene(dim, n, mu, dt, massless)))
+                        out = work / f"run-{dim}-{n}-{mu}-{dt}-{massless}"
                         run = subprocess.run(
                             [args.skid, "run", str(path), "--out", str(out)],
                             capture_output=True,
@@ -136,10 +156,10 @@ def main():
                             cells.append(f"{100 * error:+.3f} %, {100 * scatter:.2f} %")
                             ok = abs(error) < 0.002 and scatter < 0.02
                         if massless and mu <= 0.3:
-                            checks.append((f"{n} x {n}, mu {mu}, dt {dt:g}: massless contact nodes", ok))
-                        print(f"{n} x {n} mu {mu} massless {massless} dt {dt:g}: {cells[-1]}", file=sys.stderr)
+                            checks.append((f"{mesh}, mu {mu}, dt {dt:g}: massless contact nodes", ok))
+                        print(f"{mesh} mu {mu} massless {massless} dt {dt:g}: {cells[-1]}", file=sys.stderr)
                     kind = "massless" if massless else "lumped"
-                    lines.append(f"| {n} x {n} | {mu} | {kind} | " + " | ".join(cells) + " |")
+                    lines.append(f"| {mesh} | {mu} | {kind} | " + " | ".join(cells) + " |")
     lines += ["", "## Checks", ""]
     lines += [f"- {'pass' if ok else 'FAIL'}: {what}" for what, ok in checks]
     lines.append("")
