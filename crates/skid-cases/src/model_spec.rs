@@ -165,18 +165,6 @@ pub enum ElementType {
 }
 
 impl ElementType {
-    /// Every element type.
-    pub const ALL: [Self; 8] = [
-        Self::Cpe4r,
-        Self::Cpe4,
-        Self::Cpe4h,
-        Self::Cpe4i,
-        Self::C3d8r,
-        Self::C3d8,
-        Self::C3d8h,
-        Self::C3d8i,
-    ];
-
     /// Dimension the element lives in.
     pub fn dimension(self) -> usize {
         match self {

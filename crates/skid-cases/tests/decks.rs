@@ -998,25 +998,16 @@ fn roller_deck(kind: &str) -> String {
             }
         }
     }
-    for (a, b) in [
-        (0, 0),
-        (0, 1),
-        (0, 2),
-        (1, 0),
-        (1, 1),
-        (1, 2),
-        (2, 0),
-        (2, 1),
-        (2, 2),
-    ] {
+    // the bottom and top faces: y = 0 and y = 1 in 2D, z = 0 and z = 1 in 3D
+    for i in 0..3 {
         if dim == 2 {
-            if b == 0 {
-                bottom.push(label(a, 0, 0));
-                top.push(label(a, 2, 0));
-            }
+            bottom.push(label(i, 0, 0));
+            top.push(label(i, 2, 0));
         } else {
-            bottom.push(label(a, b, 0));
-            top.push(label(a, b, 2));
+            for j in 0..3 {
+                bottom.push(label(i, j, 0));
+                top.push(label(i, j, 2));
+            }
         }
     }
     let join = |v: &[usize]| {

@@ -22,6 +22,9 @@ pub enum Formulation {
 }
 
 impl Formulation {
+    /// Every formulation.
+    pub const ALL: [Self; 4] = [Self::Reduced, Self::Full, Self::Hybrid, Self::Incompatible];
+
     /// The Abaqus name of the element: `CPE4R`, `CPE4`, `CPE4H`, `CPE4I` for `dim = 2` (plane
     /// strain), `C3D8R`, `C3D8`, `C3D8H`, `C3D8I` otherwise.
     pub fn abaqus_name(self, dim: usize) -> &'static str {
@@ -166,7 +169,7 @@ impl<const D: usize> SolidElement<D> {
 mod tests {
     use super::*;
     use crate::cell::corners;
-    use crate::material::PolynomialN1;
+    use crate::test_fixtures::material;
 
     fn square<const D: usize>() -> Vec<SVector<f64, D>> {
         corners::<D>()
@@ -177,18 +180,13 @@ mod tests {
     }
 
     fn check_formulations<const D: usize>() -> Result<(), FemError> {
-        let m = PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6)?;
+        let m = material()?;
         let x = square::<D>();
         let u: Vec<SVector<f64, D>> = x
             .iter()
             .map(|x| x * 0.1 + x.map(|c| c * c) * 0.02)
             .collect();
-        for formulation in [
-            Formulation::Reduced,
-            Formulation::Full,
-            Formulation::Hybrid,
-            Formulation::Incompatible,
-        ] {
+        for formulation in Formulation::ALL {
             let element = SolidElement::new(formulation, &x, 0.4, m.initial_shear_modulus(), 1.0)?;
             assert_eq!(element.formulation(), formulation);
             assert_eq!(element.node_count(), 1 << D);
@@ -218,15 +216,10 @@ mod tests {
 
     #[test]
     fn abaqus_names() {
-        let names: Vec<_> = [
-            Formulation::Reduced,
-            Formulation::Full,
-            Formulation::Hybrid,
-            Formulation::Incompatible,
-        ]
-        .iter()
-        .flat_map(|f| [f.abaqus_name(2), f.abaqus_name(3)])
-        .collect();
+        let names: Vec<_> = Formulation::ALL
+            .iter()
+            .flat_map(|f| [f.abaqus_name(2), f.abaqus_name(3)])
+            .collect();
         assert_eq!(
             names,
             [

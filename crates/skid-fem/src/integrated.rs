@@ -607,6 +607,9 @@ mod tests {
     use crate::cell::corners;
     use crate::material::PolynomialN1;
     use crate::mesh::SolidMesh;
+    use crate::test_fixtures::{
+        self as fixtures, affine, dense_tangent, distorted, in_plane, jitter, material, perturb,
+    };
     use nalgebra::{DMatrix, DVector, Rotation3, SymmetricEigen, Vector3 as V3};
 
     const TECHNOLOGIES: [Technology; 3] = [
@@ -615,53 +618,16 @@ mod tests {
         Technology::Incompatible,
     ];
 
-    fn material() -> Result<PolynomialN1, FemError> {
-        PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6)
-    }
-
-    /// Deterministic pseudo-random number in [-0.5, 0.5].
-    fn jitter(k: usize) -> f64 {
-        let s = (k as f64 * 12.9898 + 78.233).sin() * 43758.5453;
-        s - s.floor() - 0.5
-    }
-
-    /// A distorted element around the box with half-widths 1.0, 0.6, 0.8.
-    fn distorted<const D: usize>() -> Vec<SVector<f64, D>> {
-        let half = [1.0, 0.6, 0.8];
-        corners::<D>()
-            .iter()
-            .enumerate()
-            .map(|(a, c)| SVector::from_fn(|k, _| half[k] * c[k] + 0.3 * jitter(a * D + k)))
-            .collect()
-    }
-
     /// Homogeneous finite deformation gradient of 15-25 % strain (in-plane block in 2D).
     fn homogeneous_f<const D: usize>() -> Matrix3<f64> {
-        let f = Matrix3::new(1.25, 0.18, -0.06, -0.1, 0.85, 0.12, 0.05, -0.07, 1.1);
-        Matrix3::from_fn(|i, j| {
-            if i < D && j < D {
-                f[(i, j)]
-            } else if i == j {
-                1.0
-            } else {
-                0.0
-            }
-        })
-    }
-
-    fn affine<const D: usize>(f: &Matrix3<f64>, x: &[SVector<f64, D>]) -> Vec<SVector<f64, D>> {
-        x.iter()
-            .map(|x| restrict(&((f - Matrix3::identity()) * embed(x))))
-            .collect()
+        in_plane::<D>(Matrix3::new(
+            1.25, 0.18, -0.06, -0.1, 0.85, 0.12, 0.05, -0.07, 1.1,
+        ))
     }
 
     /// A general large deformation: the homogeneous one plus a non-affine part.
     fn general_u<const D: usize>(x: &[SVector<f64, D>]) -> Vec<SVector<f64, D>> {
-        affine(&homogeneous_f::<D>(), x)
-            .iter()
-            .enumerate()
-            .map(|(a, u)| u + SVector::from_fn(|k, _| 0.1 * jitter(100 + a * D + k)))
-            .collect()
+        fixtures::general_u(x, &homogeneous_f::<D>(), 0.1)
     }
 
     fn tangent<const D: usize>(
@@ -670,20 +636,13 @@ mod tests {
         u: &[SVector<f64, D>],
         tangent: Tangent,
     ) -> Result<(ElementResponse, DMatrix<f64>), FemError> {
-        let n = D * element.node_count();
-        let mut k = vec![f64::NAN; n * n];
-        let r = element.respond_with_tangent(m, u, tangent, &mut k)?;
-        Ok((r, DMatrix::from_vec(n, n, k)))
+        dense_tangent(D * element.node_count(), |k| {
+            element.respond_with_tangent(m, u, tangent, k)
+        })
     }
 
     fn force(r: &ElementResponse) -> DVector<f64> {
         DVector::from_column_slice(r.force())
-    }
-
-    fn perturb<const D: usize>(u: &[SVector<f64, D>], dof: usize, h: f64) -> Vec<SVector<f64, D>> {
-        let mut u = u.to_vec();
-        u[dof / D][dof % D] += h;
-        u
     }
 
     /// Central differences: force = d energy / du, tangent = d force / du,

@@ -32,6 +32,8 @@ pub mod ordering;
 pub mod pressure;
 pub mod rigid;
 pub mod solid;
+#[cfg(test)]
+mod test_fixtures;
 pub mod tetra;
 
 pub use element::{Formulation, SolidElement};

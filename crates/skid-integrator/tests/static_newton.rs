@@ -33,13 +33,6 @@ const DENSITY: f64 = 1000.0;
 const STRAIN: f64 = 0.01;
 const TOLERANCE: f64 = 1e-10;
 const MAX_ITERATIONS: usize = 5;
-/// Every element formulation: CPE4R/C3D8R, CPE4/C3D8, CPE4H/C3D8H, CPE4I/C3D8I.
-const FORMULATIONS: [Formulation; 4] = [
-    Formulation::Reduced,
-    Formulation::Full,
-    Formulation::Hybrid,
-    Formulation::Incompatible,
-];
 
 /// How the top is loaded.
 #[derive(Clone, Copy, Debug)]
@@ -253,7 +246,7 @@ fn check<const D: usize>(n: usize, loading: Loading, formulation: Formulation) {
 
 #[test]
 fn plane_strain_compression_on_rollers_converges_quadratically() {
-    for formulation in FORMULATIONS {
+    for formulation in Formulation::ALL {
         for n in [1, 2, 4] {
             check::<2>(n, Loading::Force, formulation);
             check::<2>(n, Loading::Displacement, formulation);
@@ -263,7 +256,7 @@ fn plane_strain_compression_on_rollers_converges_quadratically() {
 
 #[test]
 fn three_dimensional_compression_on_rollers_converges_quadratically() {
-    for formulation in FORMULATIONS {
+    for formulation in Formulation::ALL {
         for n in [1, 2, 4] {
             check::<3>(n, Loading::Force, formulation);
             check::<3>(n, Loading::Displacement, formulation);
