@@ -3,7 +3,8 @@
 # every hard case of cases/hard in parallel, and the convergence study (scripts/convergence.sh);
 # runs the verification scenes of cases/verification (block on a flat and an incline, Hertz);
 # writes the report validation/report.md (benchmark, hard cases, convergence, verification, and
-# the last measured scaling study and stress sweep of validation/) with its plots;
+# the last measured scaling study, stress sweep and pad failure loads of validation/) with its
+# plots;
 # checks that the input decks of cases/inp stop where their case files do (scripts/check_decks.py);
 # and checks the 2D benchmark's convergence in time step, its insensitivity to the pad density,
 # that the conic (clarabel) Coulomb solve gives the run of the default Newton-first one, and
@@ -28,11 +29,13 @@ SKID="$skid" scripts/convergence.sh out/convergence || status=1
 # the verification scenes, model files and decks
 rm -rf out/verification
 "$skid" batch cases/verification --out out/verification >/dev/null || status=1
-# the cost against problem size and the stress sweep, as last measured (scripts/scaling.py and
-# scripts/stress.py take too long to run here)
+# the cost against problem size, the stress sweep and the pad formulations' failure loads, as
+# last measured (scripts/scaling.py, scripts/stress.py and scripts/pressure_limit.py take too
+# long to run here)
 measured=()
 [ -f validation/scaling.json ] && measured+=(--scaling validation/scaling.json)
 [ -f validation/stress.json ] && measured+=(--stress validation/stress.json)
+[ -f validation/pressure-limit.json ] && measured+=(--pressure-limit validation/pressure-limit.json)
 "$skid" report --runs out/drum/runs --hard out/hard --convergence out/convergence \
     --verification out/verification "${measured[@]}" --out validation/report.md || status=1
 

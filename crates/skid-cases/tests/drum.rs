@@ -84,8 +84,8 @@ fn drum_spins_down_in_a_straight_line_and_rocks_in_stick_after_the_stop() {
 /// 5 kN each. The contact force must do no work on that motion beyond `p_N dg`: along the
 /// end-of-increment normal it did `p_N ds^2 / (2 R)` per node and increment, 1.9 J created in
 /// these 2 ms (first order in the time step). Without numerical dissipation (alpha = 0) what is
-/// left is the trapezoidal rule's error, 0.1 J. (Half a millisecond later the leading element
-/// folds: see the hard case 2d-pressure-x10.)
+/// left is the trapezoidal rule's error, 0.1 J. (Half a millisecond later the one-point pad's
+/// leading element folds; the hard case 2d-pressure-x10 runs this load on CPE4.)
 #[test]
 fn normal_contact_forces_do_no_work_on_nodes_sliding_along_the_drum() {
     let (s, _dir) = run(&[

@@ -108,9 +108,10 @@ enum Command {
     },
     /// The validation report (markdown with SVG plots): the benchmark runs against a reference
     /// run, the hard-case checks, the convergence study, the cost against problem size, the
-    /// verification scenes against their analytic answers, the stress sweep; each section from
-    /// its own directory or file. With none of --runs, --hard, --convergence, --scaling,
-    /// --verification, --stress, --sweep: the benchmark section of `out`.
+    /// verification scenes against their analytic answers, the stress sweep, the pad
+    /// formulations' failure loads; each section from its own directory or file. With none of
+    /// --runs, --hard, --convergence, --scaling, --verification, --stress, --pressure-limit,
+    /// --sweep: the benchmark section of `out`.
     /// With --sweep: the sweep report instead, merged from batch directories.
     Report {
         /// Benchmark runs: one subdirectory per run (summary.json, history.csv).
@@ -133,6 +134,10 @@ enum Command {
         /// The stress sweep of the solver: the stress.json of `scripts/stress.py`.
         #[arg(long, value_name = "FILE")]
         stress: Option<PathBuf>,
+        /// The load at which each pad formulation fails: the pressure-limit.json of
+        /// `scripts/pressure_limit.py`.
+        #[arg(long, value_name = "FILE")]
+        pressure_limit: Option<PathBuf>,
         /// Verification scenes (`skid batch cases/verification`): one subdirectory per
         /// run, each checked against the analytic answer of its model (Hertz contact, Coulomb
         /// friction).
@@ -142,7 +147,7 @@ enum Command {
         /// `skid batch` of sweep files, or its shards), one table per sweep in run order.
         #[arg(long, num_args = 1.., value_name = "DIR",
               conflicts_with_all = ["runs", "reference", "hard", "convergence", "scaling", "stress",
-                                    "verification"])]
+                                    "pressure_limit", "verification"])]
         sweep: Vec<PathBuf>,
         /// The markdown report; the plots are written beside it [default: validation/report.md,
         /// with --sweep out/sweep.md].
@@ -233,6 +238,7 @@ fn main() -> ExitCode {
             convergence,
             scaling,
             stress,
+            pressure_limit,
             verification,
             sweep,
             out,
@@ -242,8 +248,16 @@ fn main() -> ExitCode {
                 return report::run_sweep(&sweep, &out);
             }
             let out = out.unwrap_or_else(|| PathBuf::from("validation/report.md"));
-            let runs = match (&runs, &hard, &convergence, &scaling, &stress, &verification) {
-                (None, None, None, None, None, None) => Some(PathBuf::from("out")),
+            let given = [
+                &hard,
+                &convergence,
+                &scaling,
+                &stress,
+                &pressure_limit,
+                &verification,
+            ];
+            let runs = match (&runs, given.iter().all(|g| g.is_none())) {
+                (None, true) => Some(PathBuf::from("out")),
                 _ => runs,
             };
             let sources = ReportSources {
@@ -253,6 +267,7 @@ fn main() -> ExitCode {
                 convergence: convergence.as_deref(),
                 scaling: scaling.as_deref(),
                 stress: stress.as_deref(),
+                pressure_limit: pressure_limit.as_deref(),
                 verification: verification.as_deref(),
             };
             report::run(&sources, &out)

@@ -162,7 +162,12 @@ fn batch_exits_0_when_a_case_fails_as_it_expects() {
         env!("CARGO_MANIFEST_DIR"),
         "/../../cases/hard/2d-pressure-x10.json"
     );
-    std::fs::copy(shipped, cases.join("folds.json")).expect("copy");
+    // on one-point elements the pad folds under this load (the case runs it on CPE4)
+    let text = std::fs::read_to_string(shipped).expect("shipped case");
+    let mut case: serde_json::Value = serde_json::from_str(&text).expect("json");
+    case["pad"]["formulation"] = "reduced".into();
+    case["expect"]["failure"] = "inverted_element".into();
+    std::fs::write(cases.join("folds.json"), case.to_string()).expect("write");
     let runs = tmp.path().join("runs");
     let batch = |dir: &Path| {
         let out = skid()
@@ -189,8 +194,6 @@ fn batch_exits_0_when_a_case_fails_as_it_expects() {
     );
     assert!(runs.join("2d-pressure-x10/history.csv").is_file());
 
-    let text = std::fs::read_to_string(shipped).expect("shipped case");
-    let mut case: serde_json::Value = serde_json::from_str(&text).expect("json");
     case["expect"]["failure"] = "newton_not_converged".into();
     std::fs::write(cases.join("folds.json"), case.to_string()).expect("write");
     let (code, stdout) = batch(&cases);

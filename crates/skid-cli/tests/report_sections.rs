@@ -20,16 +20,27 @@ fn case(edit: impl Fn(&mut Value)) -> Value {
 }
 
 /// A run directory `dir`: the case as run, a history where the drum decelerates at `decel` from
-/// 60 rad/s every `dt` to 0.15 s (after a static preload row), and a summary that says so;
-/// `energy_error` is the energy balance error it reports.
+/// 60 rad/s every `dt` to 0.15 s (after a static preload row), with the contact torque that
+/// does it (I = 0.175 kg m^2, R = 0.2 m) from a friction of mu N on six sliding contacts (mu =
+/// 0.15), and a summary that says so; `energy_error` is the energy balance error it reports.
 fn write_run(dir: &Path, case: &Value, decel: f64, dt: f64, energy_error: f64) {
     std::fs::create_dir_all(dir).expect("mkdir");
     std::fs::write(dir.join("case.json"), case.to_string()).expect("case");
-    let mut history = String::from("time,step,drum_omega\n0,initial,60\n0,preload,60\n");
+    let mut history = String::from(
+        "time,step,drum_omega,normal_force,friction_force,friction_torque,active_contacts,\
+         sliding_contacts\n0,initial,60,0,0,0,0,0\n0,preload,60,3500,0,0,6,0\n",
+    );
     let n = (0.15 / dt).round() as usize;
+    let omega = |k: usize| (60.0 - decel * k as f64 * dt).max(0.0);
     for k in 1..=n {
         let t = k as f64 * dt;
-        history.push_str(&format!("{t},spin-down,{}\n", (60.0 - decel * t).max(0.0)));
+        let torque = 0.175 * (omega(k) - omega(k - 1)) / dt;
+        let (friction, sliding) = (torque.abs() / 0.2, if torque != 0.0 { 6 } else { 0 });
+        let normal = if sliding > 0 { friction / 0.15 } else { 3500.0 };
+        history.push_str(&format!(
+            "{t},spin-down,{},{normal},{friction},{torque},6,{sliding}\n",
+            omega(k)
+        ));
     }
     std::fs::write(dir.join("history.csv"), history).expect("history");
     let summary = json!({
@@ -83,17 +94,17 @@ fn hard_cases_are_checked_from_their_case_and_failures_exit_1() {
     // t_stop 0.1007 s against the estimate 0.1 s; then a run losing 2 % of its energy.
     let good = case(|c| c["name"] = "2d-good".into());
     write_run(&hard.join("2d-good"), &good, 600.0 / 1.007, 1e-3, 1e-3);
-    // Five checks: the hourglass check does not apply to a pad one element thick.
+    // Seven checks: the hourglass check does not apply to a pad one element thick.
     let (code, stdout, stderr, text) = report(&[("--hard", "hard")], tmp.path());
     assert_eq!(code, Some(0), "{stdout}\n{stderr}\n{text}");
-    assert!(stdout.contains("5 passed, 0 failed"), "{stdout}");
+    assert!(stdout.contains("7 passed, 0 failed"), "{stdout}");
     assert!(text.contains("## Hard cases"), "{text}");
     assert!(
         !text.contains("## Benchmark"),
         "only the sections asked for: {text}"
     );
     assert!(
-        text.contains("| 2d-good | 2D | completed | 0.1007 | 0.1000 | +0.70 | 0.1000 |"),
+        text.contains("| 2d-good | CPE4R | completed | 0.1007 | 0.1000 | +0.70 | 0.1000 |"),
         "{text}"
     );
     assert!(text.contains("skid batch cases/hard --out"), "{text}");
@@ -104,7 +115,7 @@ fn hard_cases_are_checked_from_their_case_and_failures_exit_1() {
     write_run(&hard.join("2d-lossy"), &lossy, 600.0, 1e-3, 0.02);
     let (code, stdout, _, text) = report(&[("--hard", "hard")], tmp.path());
     assert_eq!(code, Some(1), "{stdout}");
-    assert!(stdout.contains("9 passed, 1 failed"), "{stdout}");
+    assert!(stdout.contains("13 passed, 1 failed"), "{stdout}");
     assert!(
         text.contains("- **FAIL** energy: 2.000 % of the drum energy lost (limit 1 %)"),
         "{text}"

@@ -61,10 +61,18 @@ pub const CONTACT_LIMIT_M: f64 = 1e-6;
 const POST_STOP_OMEGA: f64 = 5.0;
 /// DRUM.md section 3: largest angle change after the stop, rad, at the benchmark's spring-back.
 const POST_STOP_ANGLE: f64 = 0.03;
+/// Relative tolerance of the friction resultant against `mu N` on increments where every
+/// contact slides: the contact totals count a contact as sliding from `|t| >= mu N (1 - 1e-6)`.
+pub const FRICTION_TOLERANCE: f64 = 1e-6;
+/// Largest residual of the drum's angular momentum balance, relative to `I |omega0|`: the
+/// history's ten significant digits leave about 1e-10 per increment.
+pub const MOMENTUM_TOLERANCE: f64 = 1e-6;
 /// The names of the checks, in table order.
-pub const CHECKS: [&str; 6] = [
+pub const CHECKS: [&str; 8] = [
     "outcome",
     "contact",
+    "friction",
+    "momentum",
     "energy",
     "drum",
     "post-stop",
@@ -205,7 +213,7 @@ pub struct Assessment {
     /// The energy error the energy check used (relative).
     pub energy_error: Option<f64>,
     /// The checks, in the order of [`CHECKS`].
-    pub checks: [Check; 6],
+    pub checks: [Check; 8],
 }
 
 fn outcome(run: &Run, expected: Option<ExpectedFailure>) -> Check {
@@ -254,6 +262,89 @@ fn contact(run: &Run) -> Check {
             Sig(pen),
             Sig(sep),
             plain(CONTACT_LIMIT_M)
+        ),
+    )
+}
+
+/// The Coulomb law in the resultants: on every dynamic increment `|F_t| <= mu N (1 + tol)`,
+/// the friction the drum feels never exceeds `mu N` (with `mu = 0`: `|F_t| <= tol max N`).
+/// Reported beside it: on how many of the increments where every contact slides the friction
+/// is `mu N` to `tol`. The others slide partly backwards (a front face vibrating faster than
+/// the drum), or, in 3D, partly across (`F_t` is the circumferential component only).
+fn friction(run: &Run, case: &Case) -> Check {
+    let rows = &run.history.contact;
+    let mu = case.contact.mu;
+    if rows.is_empty() {
+        return check(false, "no contact resultants in history.csv".into());
+    }
+    let tol = FRICTION_TOLERANCE;
+    let n_max = rows.iter().map(|r| r.normal_force).fold(0.0, f64::max);
+    if mu == 0.0 {
+        let f_max = rows
+            .iter()
+            .map(|r| r.friction_force.abs())
+            .fold(0.0, f64::max);
+        return check(
+            within(f_max, tol * n_max),
+            format!(
+                "mu = 0: max |F_t| {} N (limit {} of max N {} N)",
+                Sig(f_max),
+                Sig(tol),
+                Sig(n_max)
+            ),
+        );
+    }
+    let excess = rows
+        .iter()
+        .map(|r| r.friction_force.abs() - mu * r.normal_force.max(0.0))
+        .fold(f64::NEG_INFINITY, f64::max);
+    let sliding: Vec<f64> = rows
+        .iter()
+        .filter(|r| {
+            r.active_contacts > 0 && r.sliding_contacts == r.active_contacts && r.normal_force > 0.0
+        })
+        .map(|r| r.friction_force.abs() / (mu * r.normal_force))
+        .collect();
+    let at_limit = sliding.iter().filter(|&&q| q >= 1.0 - tol).count();
+    check(
+        within(excess, tol * mu * n_max),
+        format!(
+            "max (|F_t| - mu N) {} N (limit {} mu max N = {} N); |F_t| = mu N to {} on {at_limit} \
+             of the {} increments where every contact slides",
+            Sig(excess),
+            Sig(tol),
+            Sig(tol * mu * n_max),
+            Sig(tol),
+            sliding.len()
+        ),
+    )
+}
+
+/// The drum's angular momentum balance over the dynamic part: `I (omega_k - omega_0)` against
+/// the contact impulses `sum_n h_n T_n` of the increments up to row `k`, `T_n` the contact
+/// torque on the drum at the end of increment `n` (the contact law holds at the end of each
+/// increment, and the drum feels its reaction over the whole increment). Exact but for the
+/// history's ten digits, so held to [`MOMENTUM_TOLERANCE`] of `I |omega0|`: a torque lost or
+/// gained on the way to the drum, or reported but not applied, fails it.
+fn momentum(run: &Run, case: &Case) -> Check {
+    let h = &run.history;
+    if h.contact.len() != h.time.len() || h.time.len() < 2 {
+        return check(false, "no contact torque history in history.csv".into());
+    }
+    let inertia = case.drum.rotary_inertia;
+    let (mut impulse, mut worst) = (0.0, 0.0_f64);
+    for k in 1..h.time.len() {
+        impulse += (h.time[k] - h.time[k - 1]) * h.contact[k].friction_torque;
+        worst = worst.max((inertia * (h.omega[k] - h.omega[0]) - impulse).abs());
+    }
+    let scale = inertia * case.drum.omega0.abs();
+    check(
+        within(worst, MOMENTUM_TOLERANCE * scale),
+        format!(
+            "max |I (omega - omega0) - sum h T| {} N m s = {} of I omega0 (limit {})",
+            Sig(worst),
+            Sig(worst / scale),
+            Sig(MOMENTUM_TOLERANCE)
         ),
     )
 }
@@ -436,6 +527,8 @@ pub fn assess(run: &Run, case: &Case) -> Assessment {
         checks: [
             outcome(run, case.expect.failure),
             contact(run),
+            friction(run, case),
+            momentum(run, case),
             energy_check,
             drum_check,
             post_stop_check,
@@ -446,7 +539,7 @@ pub fn assess(run: &Run, case: &Case) -> Assessment {
 
 fn table(runs: &[(&Run, &Case, Assessment)], out: &mut String) {
     out.push_str(
-        "| case | dim | status | t_stop [s] (or final omega) | estimate [s] | deviation [%] \
+        "| case | element | status | t_stop [s] (or final omega) | estimate [s] | deviation [%] \
          | energy error [%] | increments | cutbacks | wall time [s] |",
     );
     for name in CHECKS {
@@ -468,9 +561,9 @@ fn table(runs: &[(&Run, &Case, Assessment)], out: &mut String) {
         };
         let _ = write!(
             out,
-            "| {} | {}D | {status} | {stop} | {} | {} | {} | {} | {} | {:.2} |",
+            "| {} | {} | {status} | {stop} | {} | {} | {} | {} | {} | {:.2} |",
             run.name,
-            s.dimension,
+            case.pad.formulation.formulation().abaqus_name(s.dimension),
             show(a.estimates.t_stop),
             a.deviation
                 .map_or_else(|| "n/a".into(), |d| format!("{:+.2}", 100.0 * d)),
@@ -528,6 +621,16 @@ pub fn section(
          post-stop checks do not apply to a run expected to stop early;\n\
          - **contact**: max penetration and max gap of a sliding contact carrying force \
          <= {contact} m;\n\
+         - **friction**: on every increment the friction resultant never exceeds mu N, N the \
+         contacts' total normal force: |F_t| - mu N <= {friction} mu max N (with mu = 0: \
+         |F_t| <= {friction} max N); the detail says on how many of the increments where every \
+         contact slides |F_t| = mu N (the others slide partly backwards, a front face vibrating \
+         faster than the drum, or in 3D partly across the circumference);\n\
+         - **momentum**: the drum's angular momentum balance I (omega(t) - omega0) = sum h T \
+         over the increments to t, T the contact torque on the drum at the end of each \
+         increment of size h (history.csv's friction_torque; the contact law holds at the end \
+         of the increment and the drum feels its reaction over all of it), to {momentum} of \
+         I omega0 (the history's ten digits);\n\
          - **energy**: |energy balance residual| <= {energy} % of the drum energy lost \
          (frictionless: of the initial kinetic energy I omega0^2 / 2);\n\
          - **drum**: with friction, t_stop within {tol} % (unless the case sets \
@@ -559,6 +662,8 @@ pub fn section(
          1 - t / t_est]({HARD_OMEGA_SVG})\n\n",
         dir = dir.display(),
         contact = Sig(CONTACT_LIMIT_M),
+        friction = Sig(FRICTION_TOLERANCE),
+        momentum = Sig(MOMENTUM_TOLERANCE),
         energy = plain(100.0 * ENERGY_TOLERANCE),
         tol = plain(100.0 * T_STOP_TOLERANCE),
         spin = Sig(OMEGA_CONSTANCY),
@@ -607,6 +712,12 @@ mod tests {
         a.checks.iter().map(|c| c.verdict).collect()
     }
 
+    /// The check of `a` named `name` (one of [`CHECKS`]).
+    fn named<'a>(a: &'a Assessment, name: &str) -> &'a Check {
+        let k = CHECKS.iter().position(|n| *n == name).expect("a check");
+        &a.checks[k]
+    }
+
     #[test]
     fn the_benchmark_estimates_are_those_of_drum_md() {
         let e = estimates(&case(&[]));
@@ -639,7 +750,7 @@ mod tests {
     fn a_run_that_behaves_as_estimated_passes_every_check() {
         let run = spin_down("2d-x", 600.0 / 1.007);
         let a = assess(&run, &case(&["pad.elements.radial=8"]));
-        assert_eq!(verdicts(&a), vec![Verdict::Pass; 6], "{a:#?}");
+        assert_eq!(verdicts(&a), vec![Verdict::Pass; CHECKS.len()], "{a:#?}");
         assert!((a.deviation.expect("stops") - 0.007).abs() < 1e-9);
     }
 
@@ -692,6 +803,27 @@ mod tests {
         let mut run = spin_down("x", 600.0);
         run.summary.max_hourglass_ratio = None;
         assert_eq!(failing(&run), ["hourglass"]);
+        // Friction 1e-5 above mu N on one increment.
+        let mut run = spin_down("x", 600.0);
+        run.history.contact[10].normal_force /= 1.0 + 1e-5;
+        assert_eq!(failing(&run), ["friction"]);
+        let mut run = spin_down("x", 600.0);
+        run.history.contact[10].normal_force *= 1.0 + 1e-5;
+        assert!(failing(&run).is_empty());
+        let a = assess(&run, &c);
+        assert!(
+            named(&a, "friction")
+                .detail
+                .contains("on 99 of the 100 increments"),
+            "{a:#?}"
+        );
+        // One increment's torque recorded 1 % larger than the drum felt it.
+        let mut run = spin_down("x", 600.0);
+        run.history.contact[10].friction_torque *= 1.01;
+        assert_eq!(failing(&run), ["momentum"]);
+        let mut run = spin_down("x", 600.0);
+        run.history.contact.clear();
+        assert_eq!(failing(&run), ["friction", "momentum"]);
     }
 
     #[test]
@@ -699,12 +831,21 @@ mod tests {
         let mut run = spin_down("x", 600.0);
         run.summary.max_hourglass_ratio = Some(0.011);
         let single = assess(&run, &case(&[]));
-        assert_eq!(single.checks[5].verdict, Verdict::NotApplicable);
-        assert!(single.checks[5].detail.contains("1.100 %"), "{single:#?}");
+        assert_eq!(named(&single, "hourglass").verdict, Verdict::NotApplicable);
+        assert!(
+            named(&single, "hourglass").detail.contains("1.100 %"),
+            "{single:#?}"
+        );
         let layered = case(&["pad.elements.radial=2"]);
-        assert_eq!(assess(&run, &layered).checks[5].verdict, Verdict::Fail);
+        assert_eq!(
+            named(&assess(&run, &layered), "hourglass").verdict,
+            Verdict::Fail
+        );
         run.summary.max_hourglass_ratio = Some(0.009);
-        assert_eq!(assess(&run, &layered).checks[5].verdict, Verdict::Pass);
+        assert_eq!(
+            named(&assess(&run, &layered), "hourglass").verdict,
+            Verdict::Pass
+        );
     }
 
     #[test]
@@ -716,7 +857,10 @@ mod tests {
         run.summary.failure = Some("inverted element".into());
         run.summary.t_stop = None;
         let a = assess(&run, &expects);
+        // outcome, contact, friction, momentum, energy; drum, post-stop, hourglass n/a
         let expected = [
+            Verdict::Pass,
+            Verdict::Pass,
             Verdict::Pass,
             Verdict::Pass,
             Verdict::Pass,
@@ -725,27 +869,36 @@ mod tests {
             Verdict::NotApplicable,
         ];
         assert_eq!(verdicts(&a), expected, "{a:#?}");
-        assert!(a.checks[0].detail.contains("corner 3"), "{a:#?}");
+        assert!(named(&a, "outcome").detail.contains("corner 3"), "{a:#?}");
         // Another failure, a completed run, or NaN in the history fail the outcome.
         run.summary.failure = Some("newton not converged".into());
         let a = assess(&run, &expects);
-        assert_eq!(a.checks[0].verdict, Verdict::Fail);
+        assert_eq!(named(&a, "outcome").verdict, Verdict::Fail);
         assert!(
-            a.checks[0]
+            named(&a, "outcome")
                 .detail
                 .contains("expected to stop with inverted element")
         );
         let completed = spin_down("x", 600.0);
         let a = assess(&completed, &expects);
-        assert_eq!(a.checks[0].verdict, Verdict::Fail);
-        assert!(a.checks[0].detail.contains("out of date"), "{a:#?}");
+        assert_eq!(named(&a, "outcome").verdict, Verdict::Fail);
+        assert!(
+            named(&a, "outcome").detail.contains("out of date"),
+            "{a:#?}"
+        );
         run.summary.failure = Some("inverted element".into());
         run.history.non_finite = 2;
-        assert_eq!(assess(&run, &expects).checks[0].verdict, Verdict::Fail);
+        assert_eq!(
+            named(&assess(&run, &expects), "outcome").verdict,
+            Verdict::Fail
+        );
         // The run's energy balance is still checked.
         run.history.non_finite = 0;
         run.summary.energy_balance_error = Some(0.02);
-        assert_eq!(assess(&run, &expects).checks[2].verdict, Verdict::Fail);
+        assert_eq!(
+            named(&assess(&run, &expects), "energy").verdict,
+            Verdict::Fail
+        );
     }
 
     #[test]
@@ -754,14 +907,17 @@ mod tests {
         let mut run = spin_down("x", 300.0);
         run.summary.t_stop = None;
         let a = assess(&run, &c);
-        assert_eq!(a.checks[3].verdict, Verdict::Fail);
-        assert!(a.checks[3].detail.contains("did not stop"), "{a:#?}");
-        assert_eq!(a.checks[4].verdict, Verdict::Fail);
+        assert_eq!(named(&a, "drum").verdict, Verdict::Fail);
+        assert!(named(&a, "drum").detail.contains("did not stop"), "{a:#?}");
+        assert_eq!(named(&a, "post-stop").verdict, Verdict::Fail);
         // Stops at 0.14 s of a 0.15 s run: 10 ms of rocking, less than a period.
         let run = spin_down("x", 60.0 / 0.14);
         let a = assess(&run, &c);
-        assert_eq!(a.checks[4].verdict, Verdict::Fail);
-        assert!(a.checks[4].detail.contains("rocking period"), "{a:#?}");
+        assert_eq!(named(&a, "post-stop").verdict, Verdict::Fail);
+        assert!(
+            named(&a, "post-stop").detail.contains("rocking period"),
+            "{a:#?}"
+        );
     }
 
     #[test]
@@ -771,7 +927,10 @@ mod tests {
         run.summary.energy_balance_error = None;
         run.summary.energy_balance_residual_j = Some(1e-8);
         let a = assess(&run, &c);
+        // outcome, contact, friction, momentum, energy, drum; post-stop, hourglass n/a
         let expected = [
+            Verdict::Pass,
+            Verdict::Pass,
             Verdict::Pass,
             Verdict::Pass,
             Verdict::Pass,
@@ -785,8 +944,8 @@ mod tests {
         run.history.omega[100] = 60.0 * (1.0 + 1e-8);
         run.summary.energy_balance_residual_j = Some(-4.0);
         let a = assess(&run, &c);
-        assert_eq!(a.checks[2].verdict, Verdict::Fail);
-        assert_eq!(a.checks[3].verdict, Verdict::Fail);
+        assert_eq!(named(&a, "energy").verdict, Verdict::Fail);
+        assert_eq!(named(&a, "drum").verdict, Verdict::Fail);
     }
 
     #[test]
@@ -804,9 +963,9 @@ mod tests {
         let runs = [good, late, folded];
         let (text, counts, plots) =
             section(Path::new("out/hard"), &runs, dir.path()).expect("section");
-        // Five checks each for the runs that complete, three for the one expected to fail;
+        // Seven checks each for the runs that complete, five for the one expected to fail;
         // the hourglass check does not apply to the single-layer pads.
-        assert_eq!(counts.passed, 12);
+        assert_eq!(counts.passed, 18);
         assert_eq!(counts.failed, 1);
         assert!(plots[0].is_file());
         let row = |name: &str| {
@@ -820,7 +979,9 @@ mod tests {
             "{}",
             row("2d-good")
         );
-        assert!(row("2d-late").ends_with("| PASS | PASS | PASS | FAIL | PASS | n/a |"));
+        assert!(
+            row("2d-late").ends_with("| PASS | PASS | PASS | PASS | PASS | FAIL | PASS | n/a |")
+        );
         assert!(text.contains("Expectation: why it differs"), "{text}");
         assert!(
             row("2d-folded").contains("| failed (as expected) |"),

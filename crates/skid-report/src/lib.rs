@@ -10,6 +10,7 @@
 //! - the benchmark ([`markdown`]): every run's drum spin-down against a reference run
 //!   (DRUM.md section 3), with [`plot`]'s omega plots;
 //! - the hard cases ([`hard`]): checks derived from each run's case;
+//! - the load at which each pad formulation fails ([`pressure_limit`]);
 //! - the convergence study ([`convergence`]): t_stop and e_slide against mesh and time-step
 //!   refinement with observed orders, and Newton residual histories;
 //! - the cost against problem size ([`scaling`]);
@@ -34,6 +35,7 @@ pub mod markdown;
 pub mod model_run;
 pub mod moved_block;
 pub mod plot;
+pub mod pressure_limit;
 pub mod scaling;
 pub mod stress;
 pub mod sweep;
@@ -164,8 +166,26 @@ pub struct History {
     pub time: Vec<f64>,
     /// Drum angular velocity, rad/s.
     pub omega: Vec<f64>,
+    /// The contact resultants of the same rows, where the history has them (a drum case's
+    /// `history.csv`); empty otherwise.
+    pub contact: Vec<ContactRow>,
     /// Non-finite numbers (NaN, infinity) anywhere in the file's rows.
     pub non_finite: usize,
+}
+
+/// The contact resultants of one history row (the drum history's columns of the same names).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactRow {
+    /// Total normal contact force, N.
+    pub normal_force: f64,
+    /// Total friction force along the first tangent (the drum's circumference), N.
+    pub friction_force: f64,
+    /// The contact forces' moment about the drum's axis, acting on the drum, N m.
+    pub friction_torque: f64,
+    /// Contacts carrying force.
+    pub active_contacts: usize,
+    /// Of those, contacts sliding (`|t| >= mu N` to the solver's tolerance).
+    pub sliding_contacts: usize,
 }
 
 /// One run of a batch.
@@ -191,7 +211,7 @@ pub fn dynamic_part(time: &[f64], omega: &[f64]) -> History {
     History {
         time: rows.iter().map(|&r| time[r] - t0).collect(),
         omega: rows.iter().map(|&r| omega[r]).collect(),
-        non_finite: 0,
+        ..History::default()
     }
 }
 
@@ -220,19 +240,51 @@ pub(crate) fn dynamic_rows(time: &[f64]) -> Vec<usize> {
 pub fn parse_history(text: &str, path: &Path) -> Result<History, ReportError> {
     let table = CsvTable::new(text, path)?;
     let (it, iw) = (table.column("time")?, table.column("drum_omega")?);
-    let (mut time, mut omega) = (Vec::new(), Vec::new());
+    let has = |name: &str| table.header().any(|n| n == name);
+    let contact_columns = if CONTACT_COLUMNS.iter().all(|c| has(c)) {
+        let [n, f, t, a, s] = CONTACT_COLUMNS.map(|c| table.column(c));
+        Some((n?, f?, t?, a?, s?))
+    } else {
+        None
+    };
+    let (mut time, mut omega, mut contact) = (Vec::new(), Vec::new(), Vec::new());
     let mut non_finite = 0;
     for row in table {
         let row = row?;
         non_finite += non_finite_fields(&row);
         time.push(row.number(it)?);
         omega.push(row.number(iw)?);
+        if let Some((n, f, t, a, s)) = contact_columns {
+            contact.push(ContactRow {
+                normal_force: row.number(n)?,
+                friction_force: row.number(f)?,
+                friction_torque: row.number(t)?,
+                active_contacts: row.number(a)?,
+                sliding_contacts: row.number(s)?,
+            });
+        }
     }
+    let rows = dynamic_rows(&time);
+    let contact = if contact.is_empty() {
+        contact
+    } else {
+        rows.iter().map(|&r| contact[r]).collect()
+    };
     Ok(History {
         non_finite,
+        contact,
         ..dynamic_part(&time, &omega)
     })
 }
+
+/// The drum history's columns that [`ContactRow`] reads, in its field order.
+const CONTACT_COLUMNS: [&str; 5] = [
+    "normal_force",
+    "friction_force",
+    "friction_torque",
+    "active_contacts",
+    "sliding_contacts",
+];
 
 /// The fields of a history row that read as NaN or an infinity.
 pub(crate) fn non_finite_fields(row: &Row<'_>) -> usize {
@@ -428,6 +480,9 @@ pub struct ReportSources<'a> {
     pub scaling: Option<&'a Path>,
     /// The records of the stress sweep (`stress.json` of `scripts/stress.py`).
     pub stress: Option<&'a Path>,
+    /// The pad formulations' failure loads (`pressure-limit.json` of
+    /// `scripts/pressure_limit.py`).
+    pub pressure_limit: Option<&'a Path>,
     /// Runs of the verification scenes (`skid batch cases/verification`), one
     /// subdirectory per run.
     pub verification: Option<&'a Path>,
@@ -462,6 +517,10 @@ fn regenerate(sources: &ReportSources<'_>, out: &Path) -> String {
     if let Some(hard) = sources.hard {
         commands.push(format!("skid batch cases/hard --out {}", hard.display()));
         let _ = write!(report, " --hard {}", hard.display());
+    }
+    if let Some(limit) = sources.pressure_limit {
+        commands.push("scripts/pressure_limit.py".into());
+        let _ = write!(report, " --pressure-limit {}", limit.display());
     }
     if let Some(convergence) = sources.convergence {
         commands.push(format!("scripts/convergence.sh {}", convergence.display()));
@@ -533,6 +592,13 @@ pub fn write_report(sources: &ReportSources<'_>, out: &Path) -> Result<ReportOut
         files.extend(plots);
         counts += n;
     }
+    if let Some(limit_file) = sources.pressure_limit {
+        let ladder = pressure_limit::load(limit_file)?;
+        let (section, n) = pressure_limit::section(limit_file, &ladder);
+        text.push('\n');
+        text.push_str(&section);
+        counts += n;
+    }
     if let Some(study_dir) = sources.convergence {
         let study = convergence::load_study(study_dir)?;
         let (section, plots) = convergence::section(study_dir, &study, dir)?;
@@ -578,14 +644,37 @@ pub fn write_report(sources: &ReportSources<'_>, out: &Path) -> Result<ReportOut
 /// Synthetic runs for the report's unit tests.
 #[cfg(test)]
 pub(crate) mod test_runs {
-    use super::{History, Run, RunSummary};
+    use super::{ContactRow, History, Run, RunSummary};
 
     /// A completed 3D run whose drum decelerates from 60 rad/s at `decel` rad/s^2, sampled
     /// every millisecond to 0.15 s and held at zero after the stop, with a summary that says
-    /// so (post-stop motion 2 rad/s and 0.01 rad, energy error 0.1 %, no case).
+    /// so (post-stop motion 2 rad/s and 0.01 rad, energy error 0.1 %, no case), and the
+    /// contact resultants of the benchmark's drum (I = 0.175 kg m^2, R = 0.2 m, mu = 0.15):
+    /// six contacts sliding with the torque that decelerates it into each row until the stop,
+    /// sticking after it.
     pub(crate) fn spin_down(name: &str, decel: f64) -> Run {
         let time: Vec<f64> = (0..=150).map(|k| k as f64 * 1e-3).collect();
-        let omega = time.iter().map(|t| (60.0 - decel * t).max(0.0)).collect();
+        let omega: Vec<f64> = time.iter().map(|t| (60.0 - decel * t).max(0.0)).collect();
+        let (inertia, radius, mu) = (0.175, 0.2, 0.15);
+        let contact = (0..time.len())
+            .map(|k| {
+                // the torque that takes the drum from the previous row to this one
+                let torque = if k == 0 {
+                    0.0
+                } else {
+                    inertia * (omega[k] - omega[k - 1]) / (time[k] - time[k - 1])
+                };
+                let slides = torque != 0.0;
+                let friction = torque.abs() / radius;
+                ContactRow {
+                    normal_force: if slides { friction / mu } else { 3500.0 },
+                    friction_force: friction,
+                    friction_torque: torque,
+                    active_contacts: 6,
+                    sliding_contacts: if slides { 6 } else { 0 },
+                }
+            })
+            .collect();
         Run {
             name: name.into(),
             summary: RunSummary {
@@ -614,6 +703,7 @@ pub(crate) mod test_runs {
             history: History {
                 time,
                 omega,
+                contact,
                 non_finite: 0,
             },
             case: None,
@@ -646,7 +736,7 @@ mod tests {
         History {
             time,
             omega,
-            non_finite: 0,
+            ..History::default()
         }
     }
 
@@ -655,7 +745,7 @@ mod tests {
         let h = History {
             time: vec![0.0, 1.0, 3.0],
             omega: vec![10.0, 8.0, 0.0],
-            non_finite: 0,
+            ..History::default()
         };
         assert_eq!(interpolate(&h.time, &h.omega, 0.0), Some(10.0));
         assert_eq!(interpolate(&h.time, &h.omega, 0.5), Some(9.0));

@@ -94,6 +94,7 @@ pub(crate) fn load(dir: &Path) -> Result<Run, ReportError> {
             time: spin.points.iter().map(|p| p.time - t0).collect(),
             omega: spin.points.iter().map(|p| p.omega).collect(),
             non_finite: spin.non_finite,
+            ..History::default()
         },
         case: None,
     })
