@@ -135,6 +135,7 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
         section: SectionSpec {
             material: pad.material.clone(),
             density: pad.density,
+            stiffness_damping: pad.stiffness_damping,
             thickness: if D == 2 { pad.width } else { 1.0 },
             hourglass_scale: pad.hourglass_scale,
             quasi_static: pad.quasi_static,

@@ -132,6 +132,15 @@ pub struct SetMaterialSpec {
     pub material: MaterialSpec,
     /// Mass density, kg/m^3.
     pub density: f64,
+    /// Stiffness-proportional (Rayleigh) damping factor `beta`, s (see
+    /// `part.section.stiffness_damping`).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub stiffness_damping: f64,
+}
+
+/// Whether a factor is 0 (left out when written).
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// Element types of a deformable part: bilinear quads (plane strain, 2D) and trilinear hexes
@@ -228,6 +237,13 @@ pub struct SectionSpec {
     pub material: MaterialSpec,
     /// Mass density, kg/m^3.
     pub density: f64,
+    /// Stiffness-proportional (Rayleigh) damping factor `beta`, s (Abaqus' `*DAMPING, BETA`):
+    /// in dynamic steps each element adds the viscous force `beta K_T v`, `K_T` its tangent
+    /// stiffness and `v` its nodal velocities, which damps a mode of frequency `omega` at the
+    /// ratio `beta omega / 2`. A real rubber's loss factor of 0.1 is about `beta = 0.1 /
+    /// omega` at the frequencies that matter. 0 (the default): no damping.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub stiffness_damping: f64,
     /// Out-of-plane thickness in 2D, m (must be 1 in 3D).
     #[serde(default = "one")]
     pub thickness: f64,

@@ -154,6 +154,15 @@ pub struct PadSpec {
     /// (see the model file's `part.section.massless_contact_nodes`).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub massless_contact_nodes: bool,
+    /// Stiffness-proportional (Rayleigh) damping factor `beta` of the pad, s (see the model
+    /// file's `part.section.stiffness_damping`); 0, the default: none.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub stiffness_damping: f64,
+}
+
+/// Whether a factor is 0 (left out when written).
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// The element formulation of a pad, in either dimension.

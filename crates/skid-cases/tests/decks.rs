@@ -1086,3 +1086,36 @@ fn quads_and_hexahedra_in_one_deck_are_refused_at_the_element() {
     assert!(message.contains("cannot share a model"), "{message}");
     assert!(message.contains("scene.inp:"), "{message}");
 }
+
+/// `*DAMPING, BETA=` in a `*MATERIAL` is the section's stiffness-proportional damping, written
+/// back as read; `ALPHA` (mass-proportional), a missing or negative `BETA`, a data line, or a
+/// second `*DAMPING` are refused at their keyword.
+#[test]
+fn material_damping_reads_as_stiffness_proportional_damping() {
+    let damped = roller_deck("CPE4R").replace(
+        "*DENSITY\n1000.0\n",
+        "*DENSITY\n1000.0\n*DAMPING, BETA=2.5e-5\n",
+    );
+    let model = read_text(&damped).expect("reads").model;
+    assert_eq!(model.part.section.stiffness_damping, 2.5e-5);
+    let written = skid_cases::deck::write::write_deck(&model, &Default::default()).expect("writes");
+    assert!(written.contains("*DAMPING, BETA=2.5e-5"), "{written}");
+    assert_eq!(read_text(&written).expect("rereads").model, model);
+    let plain = read_text(&roller_deck("CPE4R")).expect("reads").model;
+    assert_eq!(plain.part.section.stiffness_damping, 0.0);
+    for (damping, expected) in [
+        ("*DAMPING, ALPHA=3.0, BETA=1e-5\n", "ALPHA"),
+        ("*DAMPING\n", "give BETA"),
+        ("*DAMPING, BETA=-1e-5\n", "expected a number >= 0"),
+        ("*DAMPING, BETA=1e-5\n0.1\n", "*DAMPING"),
+        ("*DAMPING, BETA=1e-5\n*DAMPING, BETA=2e-5\n", "given twice"),
+    ] {
+        let text = roller_deck("CPE4R").replace(
+            "*DENSITY\n1000.0\n",
+            &format!("*DENSITY\n1000.0\n{damping}"),
+        );
+        let error = read_text(&text).expect_err(damping);
+        assert!(error.contains(expected), "{damping}: {error}");
+        assert!(error.contains("scene.inp:"), "{damping}: {error}");
+    }
+}

@@ -113,11 +113,33 @@ fn materials_of_element_sets_are_checked_with_their_field() {
             "part.materials[0].material",
             "",
         ),
+        (
+            r#"[{"element_set": "upper", "material": UPPER, "density": 1000.0, "stiffness_damping": -1e-5}]"#,
+            "part.materials[0].stiffness_damping",
+            "",
+        ),
     ] {
         let error = model_file::build::<2>(&spec(materials)).expect_err(materials);
         assert_eq!(error.field, field, "{materials}: {error:?}");
         assert!(error.message.contains(fragment), "{}", error.message);
     }
+}
+
+/// Each section keeps its own stiffness damping (the part's, and each set material's).
+#[test]
+fn stiffness_damping_is_a_property_of_each_section() {
+    let spec = spec(
+        r#"[{"element_set": "upper", "material": UPPER, "density": 1000.0, "stiffness_damping": 3e-5}]"#,
+    );
+    let scene = model_file::build::<2>(&spec).expect("scene builds");
+    let sections = &scene.model.part().sections;
+    assert_eq!(sections[0].stiffness_damping, 0.0);
+    assert_eq!(sections[1].stiffness_damping, 3e-5);
+    assert!(scene.model.has_stiffness_damping());
+    let mut negative = spec.clone();
+    negative.part.section.stiffness_damping = f64::NAN;
+    let error = model_file::build::<2>(&negative).expect_err("NaN");
+    assert_eq!(error.field, "part.section.stiffness_damping", "{error:?}");
 }
 
 /// The column as a deck: one `*SOLID SECTION` per layer, each with its `*MATERIAL`.

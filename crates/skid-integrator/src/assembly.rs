@@ -11,7 +11,7 @@ use faer::sparse::SparseColMatRef;
 use nalgebra::{DVector, SVector};
 use skid_fem::error::FemError;
 use skid_fem::pressure::pressure_face_forces;
-use skid_fem::solid::{ElementResponse, MAX_COMPONENTS, MAX_NODES};
+use skid_fem::solid::{ElementResponse, MAX_COMPONENTS, MAX_NODES, Tangent};
 
 use crate::contact_rows::{ContactRows, contact_coordinates};
 use crate::error::{IncrementFailure, LinearFailure, ModelError};
@@ -121,10 +121,32 @@ struct HeldSlots {
 pub struct InternalState {
     /// Internal force per equation, N (N m for rotations).
     pub force: DVector<f64>,
+    /// The viscous force of the sections' stiffness damping per equation, N (zero without
+    /// [`Damping`]).
+    pub damping_force: DVector<f64>,
     /// Elastic strain energy, J.
     pub strain_energy: f64,
     /// Hourglass stabilisation energy, J.
     pub hourglass_energy: f64,
+}
+
+/// Stiffness-proportional (Rayleigh) damping in a dynamic increment: each element of a
+/// section with damping factor `beta > 0` adds the viscous force `f_d = beta K_T(x) v_e`, `K_T`
+/// the element's consistent tangent and `v_e` its nodal velocities, and to the tangent
+/// `beta K_T dv/dx = beta rate K_T` (the derivative of `K_T` itself along `v` is left out, a
+/// term of order `beta |v| / L` against the rest). The increment takes the mean velocity
+/// `v = (x - x_n) / h`, `rate = 1 / h`, for every equation: the same rate for the nodes with
+/// inertia, the massless contact nodes and a quasi-static solid keeps the tangent symmetric,
+/// and `f_d . dx = beta dx^T K_T dx / h >= 0` dissipates wherever `K_T` is positive. Against
+/// the end velocity it lags by half an increment, which changes a mode's damping by the
+/// factor `cos(omega h / 2)`. `K_T` includes the geometric stiffness, so a stressed element
+/// turning rigidly at `W` feels `beta W f_int`, of order `beta |W|` of its internal force.
+#[derive(Clone, Copy, Debug)]
+pub struct Damping<'a> {
+    /// The velocity per equation the viscous force acts on.
+    pub velocity: &'a DVector<f64>,
+    /// `dv/dx`, the same for every equation.
+    pub rate: f64,
 }
 
 /// Owns the pattern, the scatter maps and the value array of the effective tangent.
@@ -151,6 +173,8 @@ pub struct Assembler {
     /// Per element, its response at the configuration of the last [`Self::internal`] call
     /// (storage kept from call to call).
     responses: Vec<ElementResponse>,
+    /// Per element, its damping force at that call (zero without damping).
+    damping_forces: Vec<[f64; MAX_COMPONENTS]>,
     /// Element pressures of the mixed tangent between Newton iterates.
     mixed: MixedPressures,
     /// Numeric factorizations of the tangent so far.
@@ -198,6 +222,7 @@ impl Assembler {
             compressed: Vec::new(),
             element_slots,
             responses: vec![ElementResponse::default(); elements],
+            damping_forces: vec![[0.0; MAX_COMPONENTS]; elements],
             mixed: MixedPressures::new(elements),
             factorizations: 0,
             factorization_time: Duration::ZERO,
@@ -215,35 +240,65 @@ impl Assembler {
         x: &DVector<f64>,
         tangent_factor: Option<f64>,
     ) -> Result<InternalState, IncrementFailure> {
+        self.internal_damped(model, x, tangent_factor, None)
+    }
+
+    /// [`Self::internal`] with the sections' stiffness damping at the velocity and rate of
+    /// `damping` (none if `None`): its force in [`InternalState::damping_force`], its tangent
+    /// added to `c_K K_T`.
+    ///
+    /// # Errors
+    /// As [`Self::internal`].
+    pub fn internal_damped<const D: usize>(
+        &mut self,
+        model: &Model<D>,
+        x: &DVector<f64>,
+        tangent_factor: Option<f64>,
+        damping: Option<Damping<'_>>,
+    ) -> Result<InternalState, IncrementFailure> {
         let element_loop = ElementLoop {
             model,
             x,
             tangent_factor,
+            damping,
             mixed: &self.mixed,
             scatter: &self.scatter,
         };
         let (element_values, other_values) = self.values.split_at_mut(self.element_slots);
-        if self.responses.len() >= PARALLEL_ELEMENT_THRESHOLD {
-            element_loop.run_parallel(0, &mut self.responses, element_values)?;
+        let out = ElementOutputs {
+            responses: &mut self.responses,
+            damping: &mut self.damping_forces,
+        };
+        if out.responses.len() >= PARALLEL_ELEMENT_THRESHOLD {
+            element_loop.run_parallel(0, out, element_values)?;
         } else {
-            element_loop.run(0, &mut self.responses, element_values)?;
+            element_loop.run(0, out, element_values)?;
         }
         if tangent_factor.is_some() {
             other_values.fill(0.0);
         }
 
         self.mixed.record(model, x, &self.responses);
+        let n = model.dofs().len();
         let mut state = InternalState {
-            force: DVector::zeros(model.dofs().len()),
+            force: DVector::zeros(n),
+            damping_force: DVector::zeros(n),
             strain_energy: 0.0,
             hourglass_energy: 0.0,
         };
-        for (response, scatter) in self.responses.iter().zip(&self.scatter) {
+        for (e, (response, scatter)) in self.responses.iter().zip(&self.scatter).enumerate() {
             state.strain_energy += response.strain_energy;
             state.hourglass_energy += response.hourglass_energy;
             for (eq, force) in scatter.eqs.iter().zip(response.force()) {
                 if let Some(eq) = eq {
                     state.force[*eq] += force;
+                }
+            }
+            if damping.is_some() {
+                for (eq, force) in scatter.eqs.iter().zip(&self.damping_forces[e]) {
+                    if let Some(eq) = eq {
+                        state.damping_force[*eq] += force;
+                    }
                 }
             }
         }
@@ -484,26 +539,37 @@ struct ElementLoop<'a, const D: usize> {
     x: &'a DVector<f64>,
     /// `c_K`, if the tangent is assembled.
     tangent_factor: Option<f64>,
+    damping: Option<Damping<'a>>,
     mixed: &'a MixedPressures,
     scatter: &'a [ElementScatter],
 }
 
+/// What the element loop writes per element, for a range of elements.
+struct ElementOutputs<'a> {
+    responses: &'a mut [ElementResponse],
+    damping: &'a mut [[f64; MAX_COMPONENTS]],
+}
+
 impl<const D: usize> ElementLoop<'_, D> {
-    /// Evaluates the elements `first..first + responses.len()` in order into `responses`, and
-    /// with a tangent factor `c` sets their value slots, `values` (theirs alone: they follow one
-    /// another in element order), to `c K_e`.
+    /// Evaluates the elements `first..first + responses.len()` in order into `out`, and with
+    /// a tangent factor `c` sets their value slots, `values` (theirs alone: they follow one
+    /// another in element order), to `c K_e`, or with damping (see [`Damping`]) to
+    /// `c (K_e + beta rate K_e^cons)`.
     ///
     /// # Errors
     /// The failure of the first element that fails; the elements after it are not evaluated.
     fn run(
         &self,
         first: usize,
-        responses: &mut [ElementResponse],
+        out: ElementOutputs<'_>,
         mut values: &mut [f64],
     ) -> Result<(), IncrementFailure> {
         let (part, dofs) = (self.model.part(), self.model.dofs());
         let mut k = [0.0; MAX_COMPONENTS * MAX_COMPONENTS];
-        for (e, response) in (first..).zip(responses) {
+        let mut k_mixed = [0.0; MAX_COMPONENTS * MAX_COMPONENTS];
+        for (e, (response, damping_force)) in
+            (first..).zip(out.responses.iter_mut().zip(out.damping.iter_mut()))
+        {
             let element = &self.model.elements()[e];
             let mut u = [SVector::zeros(); MAX_NODES];
             for (u_a, &node) in u.iter_mut().zip(&part.mesh.elements[e]) {
@@ -511,16 +577,55 @@ impl<const D: usize> ElementLoop<'_, D> {
             }
             let u = &u[..element.node_count()];
             let failure = |err| element_failure(e, err);
+            let components = D * element.node_count();
+            let scatter = &self.scatter[e];
+            let beta = part.section(e).stiffness_damping;
+            let damping = self.damping.filter(|_| beta > 0.0);
+            let tangent = self.mixed.tangent(e);
+            let k = &mut k[..components * components];
+            match (self.tangent_factor, damping) {
+                (None, None) => {
+                    *response = element.respond(part.material(e), u).map_err(failure)?;
+                    continue;
+                }
+                (Some(_), None) => {
+                    *response = element
+                        .respond_with_tangent(part.material(e), u, tangent, k)
+                        .map_err(failure)?;
+                }
+                (_, Some(d)) => {
+                    // the damping force takes the consistent tangent, so that the residual
+                    // does not depend on the Newton path
+                    *response = element
+                        .respond_with_tangent(part.material(e), u, Tangent::Consistent, k)
+                        .map_err(failure)?;
+                    for (p, f) in damping_force[..components].iter_mut().enumerate() {
+                        *f = beta
+                            * (scatter.eqs.iter().enumerate())
+                                .filter_map(|(q, eq)| {
+                                    eq.map(|eq| k[p + q * components] * d.velocity[eq])
+                                })
+                                .sum::<f64>();
+                    }
+                    if self.tangent_factor.is_none() {
+                        continue;
+                    }
+                    if tangent == Tangent::Consistent {
+                        k.iter_mut().for_each(|v| *v *= 1.0 + beta * d.rate);
+                    } else {
+                        let k_mixed = &mut k_mixed[..components * components];
+                        element
+                            .respond_with_tangent(part.material(e), u, tangent, k_mixed)
+                            .map_err(failure)?;
+                        for (v, m) in k.iter_mut().zip(k_mixed.iter()) {
+                            *v = m + beta * d.rate * *v;
+                        }
+                    }
+                }
+            }
             let Some(c) = self.tangent_factor else {
-                *response = element.respond(part.material(e), u).map_err(failure)?;
                 continue;
             };
-            let components = D * element.node_count();
-            let k = &mut k[..components * components];
-            *response = element
-                .respond_with_tangent(part.material(e), u, self.mixed.tangent(e), k)
-                .map_err(failure)?;
-            let scatter = &self.scatter[e];
             let (own, rest) = std::mem::take(&mut values).split_at_mut(scatter.entries.len());
             scatter.write(own, c, k);
             values = rest;
@@ -529,7 +634,7 @@ impl<const D: usize> ElementLoop<'_, D> {
     }
 
     /// [`Self::run`] on halves of the range, evaluated in parallel, until a part has at most
-    /// [`ELEMENTS_PER_TASK`] elements. Every element writes only its own response and slots,
+    /// [`ELEMENTS_PER_TASK`] elements. Every element writes only its own outputs and slots,
     /// so the results do not depend on the threads.
     ///
     /// # Errors
@@ -538,19 +643,32 @@ impl<const D: usize> ElementLoop<'_, D> {
     fn run_parallel(
         &self,
         first: usize,
-        responses: &mut [ElementResponse],
+        out: ElementOutputs<'_>,
         values: &mut [f64],
     ) -> Result<(), IncrementFailure> {
-        if responses.len() <= ELEMENTS_PER_TASK {
-            return self.run(first, responses, values);
+        if out.responses.len() <= ELEMENTS_PER_TASK {
+            return self.run(first, out, values);
         }
-        let middle = responses.len() / 2;
-        let (left, right) = responses.split_at_mut(middle);
+        let middle = out.responses.len() / 2;
+        let (left, right) = out.responses.split_at_mut(middle);
+        let (left_damping, right_damping) = out.damping.split_at_mut(middle);
         let split = self.scatter[first + middle].first_slot - self.scatter[first].first_slot;
         let (left_values, right_values) = values.split_at_mut(split);
         let (left, right) = rayon::join(
-            || self.run_parallel(first, left, left_values),
-            || self.run_parallel(first + middle, right, right_values),
+            || {
+                let out = ElementOutputs {
+                    responses: left,
+                    damping: left_damping,
+                };
+                self.run_parallel(first, out, left_values)
+            },
+            || {
+                let out = ElementOutputs {
+                    responses: right,
+                    damping: right_damping,
+                };
+                self.run_parallel(first + middle, out, right_values)
+            },
         );
         left.and(right)
     }
@@ -698,6 +816,128 @@ mod tests {
         // Ties: the plate equation collects the whole top face.
         let plate_eq = model.dofs().body_translation(0)[1].expect("plate y");
         assert!(k[(plate_eq, plate_eq)] > 0.0);
+    }
+
+    /// With stiffness damping `beta`, the force is `beta K v` and the tangent
+    /// `K + beta rate K`: the derivative of `f_int(x) + beta K(x) v(x)` with
+    /// `v(x) = rate (x - x0)` at `x0`, where `v = 0` and the left-out `beta (dK/dx) v`
+    /// vanishes.
+    fn damped_tangent_matches_finite_differences<const D: usize>() {
+        let (beta, rate) = (2e-4, 3.0e3);
+        let mut part = pad_block::<D>([0.0; 3], [0.03, 0.02, 0.01], [3, 2, 1]);
+        part.sections[0].stiffness_damping = beta;
+        let top = part.mesh.node_sets["ymax"].clone();
+        let mut free = [false; D];
+        free[1] = true;
+        let plate = body::<D>("plate", free, Rotation::None, 0.0, 0.0);
+        let tie = Tie {
+            body: 0,
+            nodes: top,
+        };
+        let model =
+            Model::new(part, vec![plate], vec![tie], Loads::default(), vec![]).expect("model");
+        let n = model.dofs().len();
+        let mut assembler = Assembler::new(&model).expect("assembler");
+        let x0 = DVector::from_fn(n, |i, _| {
+            1e-3 * ((i as f64 * 1.7).sin() + 0.3 * (i as f64).cos())
+        });
+        // the force: beta K v, K the undamped tangent
+        assembler
+            .internal(&model, &x0, Some(1.0))
+            .expect("internal");
+        let k = assembler.dense(n);
+        let v = DVector::from_fn(n, |i, _| (i as f64 * 0.9).cos());
+        let damping = Some(Damping { velocity: &v, rate });
+        let state = assembler
+            .internal_damped(&model, &x0, None, damping)
+            .expect("damped");
+        let expected = &k * &v * beta;
+        assert!(
+            (&state.damping_force - &expected).amax() < 1e-12 * expected.amax(),
+            "{D}D: damping force"
+        );
+        // the tangent
+        let zero = DVector::zeros(n);
+        let at_rest = Some(Damping {
+            velocity: &zero,
+            rate,
+        });
+        assembler
+            .internal_damped(&model, &x0, Some(1.0), at_rest)
+            .expect("damped tangent");
+        let kd = assembler.dense(n);
+        let eps = 1e-7;
+        let mut worst: f64 = 0.0;
+        for j in 0..n {
+            let column = central_difference(&x0, j, eps, |x| {
+                let v = (x - &x0) * rate;
+                let damping = Some(Damping { velocity: &v, rate });
+                let s = assembler
+                    .internal_damped(&model, x, None, damping)
+                    .expect("f");
+                s.force + s.damping_force
+            });
+            worst = worst.max((column - kd.column(j)).amax());
+        }
+        assert!(
+            worst < 1e-6 * kd.amax(),
+            "{D}D: worst {worst:e} vs {:e}",
+            kd.amax()
+        );
+        assert!((kd.amax() / k.amax() - (1.0 + beta * rate)).abs() < 1e-12);
+    }
+
+    /// Between Newton iterates an element's tangent may take its mixed pressure (see
+    /// [`crate::mixed`]); the damping then adds `beta rate` times the consistent tangent, as
+    /// its force takes the consistent one.
+    #[test]
+    fn damping_adds_the_consistent_tangent_to_a_mixed_one() {
+        let (beta, rate) = (2e-4, 3.0e3);
+        let mut part = pad_block::<2>([0.0; 3], [0.03, 0.02, 0.01], [3, 2, 1]);
+        part.sections[0].stiffness_damping = beta;
+        part.fixed = part.mesh.node_sets["ymin"]
+            .iter()
+            .flat_map(|&n| [(n, 0), (n, 1)])
+            .collect();
+        let model = Model::new(part, vec![], vec![], Loads::default(), vec![]).expect("model");
+        let n = model.dofs().len();
+        let x0 = DVector::zeros(n);
+        let x1 = DVector::from_fn(n, |i, _| 2e-3 * (i as f64 * 1.3).sin());
+        let mut mixed = Assembler::new(&model).expect("assembler");
+        mixed.start_mixed_pressures(&model, &x0).expect("start");
+        mixed.advance_mixed_pressures(&model, &(&x1 - &x0));
+        mixed.internal(&model, &x1, Some(1.0)).expect("mixed");
+        let k_mixed = mixed.dense(n);
+        let zero = DVector::zeros(n);
+        let at_rest = Some(Damping {
+            velocity: &zero,
+            rate,
+        });
+        mixed
+            .internal_damped(&model, &x1, Some(1.0), at_rest)
+            .expect("damped");
+        let k_damped = mixed.dense(n);
+        let mut consistent = Assembler::new(&model).expect("assembler");
+        consistent
+            .internal(&model, &x1, Some(1.0))
+            .expect("consistent");
+        let k_consistent = consistent.dense(n);
+        assert!(
+            (&k_mixed - &k_consistent).amax() > 1e-6 * k_consistent.amax(),
+            "the mixed tangent differs from the consistent one here"
+        );
+        let expected = &k_mixed + &k_consistent * (beta * rate);
+        assert!((&k_damped - &expected).amax() < 1e-12 * expected.amax());
+    }
+
+    #[test]
+    fn damped_tangent_matches_finite_differences_2d() {
+        damped_tangent_matches_finite_differences::<2>();
+    }
+
+    #[test]
+    fn damped_tangent_matches_finite_differences_3d() {
+        damped_tangent_matches_finite_differences::<3>();
     }
 
     #[test]

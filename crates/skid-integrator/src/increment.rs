@@ -33,6 +33,11 @@
 //! without one) until it can be factorized (see [`Assembler::with_mass_shift`]), which again
 //! changes only Newton's path.
 //!
+//! Stiffness damping (a section's `beta`, see [`crate::assembly::Damping`]) is part of `F` in
+//! a dynamic increment, `F = f_int + beta K_T (x - x_n)/h - f_ext`, weighted and stored as the
+//! other forces (so HHT's history term carries it), its tangent `(1 + beta/h) K_T` in place of
+//! `K_T`; its work by the trapezoidal rule is the ledger's damping dissipation.
+//!
 //! Quasi-static equations (a solid declared without inertia, [`crate::model::SolidPart`]) are
 //! in equilibrium at the end of each dynamic increment with the mean contact force
 //! `p = 2 beta r` that the bodies with inertia receive as an impulse (see [`crate::hht`]):
@@ -53,7 +58,7 @@ use std::time::{Duration, Instant};
 use nalgebra::{DVector, Vector2};
 use skid_contact::SurfacePoint;
 
-use crate::assembly::{Assembler, InternalState, external_forces};
+use crate::assembly::{Assembler, Damping, InternalState, external_forces};
 use crate::contact_rows::{ContactRows, RowStart, contact_rows};
 use crate::cost::{SolveCounts, Timings};
 use crate::coupling::contact_step;
@@ -309,6 +314,12 @@ fn solve_increment_with<const D: usize>(
         }
         _ => (m_factor, m_factor),
     };
+    // the sections' stiffness damping acts in a dynamic increment, on the iterate's mean
+    // velocity over it (see `Damping`)
+    let damping_rate = match kind {
+        IncrementKind::Dynamic { h, .. } if model.has_stiffness_damping() => Some(1.0 / h),
+        _ => None,
+    };
     let mut x = match kind {
         IncrementKind::Static { .. } => start.x.clone(),
         IncrementKind::Dynamic { hht, h, .. } => hht.predict(h, &start.x, &start.v),
@@ -374,26 +385,31 @@ fn solve_increment_with<const D: usize>(
         let check = last.is_some();
         let tangent_now =
             !check || (method == ContactSolve::Global && counters.newton_iterations == 1);
-        let internal = match assembler.internal(model, &x, tangent_now.then_some(k_factor)) {
-            Ok(internal) => internal,
-            // A full Newton step that folds an element overshoots; half of it may not. The
-            // iterate stays a Newton iterate (the next step starts from it, and convergence
-            // is still judged by the residuals), so only the path changes.
-            Err(IncrementFailure::InvertedElement { .. })
-                if halvings < MAX_STEP_HALVINGS && last_step.is_some() =>
-            {
-                if let Some(step) = last_step.as_mut() {
-                    *step *= 0.5;
-                    x -= &*step;
-                    assembler.advance_mixed_pressures(model, step);
+        let mean_velocity = damping_rate.map(|rate| (&x - &start.x) * rate);
+        let damping = damping_rate
+            .zip(mean_velocity.as_ref())
+            .map(|(rate, velocity)| Damping { velocity, rate });
+        let internal =
+            match assembler.internal_damped(model, &x, tangent_now.then_some(k_factor), damping) {
+                Ok(internal) => internal,
+                // A full Newton step that folds an element overshoots; half of it may not. The
+                // iterate stays a Newton iterate (the next step starts from it, and convergence
+                // is still judged by the residuals), so only the path changes.
+                Err(IncrementFailure::InvertedElement { .. })
+                    if halvings < MAX_STEP_HALVINGS && last_step.is_some() =>
+                {
+                    if let Some(step) = last_step.as_mut() {
+                        *step *= 0.5;
+                        x -= &*step;
+                        assembler.advance_mixed_pressures(model, step);
+                    }
+                    halvings += 1;
+                    continue;
                 }
-                halvings += 1;
-                continue;
-            }
-            Err(failure) => return Err(failure),
-        };
+                Err(failure) => return Err(failure),
+            };
         let f_ext = external_forces(model, &x, &start.orientations, kind.loads())?;
-        let net = &internal.force - &f_ext;
+        let net = &internal.force + &internal.damping_force - &f_ext;
         let mut inertia = mass.component_mul(&a);
         if let IncrementKind::Dynamic { hht, .. } = kind
             && let (Some(end), Some(begin)) = (model.gyroscopic_moments(&v), &start_gyroscopic)
@@ -470,6 +486,7 @@ fn solve_increment_with<const D: usize>(
                 &full,
                 &[
                     &internal.force,
+                    &internal.damping_force,
                     &f_ext,
                     &start.external_force,
                     &inertia,
@@ -592,7 +609,10 @@ fn solve_increment_with<const D: usize>(
         let clock = Instant::now();
         if !chord {
             if !tangent_now {
-                assembler.internal(model, &x, Some(k_factor))?;
+                let damping = damping_rate
+                    .zip(mean_velocity.as_ref())
+                    .map(|(rate, velocity)| Damping { velocity, rate });
+                assembler.internal_damped(model, &x, Some(k_factor), damping)?;
             }
             if matches!(kind, IncrementKind::Static { .. }) && counters.newton_iterations == 0 {
                 assembler.hold(held);
@@ -1004,6 +1024,12 @@ fn finish<const D: usize>(
             )
         }
     };
+    // the viscous forces' work by the trapezoidal rule, as the algorithmic dissipation takes
+    // them among the smooth forces
+    let damping = match start.damping_force.len() {
+        0 => 0.5 * internal.damping_force.dot(&dx),
+        _ => 0.5 * (&start.damping_force + &internal.damping_force).dot(&dx),
+    };
     let energy = EnergyLedger {
         kinetic: 0.5 * v.component_mul(&v).dot(model.mass()),
         strain: internal.strain_energy,
@@ -1013,6 +1039,7 @@ fn finish<const D: usize>(
         friction_dissipation: start.energy.friction_dissipation + friction,
         normal_work: start.energy.normal_work + normal_work,
         algorithmic_dissipation: start.energy.algorithmic_dissipation + algorithmic,
+        damping_dissipation: start.energy.damping_dissipation + damping,
     };
     let orientations = model.record_orientations(&start.orientations, &x);
     State {
@@ -1025,6 +1052,7 @@ fn finish<const D: usize>(
         v,
         a,
         net_force: net,
+        damping_force: internal.damping_force,
         external_force: f_ext,
         contacts,
         warm_forces,

@@ -27,6 +27,10 @@ pub struct Section {
     pub material: Box<dyn Hyperelastic>,
     /// Mass density, kg/m^3.
     pub density: f64,
+    /// Stiffness-proportional (Rayleigh) damping factor `beta`, s: in a dynamic step the
+    /// elements add the viscous force `beta K_T(x) v` (see [`crate::assembly::Damping`]);
+    /// 0 for none.
+    pub stiffness_damping: f64,
 }
 
 /// The deformable solid: mesh, materials and section data.
@@ -192,6 +196,17 @@ impl<const D: usize> Model<D> {
             return invalid(format!(
                 "{formulations} element formulations for {} elements",
                 part.mesh.elements.len()
+            ));
+        }
+        if let Some((k, section)) = part
+            .sections
+            .iter()
+            .enumerate()
+            .find(|(_, s)| !(s.stiffness_damping.is_finite() && s.stiffness_damping >= 0.0))
+        {
+            return invalid(format!(
+                "section {k}: stiffness damping must be >= 0, got {}",
+                section.stiffness_damping
             ));
         }
         if !(part.thickness.is_finite() && part.thickness > 0.0) {
@@ -612,6 +627,11 @@ impl<const D: usize> Model<D> {
             }
         }
         p
+    }
+
+    /// Whether a section of the solid has stiffness damping ([`Section::stiffness_damping`]).
+    pub fn has_stiffness_damping(&self) -> bool {
+        self.part.sections.iter().any(|s| s.stiffness_damping > 0.0)
     }
 
     /// The deformable solid.

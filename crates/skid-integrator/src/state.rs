@@ -61,6 +61,10 @@ pub struct EnergyLedger {
     /// equilibrium of quasi-static solids, see [`crate::hht::Hht::algorithmic_dissipation`]).
     #[serde(default)]
     pub algorithmic_dissipation: f64,
+    /// Energy dissipated by the sections' stiffness damping, `sum (D_n + D_{n+1})/2 . dx` over
+    /// the dynamic increments (`D` the viscous forces, see [`crate::assembly::Damping`]).
+    #[serde(default)]
+    pub damping_dissipation: f64,
 }
 
 impl EnergyLedger {
@@ -70,15 +74,16 @@ impl EnergyLedger {
     }
 
     /// Energy lost unaccounted for since the ledger `start`, J (positive when lost):
-    /// `-(dE - dW_ext - dW_R - dW_N + dD_friction + dD_algorithmic)`, `E` the mechanical
-    /// energy.
+    /// `-(dE - dW_ext - dW_R - dW_N + dD_friction + dD_algorithmic + dD_damping)`, `E` the
+    /// mechanical energy.
     pub fn unaccounted_since(&self, start: &Self) -> f64 {
         -((self.mechanical() - start.mechanical())
             - (self.external_work - start.external_work)
             - (self.reaction_work - start.reaction_work)
             - (self.normal_work - start.normal_work)
             + (self.friction_dissipation - start.friction_dissipation)
-            + (self.algorithmic_dissipation - start.algorithmic_dissipation))
+            + (self.algorithmic_dissipation - start.algorithmic_dissipation)
+            + (self.damping_dissipation - start.damping_dissipation))
     }
 }
 
@@ -97,8 +102,12 @@ pub struct State {
     pub v: DVector<f64>,
     /// Accelerations per equation.
     pub a: DVector<f64>,
-    /// `f_int - f_ext` at `x` (the history term of HHT).
+    /// `f_int + f_d - f_ext` at `x` (the history term of HHT), `f_d` the damping force.
     pub net_force: DVector<f64>,
+    /// The sections' stiffness damping force `f_d` at the end of the increment (zero after a
+    /// static one; empty in a state written before it was kept, which had none).
+    #[serde(default)]
+    pub damping_force: DVector<f64>,
     /// External forces at `x` (for the work integral).
     pub external_force: DVector<f64>,
     /// Generalized contact forces `H^T r` per equation (forces on nodes and bodies; the

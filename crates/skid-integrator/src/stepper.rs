@@ -651,6 +651,7 @@ pub fn initial_state<const D: usize>(
         v,
         a: DVector::zeros(n),
         net_force: -&f_ext,
+        damping_force: DVector::zeros(n),
         contact_reaction: DVector::zeros(n),
         reaction: DVector::zeros(n),
         external_force: f_ext,

@@ -30,6 +30,7 @@ pub(crate) fn pad_block<const D: usize>(
         sections: vec![Section {
             material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 0.145e-6).expect("material")),
             density: 1000.0,
+            stiffness_damping: 0.0,
         }],
         element_sections: Vec::new(),
         thickness: 0.1,

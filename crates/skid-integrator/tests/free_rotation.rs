@@ -56,6 +56,7 @@ fn top_with(loads: Loads<3>, axes: Rotation3<f64>) -> Model<3> {
         sections: vec![Section {
             material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, 1e-7).expect("material")),
             density: 1000.0,
+            stiffness_damping: 0.0,
         }],
         element_sections: Vec::new(),
         thickness: 1.0,

@@ -44,6 +44,7 @@ fn tip_deflection(k_over_mu: f64) -> f64 {
         sections: vec![Section {
             material: Box::new(material),
             density: 1000.0,
+            stiffness_damping: 0.0,
         }],
         element_sections: Vec::new(),
         thickness: THICKNESS,

@@ -167,6 +167,7 @@ fn roller_block<const D: usize>(n: usize, loading: Loading, formulation: Formula
         sections: vec![Section {
             material: Box::new(material()),
             density: DENSITY,
+            stiffness_damping: 0.0,
         }],
         element_sections: Vec::new(),
         thickness: 1.0,

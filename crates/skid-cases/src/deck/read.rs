@@ -56,6 +56,8 @@ pub struct MaterialDef {
     pub law: Option<MaterialSpec>,
     /// Mass density.
     pub density: Option<f64>,
+    /// `*DAMPING, BETA`: the stiffness-proportional damping factor.
+    pub stiffness_damping: Option<f64>,
 }
 
 /// Kinds of section.
@@ -341,7 +343,7 @@ fn read_model_block(
             insert_named(&mut defs.materials, block, name, MaterialDef::default())?;
             next = Context::Material(key(name));
         }
-        "HYPERELASTIC" | "ELASTIC" | "DENSITY" => {
+        "HYPERELASTIC" | "ELASTIC" | "DENSITY" | "DAMPING" => {
             let material = sub("MATERIAL")?;
             let value = read_material_option(block)?;
             let def = defs
@@ -352,6 +354,9 @@ fn read_model_block(
             match value {
                 MaterialOption::Law(law) if def.law.is_none() => def.law = Some(law),
                 MaterialOption::Density(rho) if def.density.is_none() => def.density = Some(rho),
+                MaterialOption::Damping(beta) if def.stiffness_damping.is_none() => {
+                    def.stiffness_damping = Some(beta)
+                }
                 _ => return Err(block.error("given twice for this material")),
             }
             next = context.clone();
@@ -488,13 +493,31 @@ fn insert_named<T>(
 enum MaterialOption {
     Law(MaterialSpec),
     Density(f64),
+    Damping(f64),
 }
 
 /// `*HYPERELASTIC` (`POLYNOMIAL, N=1` or `MOONEY-RIVLIN`: `C10, C01, D1`; `NEO HOOKE`:
 /// `C10, D1`), `*ELASTIC` (`E, nu`, read as the compressible neo-Hookean solid with the same
 /// small-strain shear and bulk moduli: `C10 = E / (4 (1 + nu))`, `C01 = 0`,
-/// `D1 = 6 (1 - 2 nu) / E`), `*DENSITY` (`rho`).
+/// `D1 = 6 (1 - 2 nu) / E`), `*DENSITY` (`rho`), `*DAMPING, BETA=beta` (stiffness-proportional
+/// Rayleigh damping; no data line).
 fn read_material_option(block: &Block) -> Result<MaterialOption, DeckError> {
+    if block.name == "DAMPING" {
+        allow_parameters(block, &["ALPHA", "BETA"])?;
+        no_data(block)?;
+        if valued(block, "ALPHA")?.is_some() {
+            return Err(block.error(
+                "ALPHA (mass-proportional damping, which also damps rigid motion) is not \
+                 read: give BETA, the stiffness-proportional factor",
+            ));
+        }
+        let beta = valued(block, "BETA")?
+            .ok_or_else(|| block.error("give BETA, the stiffness-proportional factor (s)"))?;
+        return match beta.trim().parse::<f64>() {
+            Ok(b) if b.is_finite() && b >= 0.0 => Ok(MaterialOption::Damping(b)),
+            _ => Err(block.error(format!("BETA={beta}: expected a number >= 0 (s)"))),
+        };
+    }
     let [line] = block.data.as_slice() else {
         return Err(block.error("expected one data line"));
     };
@@ -1213,6 +1236,7 @@ fn is_model_keyword(name: &str) -> bool {
             | "HYPERELASTIC"
             | "ELASTIC"
             | "DENSITY"
+            | "DAMPING"
             | "SOLID SECTION"
             | "MEMBRANE SECTION"
             | "SHELL SECTION"

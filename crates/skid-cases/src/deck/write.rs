@@ -188,12 +188,13 @@ pub fn write_deck(
         part.name.as_str(),
         &part.section.material,
         part.section.density,
+        part.section.stiffness_damping,
     )];
-    let others = part
-        .materials
-        .iter()
-        .map(|m| (m.element_set.as_str(), &m.material, m.density));
-    for (elset, law, density) in own.into_iter().chain(others) {
+    let others = part.materials.iter().map(|m| {
+        let set = m.element_set.as_str();
+        (set, &m.material, m.density, m.stiffness_damping)
+    });
+    for (elset, law, density, beta) in own.into_iter().chain(others) {
         let material = format!("{elset}-material");
         let _ = writeln!(out, "*SOLID SECTION, ELSET={elset}, MATERIAL={material}");
         if dim == 2 {
@@ -212,6 +213,9 @@ pub fn write_deck(
             }
         }
         let _ = writeln!(out, "*DENSITY\n{}", num(density));
+        if beta != 0.0 {
+            let _ = writeln!(out, "*DAMPING, BETA={}", num(beta));
+        }
     }
 
     // rigid bodies

@@ -371,9 +371,14 @@ fn material(field: &str, spec: &MaterialSpec) -> Result<Box<dyn Hyperelastic>, S
 fn sections(spec: &ModelSpec, elements: usize) -> Result<(Vec<Section>, Vec<usize>), SpecError> {
     let part = &spec.part;
     positive("part.section.density", part.section.density)?;
+    non_negative(
+        "part.section.stiffness_damping",
+        part.section.stiffness_damping,
+    )?;
     let mut sections = vec![Section {
         material: material("part.section.material", &part.section.material)?,
         density: part.section.density,
+        stiffness_damping: part.section.stiffness_damping,
     }];
     let mut of_element = vec![0; elements];
     for (i, set) in part.materials.iter().enumerate() {
@@ -389,9 +394,11 @@ fn sections(spec: &ModelSpec, elements: usize) -> Result<(Vec<Section>, Vec<usiz
                 ),
             })?;
         positive(&f("density"), set.density)?;
+        non_negative(&f("stiffness_damping"), set.stiffness_damping)?;
         sections.push(Section {
             material: material(&f("material"), &set.material)?,
             density: set.density,
+            stiffness_damping: set.stiffness_damping,
         });
         for &e in members {
             if of_element[e] != 0 {

@@ -16,7 +16,8 @@
 //! the model's `boundary`, the sum of its nodes' reactions, `S.reaction_x` (likewise `y`, `z`;
 //! N); then `kinetic_energy`, `strain_energy`, `hourglass_energy`,
 //! `external_work`, `friction_dissipation`, `normal_work`, `algorithmic_dissipation` and, if the
-//! model prescribes motions, `reaction_work` (J). Numbers carry 10 significant digits. The file
+//! model prescribes motions, `reaction_work`, and if a section has stiffness damping,
+//! `damping_dissipation` (J). Numbers carry 10 significant digits. The file
 //! is complete or absent ([`PartialCsv`]).
 
 use std::collections::HashMap;
@@ -137,6 +138,9 @@ pub fn columns<const D: usize>(model: &Model<D>, reactions: &ReactionColumns) ->
     );
     if !model.prescribed().is_empty() {
         names.push("reaction_work".into());
+    }
+    if model.has_stiffness_damping() {
+        names.push("damping_dissipation".into());
     }
     names
 }
@@ -367,6 +371,9 @@ impl<const D: usize> Observer<D> for ModelRecorder {
         if !model.prescribed().is_empty() {
             row.push(number(e.reaction_work));
         }
+        if model.has_stiffness_damping() {
+            row.push(number(e.damping_dissipation));
+        }
         self.csv.record(row)?;
         record.energy_scale = [
             e.kinetic + e.strain + e.hourglass,
@@ -375,6 +382,7 @@ impl<const D: usize> Observer<D> for ModelRecorder {
             e.friction_dissipation,
             e.algorithmic_dissipation.abs(),
             e.reaction_work.abs(),
+            e.damping_dissipation,
         ]
         .into_iter()
         .fold(record.energy_scale, f64::max);

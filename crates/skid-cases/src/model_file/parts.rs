@@ -114,11 +114,15 @@ fn append(merged: &mut PartSpec, part: PartSpec, field: &str) -> Result<(), Spec
     insert_all(&mut merged.node_sets, node_sets, field, "node set")?;
     insert_all(&mut merged.surfaces, surfaces, field, "surface")?;
     insert_all(&mut merged.element_sets, element_sets, field, "element set")?;
-    if own.material != base.material || own.density != base.density {
+    if own.material != base.material
+        || own.density != base.density
+        || own.stiffness_damping != base.stiffness_damping
+    {
         merged.materials.push(SetMaterialSpec {
             element_set: name.clone(),
             material: own.material.clone(),
             density: own.density,
+            stiffness_damping: own.stiffness_damping,
         });
     }
     merged

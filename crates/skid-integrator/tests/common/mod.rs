@@ -44,6 +44,7 @@ pub fn block_part(
         sections: vec![Section {
             material: Box::new(PolynomialN1::new(0.552e6, 0.138e6, d1).expect("material")),
             density: 1000.0,
+            stiffness_damping: 0.0,
         }],
         element_sections: Vec::new(),
         thickness,

@@ -112,13 +112,17 @@ pub(super) fn part_spec(
             format!("element {e} has no section: no *SOLID SECTION's ELSET holds it"),
         ));
     }
-    let (law, density, thickness) = read[0].clone();
+    let SectionProperties {
+        law,
+        density,
+        thickness,
+        stiffness_damping,
+    } = read[0].clone();
     let mut element_sets = BTreeMap::new();
     let mut materials = Vec::new();
-    for (k, (section, (law_k, density_k, thickness_k))) in
-        solid_sections.iter().zip(&read).enumerate().skip(1)
-    {
-        if *thickness_k != thickness {
+    for (k, (section, properties)) in solid_sections.iter().zip(&read).enumerate().skip(1) {
+        let thickness_k = properties.thickness;
+        if thickness_k != thickness {
             return Err(error(
                 &section.location,
                 format!(
@@ -134,8 +138,9 @@ pub(super) fn part_spec(
         element_sets.insert(section.elset.clone(), members);
         materials.push(SetMaterialSpec {
             element_set: section.elset.clone(),
-            material: law_k.clone(),
-            density: *density_k,
+            material: properties.law.clone(),
+            density: properties.density,
+            stiffness_damping: properties.stiffness_damping,
         });
     }
     let mut nodes = vec![Vec::new(); part.number.len()];
@@ -193,6 +198,7 @@ pub(super) fn part_spec(
         section: SectionSpec {
             material: law,
             density,
+            stiffness_damping,
             thickness,
             hourglass_scale: 1.0,
             quasi_static: false,
@@ -201,12 +207,22 @@ pub(super) fn part_spec(
     })
 }
 
-/// The material law, density and thickness of a `*SOLID SECTION` of a part of dimension `dim`.
+/// What a `*SOLID SECTION` and its `*MATERIAL` give a part.
+#[derive(Clone, Debug)]
+struct SectionProperties {
+    law: MaterialSpec,
+    density: f64,
+    thickness: f64,
+    /// `*DAMPING, BETA` (0 without).
+    stiffness_damping: f64,
+}
+
+/// The properties of a `*SOLID SECTION` of a part of dimension `dim`.
 fn section_properties(
     defs: &Definitions,
     dim: usize,
     section: &SectionDef,
-) -> Result<(MaterialSpec, f64, f64), DeckError> {
+) -> Result<SectionProperties, DeckError> {
     let material = defs.materials.get(&key(&section.material)).ok_or_else(|| {
         error(
             &section.location,
@@ -238,7 +254,12 @@ fn section_properties(
         }
         _ => 1.0,
     };
-    Ok((law, density, thickness))
+    Ok(SectionProperties {
+        law,
+        density,
+        thickness,
+        stiffness_damping: material.value.stiffness_damping.unwrap_or(0.0),
+    })
 }
 
 /// Faces of solid elements as part node numbers, outward.
