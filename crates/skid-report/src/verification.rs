@@ -23,8 +23,13 @@
 //! - Cook's membrane ([`cook`]), one run per element formulation and mesh: a table of the
 //!   loaded edge's deflection against the reference, checks that the locking-free elements
 //!   converge to it and that the displacement element locks where the material is nearly
-//!   incompressible.
+//!   incompressible;
+//! - a neo-Hookean block on rollers compressed homogeneously ([`compression`]), one run per
+//!   element formulation: its reaction and lateral stretch against the closed form in every
+//!   increment, to 50 % compression (the incompatible-mode elements as far as they carry, a
+//!   known gap), and its Newton iterations per increment.
 
+pub mod compression;
 pub mod cook;
 pub mod coulomb;
 pub mod free_rotation;
@@ -40,6 +45,7 @@ use super::format::{Checks, Counts, Sig, percent};
 use super::hertz::{self, HertzMeasure, HertzScene};
 use super::plot::{HERTZ_SVG, plot_hertz_pressure};
 use super::{ReportError, read};
+use compression::CompressionScene;
 use cook::CookScene;
 use free_rotation::FreeBody;
 use rolling::RollingBall;
@@ -60,6 +66,9 @@ pub struct SceneSummary {
     pub error: Option<String>,
     /// Wall time of the run, s.
     pub wall_time_s: f64,
+    /// Increments cut back after a failed attempt.
+    #[serde(default)]
+    pub cutbacks: usize,
 }
 
 /// One run of a verification scene.
@@ -185,6 +194,7 @@ pub fn section(
     let mut free_runs = Vec::new();
     let mut ball_runs = Vec::new();
     let mut cook_runs = Vec::new();
+    let mut compression_runs = Vec::new();
     for run in runs {
         if let Some(scene) = HertzScene::recognise(&run.spec) {
             hertz_runs.push((run, scene));
@@ -196,6 +206,8 @@ pub fn section(
             free_runs.push((run, body));
         } else if let Some(membrane) = CookScene::recognise(&run.spec) {
             cook_runs.push((run, membrane));
+        } else if let Some(block) = CompressionScene::recognise(&run.spec) {
+            compression_runs.push((run, block));
         } else {
             unchecked.push(run.name.as_str());
         }
@@ -216,6 +228,9 @@ pub fn section(
     }
     if !cook_runs.is_empty() {
         out.push_str(&cook::section(&cook_runs, &mut checks)?);
+    }
+    if !compression_runs.is_empty() {
+        out.push_str(&compression::section(&compression_runs, &mut checks)?);
     }
     for name in unchecked {
         checks.skip(

@@ -499,6 +499,29 @@ mod tests {
     }
 
     #[test]
+    fn the_shipped_scenes_are_recognised_with_their_tip() {
+        let read = |name: &str| {
+            let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../cases/verification")
+                .join(name);
+            skid_cases::deck::read_model(&path).expect("deck").model
+        };
+        let mut spec = read("2d-cook-incompressible-cpe4h-n8.inp");
+        let s = CookScene::recognise(&spec).expect("a Cook scene");
+        assert_eq!((s.element, s.elements, s.per_edge()), ("CPE4H", 64, 8));
+        // the tip (48, 52) is node (8, 4): 4 (8 + 1) + 8
+        assert_eq!(s.column, "tip.44.u_y");
+        assert!((s.load - 250.0 * 1e-4).abs() < 1e-12, "{}", s.load);
+        assert!((s.young / 250.0 - 1.0).abs() < 1e-9 && (s.poisson - 0.4999).abs() < 1e-9);
+        spec.output.history_nodes.clear();
+        assert_eq!(CookScene::recognise(&spec), None);
+        assert_eq!(
+            CookScene::recognise(&read("2d-compression-uniaxial-cpe4.inp")),
+            None
+        );
+    }
+
+    #[test]
     fn the_tip_displacement_is_the_last_rows() {
         let text = "time,step,tip.40.u_x,tip.40.u_y\n0,s,0,0\n1,s,1e-3,2.5e-3\n";
         let path = Path::new("history.csv");
