@@ -66,7 +66,11 @@
 //! - `*OUTPUT, FIELD` with `TIME INTERVAL=t` or `NUMBER INTERVAL=n` (the step's period over n)
 //!   turns on the field output ([`crate::fields`]) with one interval for the whole run, the
 //!   smallest of the dynamic steps' requests (of the static steps' if only they ask); a
-//!   request without either (`FREQUENCY`) writes none, with a note.
+//!   request without either (`FREQUENCY`) writes none, with a note;
+//! - `*NODE OUTPUT, NSET=S` under `*OUTPUT, HISTORY` asking for `U` (or `U1`..`U3`) in any
+//!   step writes the displacements of the nodes of `S` to `history.csv` in every increment of
+//!   the run (`output.history_nodes`); other output requests are noted (skid writes the
+//!   history it always writes).
 
 pub mod assemble;
 pub mod fields;

@@ -259,7 +259,7 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
         }],
         steps,
         solver: case.solver.clone(),
-        output: case.output.clone(),
+        output: case.output.clone().into(),
     })
 }
 

@@ -89,7 +89,32 @@ pub struct ModelSpec {
     pub solver: SolverSpec,
     /// Output settings; every field is optional.
     #[serde(default)]
-    pub output: OutputSpec,
+    pub output: ModelOutputSpec,
+}
+
+/// Output settings of a model; every field is optional.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, JsonSchema, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct ModelOutputSpec {
+    /// Physical time between ParaView field frames in dynamic steps, s (written to
+    /// `<out>/fields/`); frames are also written for the initial state, at the end of every
+    /// static step and at the end of the run. Absent or null: no field output.
+    pub field_interval: Option<f64>,
+    /// Node sets of the part whose nodes' displacements go into `history.csv` in every
+    /// increment: for each set `S`, in this order, and each of its nodes `n` (node number), in
+    /// the set's order, the columns `S.n.u_x`, `S.n.u_y` (and `S.n.u_z` in 3D), m.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub history_nodes: Vec<String>,
+}
+
+impl From<OutputSpec> for ModelOutputSpec {
+    /// A case file's output settings: its field interval, no node history.
+    fn from(output: OutputSpec) -> Self {
+        Self {
+            field_interval: output.field_interval,
+            history_nodes: Vec::new(),
+        }
+    }
 }
 
 /// The deformable part: a mesh of one-point elements with one section.

@@ -29,7 +29,7 @@ use crate::fields::{self, FieldMemory, FieldWriter};
 use crate::fingerprint::Fnv1a;
 use crate::history::{DrumRecorder, SAMPLES_JOURNAL, SampleJournal};
 use crate::model_file::contact_nodes;
-use crate::model_file::history::{ModelRecorder, ReactionColumns};
+use crate::model_file::history::{ModelRecorder, NodeColumns, ReactionColumns};
 use crate::model_file::summary::{ModelSummary, summarize as summarize_model};
 use crate::model_file::{self};
 use crate::model_spec::{ModelSpec, declares_model};
@@ -533,14 +533,16 @@ fn run_model_in<const D: usize>(
 ) -> Result<ModelSummary, CaseError> {
     let scene = model_scene::<D>(spec, source)?;
     let reactions = ReactionColumns::new(spec, &scene.model);
+    let nodes = NodeColumns::new::<D>(spec);
     let history_path = dir.join(model_file::history::HISTORY_CSV);
     let fields_dir = dir.join(fields::FIELDS_DIR);
     let (mut history, mut newton, mut field_writer, input, checkpoint) = match start {
         Start::Fresh => {
             clear_outputs(dir)?;
             let input = write_input(dir, MODEL_JSON, model_file::to_json(spec))?;
-            let history = ModelRecorder::create(dir, &scene.model, reactions.clone())
-                .map_err(output(history_path.clone()))?;
+            let history =
+                ModelRecorder::create(dir, &scene.model, reactions.clone(), nodes.clone())
+                    .map_err(output(history_path.clone()))?;
             let newton = NewtonRecorder::create(dir).map_err(output(dir.join(NEWTON_CSV)))?;
             let fields = field_writer(dir, spec.output.field_interval, None)?;
             (history, newton, fields, input, None)
@@ -558,8 +560,9 @@ fn run_model_in<const D: usize>(
             let RecorderMemory::Model(record) = recorder else {
                 return Err(misfit(dir, "it holds a drum case's history, not a model's"));
             };
-            let history = ModelRecorder::reopen(dir, &history, *record, reactions.clone())
-                .map_err(reopen_error(dir, history_path.clone()))?;
+            let history =
+                ModelRecorder::reopen(dir, &history, *record, reactions.clone(), nodes.clone())
+                    .map_err(reopen_error(dir, history_path.clone()))?;
             let newton = NewtonRecorder::reopen(dir, &newton)
                 .map_err(reopen_error(dir, dir.join(NEWTON_CSV)))?;
             let fields = field_writer(

@@ -1075,6 +1075,65 @@ fn every_solid_element_type_reads_writes_and_solves_the_compression_on_rollers()
     }
 }
 
+/// `*NODE OUTPUT, NSET=S` asking for `U` under `*OUTPUT, HISTORY` puts the displacements of
+/// the nodes of `S` into the history (`output.history_nodes`); under `*OUTPUT, FIELD`, or
+/// without `U`, it is only noted; a set not defined is an error at the request; the deck
+/// writer writes the request back.
+#[test]
+fn node_output_under_history_output_writes_the_nodes_displacements() {
+    let end = "*END STEP\n";
+    let with = |request: &str| {
+        let text = roller_deck("CPE4R").replace(end, &format!("{request}{end}"));
+        (read_text(&text), text)
+    };
+    let (asked, text) = with("*OUTPUT, HISTORY\n*NODE OUTPUT, NSET=top\nU, RF\n");
+    let model = asked.expect("deck").model;
+    assert_eq!(model.output.history_nodes, ["top"]);
+    let written = skid_cases::deck::write::write_deck(&model, &Default::default()).expect("writes");
+    let reread = read_text(&written).expect("reads back").model;
+    assert_eq!(reread.output.history_nodes, ["top"]);
+    for request in [
+        "*OUTPUT, FIELD, NUMBER INTERVAL=1\n*NODE OUTPUT, NSET=top\nU\n",
+        "*OUTPUT, HISTORY\n*NODE OUTPUT, NSET=top\nRF\n",
+    ] {
+        let deck = with(request).0.expect("deck");
+        assert!(deck.model.output.history_nodes.is_empty(), "{request}");
+        assert!(
+            deck.notes.iter().any(|n| n.contains("*NODE OUTPUT")),
+            "{:?}",
+            deck.notes
+        );
+    }
+    let err = with("*OUTPUT, HISTORY\n*NODE OUTPUT, NSET=nowhere\nU\n")
+        .0
+        .expect_err("no such set");
+    assert!(
+        err.contains("NSET=nowhere: no node set") && err.contains("scene.inp:"),
+        "{err}"
+    );
+
+    // the top nodes (labels 7, 8, 9: nodes 6, 7, 8) end moved down by 0.01
+    let dir = tempfile::tempdir().expect("tempdir");
+    let deck = dir.path().join("rollers.inp");
+    std::fs::write(&deck, &text).expect("write deck");
+    let out = dir.path().join("run");
+    run_file(&deck, &[], Some(&out), DEFAULT_RESTART_EVERY).expect("runs");
+    let (header, rows) = history(&out);
+    let last = rows.last().expect("rows");
+    for node in 6..9 {
+        for (axis, expected) in [("x", None), ("y", Some(-0.01))] {
+            let name = format!("top.{node}.u_{axis}");
+            let column = header.iter().position(|h| *h == name).expect(&name);
+            let u: f64 = last[column].parse().expect("a number");
+            match expected {
+                Some(v) => assert!((u - v).abs() < 1e-12, "{name} = {u}"),
+                // the block widens under compression, the far corner the most
+                None => assert!(u >= 0.0 && (node == 6 || u > 0.0), "{name} = {u}"),
+            }
+        }
+    }
+}
+
 /// Quads and hexahedra cannot share a deck's deformable part.
 #[test]
 fn quads_and_hexahedra_in_one_deck_are_refused_at_the_element() {

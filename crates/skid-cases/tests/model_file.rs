@@ -381,7 +381,13 @@ fn every_model_error_names_its_field() {
     )
     .expect("json");
     type Edit = fn(&mut Value);
-    let cases: [(&Value, Edit, &str, &str); 24] = [
+    let cases: [(&Value, Edit, &str, &str); 25] = [
+        (
+            &base,
+            |v| v["output"]["history_nodes"] = json!(["top", "nowhere"]),
+            "output.history_nodes[1]",
+            "no node set named 'nowhere'",
+        ),
         (
             &base,
             |v| v["skid_model"] = json!(2),

@@ -19,8 +19,18 @@
 //! - a torque-free rigid body ([`free_rotation`]): its angular momentum and kinetic energy are
 //!   constant, and a symmetric top precesses as Euler's equations say;
 //! - a ball launched onto a deformable block ([`rolling`]): it slides, then rolls at the speed
-//!   and from the time Coulomb friction and its inertia give.
+//!   and from the time Coulomb friction and its inertia give;
+//! - Cook's membrane ([`cook`]), one run per element formulation and mesh: a table of the
+//!   loaded edge's deflection against the reference, checks that the locking-free elements
+//!   converge to it and that the displacement element locks where the material is nearly
+//!   incompressible;
+//! - a neo-Hookean block on rollers compressed homogeneously ([`compression`]), one run per
+//!   element formulation: its reaction and lateral stretch against the closed form in every
+//!   increment, to 50 % compression (the incompatible-mode elements as far as they carry, a
+//!   known gap), and its Newton iterations per increment.
 
+pub mod compression;
+pub mod cook;
 pub mod coulomb;
 pub mod free_rotation;
 mod reactions;
@@ -35,6 +45,8 @@ use super::format::{Checks, Counts, Sig, percent};
 use super::hertz::{self, HertzMeasure, HertzScene};
 use super::plot::{HERTZ_SVG, plot_hertz_pressure};
 use super::{ReportError, read};
+use compression::CompressionScene;
+use cook::CookScene;
 use free_rotation::FreeBody;
 use rolling::RollingBall;
 use skid_cases::model_file::contact_nodes::CONTACT_NODES_CSV;
@@ -54,6 +66,9 @@ pub struct SceneSummary {
     pub error: Option<String>,
     /// Wall time of the run, s.
     pub wall_time_s: f64,
+    /// Increments cut back after a failed attempt.
+    #[serde(default)]
+    pub cutbacks: usize,
 }
 
 /// One run of a verification scene.
@@ -178,6 +193,8 @@ pub fn section(
     let mut coulomb_runs = Vec::new();
     let mut free_runs = Vec::new();
     let mut ball_runs = Vec::new();
+    let mut cook_runs = Vec::new();
+    let mut compression_runs = Vec::new();
     for run in runs {
         if let Some(scene) = HertzScene::recognise(&run.spec) {
             hertz_runs.push((run, scene));
@@ -187,6 +204,10 @@ pub fn section(
             coulomb_runs.push(run);
         } else if let Some(body) = FreeBody::recognise(&run.spec) {
             free_runs.push((run, body));
+        } else if let Some(membrane) = CookScene::recognise(&run.spec) {
+            cook_runs.push((run, membrane));
+        } else if let Some(block) = CompressionScene::recognise(&run.spec) {
+            compression_runs.push((run, block));
         } else {
             unchecked.push(run.name.as_str());
         }
@@ -204,6 +225,12 @@ pub fn section(
     }
     if !ball_runs.is_empty() {
         out.push_str(&rolling::section(&ball_runs, &mut checks)?);
+    }
+    if !cook_runs.is_empty() {
+        out.push_str(&cook::section(&cook_runs, &mut checks)?);
+    }
+    if !compression_runs.is_empty() {
+        out.push_str(&compression::section(&compression_runs, &mut checks)?);
     }
     for name in unchecked {
         checks.skip(

@@ -19,10 +19,10 @@ use super::read::{
 use super::rigid::{chain, prism, triangles};
 use crate::model_spec::{
     AutomaticIncrementsSpec, BoundarySpec, ContactPairSpec, Dof, ElementBlockSpec, ElementType,
-    LoadSpec, MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, NodeVelocitySpec, PartSpec,
-    RigidBodySpec, RigidSurfaceSpec, SectionSpec, SlaveSpec, StepBoundarySpec, TieSpec,
+    LoadSpec, MODEL_FORMAT_VERSION, ModelOutputSpec, ModelSpec, ModelStepSpec, NodeVelocitySpec,
+    PartSpec, RigidBodySpec, RigidSurfaceSpec, SectionSpec, SlaveSpec, StepBoundarySpec, TieSpec,
 };
-use crate::schema::{OutputSpec, SolverSpec, default_regularization_time};
+use crate::schema::{SolverSpec, default_regularization_time};
 
 mod bodies;
 mod carried;
@@ -262,8 +262,9 @@ pub fn assemble(defs: &Definitions, name: &str, deck: &Location) -> Result<Model
         contact,
         steps,
         solver: SolverSpec::default(),
-        output: OutputSpec {
+        output: ModelOutputSpec {
             field_interval: field_interval(&defs.steps),
+            history_nodes: history_nodes(defs, &part)?,
         },
     })
 }

@@ -205,6 +205,12 @@ pub struct StepDef {
     pub default_amplitude: Option<DefaultAmplitude>,
     /// The step's `*OUTPUT, FIELD` requests that give an interval.
     pub field_output: Vec<FieldRequest>,
+    /// Whether the step's latest `*OUTPUT` is `HISTORY`, so that a `*NODE OUTPUT` after it
+    /// asks for history output.
+    pub history_output: bool,
+    /// The node sets (`NSET=` as given, with the keyword line) of the step's `*NODE OUTPUT`
+    /// requests under `*OUTPUT, HISTORY` that ask for `U` or one of its components.
+    pub history_nodes: Vec<(String, Location)>,
 }
 
 /// When an `*OUTPUT, FIELD` request asks for frames: every `TIME INTERVAL`, or at `NUMBER
@@ -1000,6 +1006,8 @@ fn start_step(defs: &Definitions, block: &Block) -> Result<StepDef, DeckError> {
         nlgeom,
         default_amplitude,
         field_output: Vec::new(),
+        history_output: false,
+        history_nodes: Vec::new(),
     })
 }
 
@@ -1153,6 +1161,7 @@ fn read_step_block(
                 ],
             )?;
             no_data(block)?;
+            step.history_output = flag(block, "HISTORY")?;
             if flag(block, "FIELD")? {
                 match field_request(block)? {
                     Some(request) => step.field_output.push(request),
@@ -1180,11 +1189,24 @@ fn read_step_block(
                     ));
                 }
             }
-            defs.notes.push(format!(
-                "{}: *{}: skid writes every body's motion, every contact pair's resultants and the \
-                 energies to history.csv in every increment, whatever is requested",
-                block.location, block.name
-            ));
+            let displacement = block.data.iter().flat_map(|line| &line.fields).any(|f| {
+                ["U", "U1", "U2", "U3"]
+                    .iter()
+                    .any(|u| f.eq_ignore_ascii_case(u))
+            });
+            match valued(block, "NSET")? {
+                Some(set) if block.name == "NODE OUTPUT" && step.history_output && displacement => {
+                    step.history_nodes
+                        .push((set.to_string(), block.location.clone()));
+                }
+                _ => defs.notes.push(format!(
+                    "{}: *{}: skid writes every body's motion, every contact pair's resultants \
+                     and the energies to history.csv in every increment, whatever is \
+                     requested, and the displacements of the nodes of the sets that a *NODE \
+                     OUTPUT, NSET= under *OUTPUT, HISTORY asks U of",
+                    block.location, block.name
+                )),
+            }
         }
         "STEP" => return Err(block.error("a step cannot start inside another (missing *END STEP)")),
         other if is_model_keyword(other) => {

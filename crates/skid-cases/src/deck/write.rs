@@ -2,7 +2,8 @@
 //! the same scene: the part with its sets and surfaces, each rigid body as a reference node with
 //! its point mass and inertia and its surface (analytical, or the rigid elements the caller
 //! gives for faceted and triangulated surfaces), contact, boundary and initial conditions, and
-//! the steps, with the field interval as an `*OUTPUT, FIELD, TIME INTERVAL=` request. Numbers
+//! the steps, with the field interval as an `*OUTPUT, FIELD, TIME INTERVAL=` request and the
+//! history nodes as `*NODE OUTPUT, NSET=` requests of `U` under `*OUTPUT, HISTORY`. Numbers
 //! are written so that they read back to the same bits.
 //!
 //! Two settings have no keyword and are refused: a static step's regularisation time other
@@ -473,6 +474,12 @@ pub fn write_deck(
             // a request holds in the later steps too
             if let Some(interval) = spec.output.field_interval {
                 let _ = writeln!(out, "*OUTPUT, FIELD, TIME INTERVAL={}", num(interval));
+            }
+            if !spec.output.history_nodes.is_empty() {
+                let _ = writeln!(out, "*OUTPUT, HISTORY");
+            }
+            for set in &spec.output.history_nodes {
+                let _ = writeln!(out, "*NODE OUTPUT, NSET={set}\nU");
             }
         }
         let _ = writeln!(out, "*END STEP");

@@ -291,6 +291,9 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         positive("output.field_interval", interval)?;
         check_field_file_names(spec)?;
     }
+    for (i, set) in spec.output.history_nodes.iter().enumerate() {
+        node_set(&format!("output.history_nodes[{i}]"), set)?;
+    }
 
     let part = SolidPart {
         name: spec.part.name.clone(),

@@ -14,7 +14,8 @@
 //! that moves it, `B.reaction_x` (likewise `y`, `z`; N) or `B.reaction_moment` (N m), the mean
 //! force of the increment; for each prescribed translation of a node set `S`, in the order of
 //! the model's `boundary`, the sum of its nodes' reactions, `S.reaction_x` (likewise `y`, `z`;
-//! N); then `kinetic_energy`, `strain_energy`, `hourglass_energy`,
+//! N); for each node set `S` of the model's `output.history_nodes` and each of its nodes `n`,
+//! its displacement `S.n.u_x` (likewise `y`, `z`; m); then `kinetic_energy`, `strain_energy`, `hourglass_energy`,
 //! `external_work`, `friction_dissipation`, `normal_work`, `algorithmic_dissipation` and, if the
 //! model prescribes motions, `reaction_work`, and if a section has stiffness damping,
 //! `damping_dissipation` (J). Numbers carry 10 significant digits. The file
@@ -78,8 +79,45 @@ impl ReactionColumns {
     }
 }
 
-/// The column names of a model's history, with its reaction columns.
-pub fn columns<const D: usize>(model: &Model<D>, reactions: &ReactionColumns) -> Vec<String> {
+/// The nodal displacement columns of a model's history: each a name, a node and an axis.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NodeColumns(Vec<(String, usize, usize)>);
+
+impl NodeColumns {
+    /// The displacement columns of the nodes of `spec.output.history_nodes`, `D` components
+    /// each (see the module documentation); a set the part lacks has none (the model's build
+    /// refuses it).
+    pub fn new<const D: usize>(spec: &ModelSpec) -> Self {
+        let mut columns = Vec::new();
+        for set in &spec.output.history_nodes {
+            let nodes = spec.part.node_sets.get(set).map_or(&[][..], Vec::as_slice);
+            for &node in nodes {
+                for (axis, name) in ["x", "y", "z"].iter().enumerate().take(D) {
+                    columns.push((format!("{set}.{node}.u_{name}"), node, axis));
+                }
+            }
+        }
+        Self(columns)
+    }
+
+    /// The column of each nodal displacement component in `state`, `u_i = x[eq(node, i)]`.
+    fn values<'a, const D: usize>(
+        &'a self,
+        model: &'a Model<D>,
+        state: &'a State,
+    ) -> impl Iterator<Item = f64> + 'a {
+        self.0
+            .iter()
+            .map(|&(_, node, axis)| model.dofs().node_displacement(&state.x, node)[axis])
+    }
+}
+
+/// The column names of a model's history, with its reaction and nodal displacement columns.
+pub fn columns<const D: usize>(
+    model: &Model<D>,
+    reactions: &ReactionColumns,
+    nodes: &NodeColumns,
+) -> Vec<String> {
     let mut names: Vec<String> = [
         "time",
         "step",
@@ -122,6 +160,9 @@ pub fn columns<const D: usize>(model: &Model<D>, reactions: &ReactionColumns) ->
         }
     }
     for (name, _) in &reactions.0 {
+        names.push(name.clone());
+    }
+    for (name, _, _) in &nodes.0 {
         names.push(name.clone());
     }
     names.extend(
@@ -236,11 +277,13 @@ pub struct RunRecord {
 pub struct ModelRecorder {
     csv: PartialCsv,
     reactions: ReactionColumns,
+    nodes: NodeColumns,
     record: RunRecord,
 }
 
 impl ModelRecorder {
-    /// Creates `dir/history.csv.partial` with the header for `model` and its reaction columns.
+    /// Creates `dir/history.csv.partial` with the header for `model` and its reaction and
+    /// nodal displacement columns.
     ///
     /// # Errors
     /// I/O errors.
@@ -248,19 +291,21 @@ impl ModelRecorder {
         dir: &Path,
         model: &Model<D>,
         reactions: ReactionColumns,
+        nodes: NodeColumns,
     ) -> std::io::Result<Self> {
-        let columns = columns(model, &reactions);
+        let columns = columns(model, &reactions, &nodes);
         let names: Vec<&str> = columns.iter().map(String::as_str).collect();
         Ok(Self {
             csv: PartialCsv::create(&dir.join(HISTORY_CSV), &names)?,
             reactions,
+            nodes,
             record: RunRecord::default(),
         })
     }
 
     /// Continues the history of an interrupted run: `dir/history.csv.partial` reopened at
-    /// `mark` ([`PartialCsv::reopen`]), with the record up to that point and the reaction
-    /// columns the history was created with.
+    /// `mark` ([`PartialCsv::reopen`]), with the record up to that point and the reaction and
+    /// nodal displacement columns the history was created with.
     ///
     /// # Errors
     /// As [`PartialCsv::reopen`].
@@ -269,10 +314,12 @@ impl ModelRecorder {
         mark: &FileMark,
         record: RunRecord,
         reactions: ReactionColumns,
+        nodes: NodeColumns,
     ) -> std::io::Result<Self> {
         Ok(Self {
             csv: PartialCsv::reopen(&dir.join(HISTORY_CSV), mark)?,
             reactions,
+            nodes,
             record,
         })
     }
@@ -355,6 +402,7 @@ impl<const D: usize> Observer<D> for ModelRecorder {
                 record.max_sliding_separation.max(t.max_sliding_separation);
         }
         row.extend(self.reactions.values(s).map(number));
+        row.extend(self.nodes.values(model, s).map(number));
         let e = &s.energy;
         row.extend(
             [

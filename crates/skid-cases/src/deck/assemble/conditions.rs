@@ -449,6 +449,37 @@ pub(super) fn field_interval(steps: &[StepDef]) -> Option<f64> {
     smallest(true).or_else(|| smallest(false))
 }
 
+/// The model's `output.history_nodes` from the steps' `*NODE OUTPUT, NSET=` history requests
+/// of `U` (skid writes them for the whole run): each set once, by its name as defined, in the
+/// order first asked for.
+///
+/// # Errors
+/// [`DeckError`] at a request whose set is not defined or holds a node outside the part.
+pub(super) fn history_nodes(defs: &Definitions, part: &Part) -> Result<Vec<String>, DeckError> {
+    let mut names: Vec<String> = Vec::new();
+    for (set, location) in defs.steps.iter().flat_map(|step| &step.history_nodes) {
+        let Some(defined) = defs.mesh.node_sets.get(&key(set)) else {
+            return Err(error(
+                location,
+                format!("*NODE OUTPUT, NSET={set}: no node set of that name is defined"),
+            ));
+        };
+        if let Some(label) = defined.labels.iter().find(|n| !part.number.contains_key(n)) {
+            return Err(error(
+                location,
+                format!(
+                    "*NODE OUTPUT, NSET={set}: node {label} is not a node of the part, whose \
+                     displacements are the only ones skid writes"
+                ),
+            ));
+        }
+        if !names.contains(&defined.name) {
+            names.push(defined.name.clone());
+        }
+    }
+    Ok(names)
+}
+
 /// The degrees of freedom (1..=6) of a boundary condition that apply to a rigid body in
 /// dimension `dim`: a 2D body has no z translation and no in-plane rotations, so a range or a
 /// named condition (ENCASTRE, symmetry) drops 3 to 5; a single one of them stays, to be refused.
