@@ -13,15 +13,21 @@ the contact normal force there.
 Written with --write: cases/verification/2d-block-sliding.json (n = 4, mu = 0.3, the contact
 nodes' mass moved off them, dt 1e-5 s), which the validation report checks with the other
 Coulomb scenes. Run without it: the ladder of time steps 4e-5 to 2.5e-6 s, meshes 4 x 4 and
-8 x 8 (2D) and 4 x 4 x 2 (3D), mu 0.1, 0.3 and 1, each with the lumped mass and with massless contact nodes
-(`part.section.massless_contact_nodes`), into validation/sliding.md, with its checks (massless
-contact nodes, mu <= 0.3: acceleration within 0.2 % and normal-force scatter under 2 % at
-every step and mesh); exit status 1 if one fails.
+8 x 8 (2D) and 4 x 4 x 2 (3D), mu 0.1, 0.3, 0.7 and 1, each with the lumped mass, with
+massless contact nodes (`part.section.massless_contact_nodes`), and with massless contact
+nodes and stiffness damping beta = 1e-5 s (`part.section.stiffness_damping`, about 6 % of
+critical on the block's first mode, a rubber's loss), into validation/sliding.md, with its
+checks (acceleration within 0.2 % and normal-force scatter under 2 % at every step and mesh:
+massless contact nodes for mu <= 0.3, and with the damping for mu <= 0.7); exit status 1 if
+one fails. Steady Coulomb sliding of this block is a flutter instability without damping
+(crates/skid-integrator/tests/frictional_flutter.rs): the undamped rows hold only where HHT's
+numerical damping outweighs the growth.
 
 Usage: scripts/sliding.py [--write] [--skid PATH] [--out FILE]
 """
 
 import argparse
+import concurrent.futures
 import csv
 import json
 import statistics
@@ -39,11 +45,15 @@ WIDTH, HEIGHT = 0.02, 0.005
 STEPS = [4e-5, 2e-5, 1e-5, 5e-6, 2.5e-6]
 # (dimension, elements along x and y); along z (3D) half as many
 MESHES = [(2, 4), (2, 8), (3, 4)]
-MUS = [0.1, 0.3, 1.0]
+MUS = [0.1, 0.3, 0.7, 1.0]
 WINDOW = (0.027, 0.040)
 
 
-def scene(dim, n, mu, dt, massless):
+# the contact nodes' mass and the section's stiffness damping of each row of the ladder
+OPTIONS = [("lumped", False, 0.0), ("massless", True, 0.0), ("massless, beta 1e-5 s", True, 1e-5)]
+
+
+def scene(dim, n, mu, dt, massless, beta=0.0):
     """The sliding block of n x n (x n/2 along z in 3D, 0.01 m deep) elements as a model file
     (a dict)."""
     s = json.loads(BASE[dim].read_text())
@@ -79,6 +89,8 @@ def scene(dim, n, mu, dt, massless):
     }
     if massless:
         part["section"]["massless_contact_nodes"] = True
+    if beta:
+        part["section"]["stiffness_damping"] = beta
     s["loads"][1]["force"] = [2.0 * mu * NORMAL] + [0.0] * (dim - 1)
     s["contact"][0]["mu"] = mu
     s["steps"][0]["dt"] = dt
@@ -114,6 +126,7 @@ def main():
     parser.add_argument("--write", action="store_true")
     parser.add_argument("--skid", default=str(ROOT / "target/release/skid"))
     parser.add_argument("--out", default=str(ROOT / "validation/sliding.md"))
+    parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
     if args.write:
         SCENE.write_text(json.dumps(scene(2, 4, 0.3, 1e-5, True), indent=2) + "\n")
@@ -128,38 +141,57 @@ def main():
         "acceleration against momentum balance, and the scatter of the contact normal force,",
         f"over {WINDOW[0] * 1e3:g}-{WINDOW[1] * 1e3:g} ms.",
         "",
+        "Steady Coulomb sliding of this block flutters without damping: linearised about the",
+        "sliding state, friction couples the contact nodes' normal reactions into their",
+        "tangential rows, and mode pairs turn complex and grow (mode-coupling flutter, the",
+        "mechanism of brake squeal; crates/skid-integrator/tests/frictional_flutter.rs). With",
+        "the lumped mass on the contact nodes the 4 x 4 block grows from mu below 0.3; massless",
+        "contact nodes raise that to about 0.62 on 4 x 4, but on 8 x 8 it grows at mu = 0.3",
+        "already, and faster on finer meshes: without damping the continuum problem is",
+        "ill-posed. Undamped rows hold only where HHT's numerical damping (which fades as dt",
+        "shrinks) outweighs the growth. Stiffness damping of a rubber's loss (beta = 1e-5 s, 6 %",
+        "of critical on the first mode) makes the linearised sliding stable to mu = 1 on every",
+        "mesh; the damped rows then converge at every dt. At mu = 1 on 8 x 8 the leading",
+        "bottom corner element folds during the pull ramp (23-31 ms) for every element",
+        "formulation and beta from 1e-5 to 1e-4 s: the corner's frictional stress singularity,",
+        "static and resolved only by the finer mesh, not the flutter.",
+        "",
         "| mesh | mu | contact nodes | " + " | ".join(f"dt {dt:g} s" for dt in STEPS) + " |",
         "|---|---|---|" + "---|" * len(STEPS),
     ]
     checks = []
-    with tempfile.TemporaryDirectory() as tmp:
+
+    def one(work, dim, n, mu, dt, massless, beta):
+        path = work / f"scene-{dim}-{n}-{mu}-{dt}-{massless}-{beta}.json"
+        path.write_text(json.dumps(scene(dim, n, mu, dt, massless, beta)))
+        out = work / path.stem
+        run = subprocess.run(
+            [args.skid, "run", str(path), "--out", str(out)], capture_output=True, text=True
+        )
+        if run.returncode != 0:
+            return "failed", False
+        error, scatter = measure(out, mu)
+        return f"{100 * error:+.3f} %, {100 * scatter:.2f} %", abs(error) < 0.002 and scatter < 0.02
+
+    with tempfile.TemporaryDirectory() as tmp, \
+            concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         work = Path(tmp)
-        for dim, n in MESHES:
+        rows = [(dim, n, mu, option) for dim, n in MESHES for mu in MUS for option in OPTIONS]
+        futures = {
+            (dim, n, mu, option[0], dt): pool.submit(one, work, dim, n, mu, dt, *option[1:])
+            for dim, n, mu, option in rows
+            for dt in STEPS
+        }
+        for dim, n, mu, (kind, massless, beta) in rows:
             mesh = f"{n} x {n}" + (f" x {n // 2}" if dim == 3 else "")
-            for mu in MUS:
-                for massless in (False, True):
-                    cells = []
-                    for dt in STEPS:
-                        path = work / "scene.json"
-                        path.write_text(json.dumps(scene(dim, n, mu, dt, massless)))
-                        out = work / f"run-{dim}-{n}-{mu}-{dt}-{massless}"
-                        run = subprocess.run(
-                            [args.skid, "run", str(path), "--out", str(out)],
-                            capture_output=True,
-                            text=True,
-                        )
-                        if run.returncode != 0:
-                            cells.append("failed")
-                            ok = False
-                        else:
-                            error, scatter = measure(out, mu)
-                            cells.append(f"{100 * error:+.3f} %, {100 * scatter:.2f} %")
-                            ok = abs(error) < 0.002 and scatter < 0.02
-                        if massless and mu <= 0.3:
-                            checks.append((f"{mesh}, mu {mu}, dt {dt:g}: massless contact nodes", ok))
-                        print(f"{mesh} mu {mu} massless {massless} dt {dt:g}: {cells[-1]}", file=sys.stderr)
-                    kind = "massless" if massless else "lumped"
-                    lines.append(f"| {mesh} | {mu} | {kind} | " + " | ".join(cells) + " |")
+            cells = []
+            for dt in STEPS:
+                cell, ok = futures[(dim, n, mu, kind, dt)].result()
+                cells.append(cell)
+                if (beta > 0.0 and mu <= 0.7) or (massless and mu <= 0.3):
+                    checks.append((f"{mesh}, mu {mu}, dt {dt:g}: {kind}", ok))
+                print(f"{mesh} mu {mu} {kind} dt {dt:g}: {cell}", file=sys.stderr)
+            lines.append(f"| {mesh} | {mu} | {kind} | " + " | ".join(cells) + " |")
     lines += ["", "## Checks", ""]
     lines += [f"- {'pass' if ok else 'FAIL'}: {what}" for what, ok in checks]
     lines.append("")

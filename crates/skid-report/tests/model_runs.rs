@@ -40,7 +40,10 @@ fn a_deck_of_the_drum_reads_to_its_case_files_spin_down() {
     );
     assert!(deck.case.is_none() && case.case.is_some());
     assert_eq!(deck.summary.status, "completed");
-    assert_eq!(deck.history, case.history);
+    // the same spin-down (the drum case's history also has the contact resultants)
+    assert_eq!(deck.history.time, case.history.time);
+    assert_eq!(deck.history.omega, case.history.omega);
+    assert_eq!(deck.history.non_finite, case.history.non_finite);
     assert_eq!(deck.summary.omega0, 60.0);
     // 30 ms of a 0.1 s spin-down: no stop, the deceleration over the whole of it
     assert_eq!(deck.summary.t_stop, None);
