@@ -92,6 +92,24 @@ pub struct ModelSpec {
     pub output: ModelOutputSpec,
 }
 
+impl ModelSpec {
+    /// The `(node, axis)` components of the part that the boundary conditions hold at zero
+    /// (node sets only; prescribed motions and rigid bodies left out).
+    pub fn held_node_components(&self) -> Vec<(usize, usize)> {
+        self.boundary
+            .iter()
+            .filter(|bc| !bc.is_prescribed())
+            .filter_map(|bc| Some((bc, self.part.node_sets.get(bc.node_set.as_ref()?)?)))
+            .flat_map(|(bc, nodes)| {
+                bc.dofs
+                    .iter()
+                    .filter_map(|d| d.translation_axis())
+                    .flat_map(move |axis| nodes.iter().map(move |&n| (n, axis)))
+            })
+            .collect()
+    }
+}
+
 /// Output settings of a model; every field is optional.
 #[derive(Clone, Debug, Default, Deserialize, Serialize, JsonSchema, PartialEq)]
 #[serde(default, deny_unknown_fields)]

@@ -185,18 +185,7 @@ impl CompressionScene {
         {
             return None;
         }
-        let held: Vec<(usize, usize)> = spec
-            .boundary
-            .iter()
-            .filter(|bc| !bc.is_prescribed())
-            .filter_map(|bc| Some((bc, part.node_sets.get(bc.node_set.as_ref()?)?)))
-            .flat_map(|(bc, nodes)| {
-                bc.dofs
-                    .iter()
-                    .filter_map(|d| d.translation_axis())
-                    .flat_map(move |axis| nodes.iter().map(move |&n| (n, axis)))
-            })
-            .collect();
+        let held = spec.held_node_components();
         let is_held = |n: usize, axis: usize| held.contains(&(n, axis));
         if !(0..part.nodes.len())
             .filter(|&n| on(n, 1, 0.0))

@@ -116,18 +116,7 @@ impl CookScene {
         {
             return None;
         }
-        let held: Vec<(usize, usize)> = spec
-            .boundary
-            .iter()
-            .filter(|bc| !bc.is_prescribed())
-            .filter_map(|bc| Some((bc, part.node_sets.get(bc.node_set.as_ref()?)?)))
-            .flat_map(|(bc, nodes)| {
-                bc.dofs
-                    .iter()
-                    .filter_map(|d| d.translation_axis())
-                    .flat_map(move |axis| nodes.iter().map(move |&n| (n, axis)))
-            })
-            .collect();
+        let held = spec.held_node_components();
         let clamped = (0..part.nodes.len())
             .filter(|&n| part.nodes[n][0].abs() <= ON)
             .all(|n| held.contains(&(n, 0)) && held.contains(&(n, 1)));
