@@ -175,6 +175,9 @@ pub struct Assembler {
     responses: Vec<ElementResponse>,
     /// Per element, its damping force at that call (zero without damping).
     damping_forces: Vec<[f64; MAX_COMPONENTS]>,
+    /// Per equation, the force of a displacement of one element size along it, `sum_e
+    /// |K_e,ii| h_e` at the reference configuration (see [`Self::stiffness_scale`]).
+    stiffness_scale: DVector<f64>,
     /// Element pressures of the mixed tangent between Newton iterates.
     mixed: MixedPressures,
     /// Numeric factorizations of the tangent so far.
@@ -191,7 +194,7 @@ impl Assembler {
     /// [`ModelError::Invalid`] if the pattern cannot be analysed.
     pub fn new<const D: usize>(model: &Model<D>) -> Result<Self, ModelError> {
         let mut slots = Slots::default();
-        let scatter = model
+        let scatter: Vec<ElementScatter> = model
             .part()
             .mesh
             .elements
@@ -211,6 +214,7 @@ impl Assembler {
         let pattern = SparsePattern::new(n, slots.builder, &[]).map_err(ModelError::Invalid)?;
         let values = vec![0.0; pattern.slots()];
         let elements = model.elements().len();
+        let stiffness_scale = stiffness_scale(model, &scatter)?;
         Ok(Self {
             pattern,
             scatter,
@@ -223,10 +227,21 @@ impl Assembler {
             element_slots,
             responses: vec![ElementResponse::default(); elements],
             damping_forces: vec![[0.0; MAX_COMPONENTS]; elements],
+            stiffness_scale,
             mixed: MixedPressures::new(elements),
             factorizations: 0,
             factorization_time: Duration::ZERO,
         })
+    }
+
+    /// Per equation, `sum_e |K_e,ii| h_e`: the diagonal stiffness of the elements on it at the
+    /// reference configuration, each times its element's size `h_e` (`V^(1/D)`, the area's
+    /// square root in 2D). Internal forces are sums of stresses whose round-off is `eps` of the
+    /// element's stiffness times its size, so `eps` times this bounds the noise with which the
+    /// force of an equation can be computed (`K (J - 1)` of a nearly incompressible solid,
+    /// `J` rounded from `F = I + H`): the force of a displacement of `eps h`.
+    pub fn stiffness_scale(&self) -> &DVector<f64> {
+        &self.stiffness_scale
     }
 
     /// Internal forces at displacement `x`; if `tangent_factor` is `Some(c_K)`, also resets the
@@ -672,6 +687,45 @@ impl<const D: usize> ElementLoop<'_, D> {
         );
         left.and(right)
     }
+}
+
+/// [`Assembler::stiffness_scale`] of `model`, from its elements' consistent tangents at the
+/// reference configuration.
+///
+/// # Errors
+/// The failure of an element that cannot be evaluated there.
+fn stiffness_scale<const D: usize>(
+    model: &Model<D>,
+    scatter: &[ElementScatter],
+) -> Result<DVector<f64>, ModelError> {
+    let part = model.part();
+    let mut scale = DVector::zeros(model.dofs().len());
+    let mut k = [0.0; MAX_COMPONENTS * MAX_COMPONENTS];
+    let u = [SVector::<f64, D>::zeros(); MAX_NODES];
+    for (e, (element, scatter)) in model.elements().iter().zip(scatter).enumerate() {
+        let components = D * element.node_count();
+        let k = &mut k[..components * components];
+        element
+            .respond_with_tangent(
+                part.material(e),
+                &u[..element.node_count()],
+                Tangent::Consistent,
+                k,
+            )
+            .map_err(|err| ModelError::Invalid(format!("element {e}: {err}")))?;
+        let measure = if D == 2 {
+            element.volume() / part.thickness
+        } else {
+            element.volume()
+        };
+        let size = measure.powf(1.0 / D as f64);
+        for (p, eq) in scatter.eqs.iter().enumerate() {
+            if let Some(eq) = eq {
+                scale[*eq] += k[p + p * components].abs() * size;
+            }
+        }
+    }
+    Ok(scale)
 }
 
 /// The increment failure of element `e` failing with `err`.

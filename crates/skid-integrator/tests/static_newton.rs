@@ -264,3 +264,91 @@ fn three_dimensional_compression_on_rollers_converges_quadratically() {
         }
     }
 }
+
+/// A nearly incompressible cantilever (nu = 0.4999: `K = 5000 mu`), 8 x 2 elements of each
+/// formulation clamped at one end and sheared at the other by loads from 1e-9 to 1e-5 of the
+/// shear modulus times the end's area: the force residual of so small a load is mostly the
+/// round-off of `K (J - 1)` (`J` rounded from `F = I + H`), which no Newton step removes. It
+/// converges as at any load (the residual measured against the round-off the elements'
+/// stiffness gives, see `Assembler::stiffness_scale`), and to the linear answer: the tip
+/// deflection per unit load is the same at every load.
+#[test]
+fn a_nearly_incompressible_solid_converges_under_a_load_of_round_off_size() {
+    let shear = 1.0e3;
+    let bulk = 5000.0 * shear;
+    let tip = |load: f64, formulation: Formulation| {
+        let mesh = SolidMesh::<2>::structured_block(
+            SVector::<f64, 2>::zeros(),
+            SVector::<f64, 2>::new(4.0, 1.0),
+            [8, 2],
+        )
+        .expect("mesh");
+        let clamped = mesh.node_sets["xmin"].clone();
+        let end = mesh.node_sets["xmax"].clone();
+        let fixed = clamped.iter().flat_map(|&k| [(k, 0), (k, 1)]).collect();
+        let force = load * shear / end.len() as f64;
+        let concentrated = end
+            .iter()
+            .map(|&k| ConcentratedLoad {
+                target: LoadTarget::Nodes(vec![k]),
+                force: SVector::<f64, 2>::new(0.0, force),
+                moment: Vector3::zeros(),
+                variation: Variation::Ramp,
+            })
+            .collect();
+        let part = SolidPart {
+            name: "cantilever".into(),
+            mesh,
+            sections: vec![Section {
+                material: Box::new(
+                    PolynomialN1::new(shear / 2.0, 0.0, 2.0 / bulk).expect("material"),
+                ),
+                density: DENSITY,
+                stiffness_damping: 0.0,
+            }],
+            element_sections: Vec::new(),
+            thickness: 1.0,
+            hourglass_scale: 1.0,
+            element_formulations: vec![formulation; 16],
+            quasi_static: false,
+            fixed,
+        };
+        let loads = Loads {
+            concentrated,
+            ..Loads::default()
+        };
+        let model = Model::new(part, vec![], vec![], loads, vec![]).expect("model");
+        let steps = [Step {
+            name: "shear".into(),
+            kind: StepKind::Static {
+                increments: StaticIncrements::Fixed(1),
+                regularization_time: 1e-2,
+            },
+            held: vec![],
+        }];
+        let mut settings = Settings::default();
+        settings.cutback.max_cutbacks = 0;
+        let mut record = Record::default();
+        let (_, result) = run(&model, &steps, &settings, &mut record);
+        let name = formulation.abaqus_name(2);
+        let state = result.unwrap_or_else(|e| panic!("{name}, load {load:e}: {e}"));
+        let iterations = record.counters[0].newton_iterations;
+        assert!(
+            iterations <= 3,
+            "{name}, load {load:e}: {iterations} iterations"
+        );
+        let corner = end[end.len() - 1];
+        model.dofs().node_displacement(&state.x, corner)[1] / load
+    };
+    for formulation in Formulation::ALL {
+        let reference = tip(1e-5, formulation);
+        for load in [1e-7, 1e-9] {
+            let compliance = tip(load, formulation);
+            assert!(
+                (compliance / reference - 1.0).abs() < 1e-4,
+                "{}: load {load:e}: {compliance} against {reference} at 1e-5",
+                formulation.abaqus_name(2)
+            );
+        }
+    }
+}
