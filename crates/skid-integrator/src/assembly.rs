@@ -829,9 +829,11 @@ mod tests {
         }
     }
 
-    /// A 3 x 2 block whose top nodes are tied to a plate translating in y, in 2D or 3D.
-    fn tied_block<const D: usize>() -> Model<D> {
-        let part = pad_block::<D>([0.0; 3], [0.03, 0.02, 0.01], [3, 2, 1]);
+    /// A 3 x 2 block whose top nodes are tied to a plate translating in y, in 2D or 3D, with
+    /// stiffness damping `beta`.
+    fn tied_block<const D: usize>(beta: f64) -> Model<D> {
+        let mut part = pad_block::<D>([0.0; 3], [0.03, 0.02, 0.01], [3, 2, 1]);
+        part.sections[0].stiffness_damping = beta;
         let top = part.mesh.node_sets["ymax"].clone();
         let mut free = [false; D];
         free[1] = true;
@@ -846,7 +848,7 @@ mod tests {
     /// The assembled tangent (through the DOF map, ties included) is the derivative of the
     /// assembled internal force.
     fn tangent_matches_finite_differences<const D: usize>() {
-        let model = tied_block::<D>();
+        let model = tied_block::<D>(0.0);
         let n = model.dofs().len();
         let mut assembler = Assembler::new(&model).expect("assembler");
         let x = DVector::from_fn(n, |i, _| {
@@ -878,18 +880,7 @@ mod tests {
     /// vanishes.
     fn damped_tangent_matches_finite_differences<const D: usize>() {
         let (beta, rate) = (2e-4, 3.0e3);
-        let mut part = pad_block::<D>([0.0; 3], [0.03, 0.02, 0.01], [3, 2, 1]);
-        part.sections[0].stiffness_damping = beta;
-        let top = part.mesh.node_sets["ymax"].clone();
-        let mut free = [false; D];
-        free[1] = true;
-        let plate = body::<D>("plate", free, Rotation::None, 0.0, 0.0);
-        let tie = Tie {
-            body: 0,
-            nodes: top,
-        };
-        let model =
-            Model::new(part, vec![plate], vec![tie], Loads::default(), vec![]).expect("model");
+        let model = tied_block::<D>(beta);
         let n = model.dofs().len();
         let mut assembler = Assembler::new(&model).expect("assembler");
         let x0 = DVector::from_fn(n, |i, _| {
@@ -1059,8 +1050,8 @@ mod tests {
     #[test]
     fn in_place_assembly_matches_element_by_element_addition() {
         check_in_place_assembly(&large_block());
-        check_in_place_assembly(&tied_block::<2>());
-        check_in_place_assembly(&tied_block::<3>());
+        check_in_place_assembly(&tied_block::<2>(0.0));
+        check_in_place_assembly(&tied_block::<3>(0.0));
     }
 
     /// The parallel loop reports the failure of the lowest-numbered failing element, as the
@@ -1099,7 +1090,7 @@ mod tests {
     /// other than an indefinite matrix is passed on at once.
     #[test]
     fn mass_shift_escalates_until_the_matrix_factorizes() {
-        let model = tied_block::<2>();
+        let model = tied_block::<2>(0.0);
         let n = model.dofs().len();
         let mut assembler = Assembler::new(&model).expect("assembler");
         let x = DVector::zeros(n);
@@ -1124,7 +1115,7 @@ mod tests {
 
     #[test]
     fn held_equations_get_identity_rows() {
-        let model = tied_block::<2>();
+        let model = tied_block::<2>(0.0);
         let n = model.dofs().len();
         let mut assembler = Assembler::new(&model).expect("assembler");
         assembler

@@ -314,6 +314,11 @@ fn solve_increment_with<const D: usize>(
         }
         _ => (m_factor, m_factor),
     };
+    // The internal forces are as exact as the stresses they sum: an equation's force is known
+    // to `eps` of its elements' stiffness times their size (the round-off of `K (J - 1)` of a
+    // nearly incompressible solid: Cook's membrane at nu = 0.4999 under a load of 1e-3
+    // stalled at 1e-5 of it), see `Assembler::stiffness_scale`.
+    let stiffness_roundoff = assembler.stiffness_scale() * (ROUNDOFF_ULPS * f64::EPSILON);
     // the sections' stiffness damping acts in a dynamic increment, on the iterate's mean
     // velocity over it (see `Damping`)
     let damping_rate = match kind {
@@ -472,17 +477,13 @@ fn solve_increment_with<const D: usize>(
             // `1 / (beta h^2)`, which on a very short increment exceeds the force tolerance
             // (2e-5 of the forces on the spinning drum at h = 5e-8 s), so that Newton could
             // never converge there.
-            // The internal forces are as exact as the stresses they sum: an equation's force
-            // is known to `eps` of its elements' stiffness times their size (the round-off
-            // of `K (J - 1)` of a nearly incompressible solid: Cook's membrane at nu = 0.4999
-            // under a load of 1e-3 stalled at 1e-5 of it), see `Assembler::stiffness_scale`.
-            let stiffness = assembler.stiffness_scale() * (ROUNDOFF_ULPS * f64::EPSILON);
             let roundoff = match kind {
-                IncrementKind::Static { .. } => stiffness,
+                IncrementKind::Static { .. } => stiffness_roundoff.clone(),
                 IncrementKind::Dynamic { hht, h, .. } => {
                     let factor = ROUNDOFF_ULPS * f64::EPSILON * hht.mass_factor(h);
                     DVector::from_fn(n, |i, _| {
-                        (factor * mass[i] * x[i].abs().max(start.x[i].abs())).max(stiffness[i])
+                        (factor * mass[i] * x[i].abs().max(start.x[i].abs()))
+                            .max(stiffness_roundoff[i])
                     })
                 }
             };
@@ -614,9 +615,6 @@ fn solve_increment_with<const D: usize>(
         let clock = Instant::now();
         if !chord {
             if !tangent_now {
-                let damping = damping_rate
-                    .zip(mean_velocity.as_ref())
-                    .map(|(rate, velocity)| Damping { velocity, rate });
                 assembler.internal_damped(model, &x, Some(k_factor), damping)?;
             }
             if matches!(kind, IncrementKind::Static { .. }) && counters.newton_iterations == 0 {

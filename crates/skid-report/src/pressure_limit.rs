@@ -176,36 +176,38 @@ pub fn section(path: &Path, ladder: &Ladder) -> (String, Counts) {
     let crashed = ladder.runs.iter().filter(|r| r.status == "crashed").count();
     checks.record("no run crashed", crashed == 0, format!("{crashed} crashed"));
     let completed = ladder.runs.iter().filter(|r| r.completed()).count();
-    let label = |what: &str| format!("{what}, over the {completed} completed runs");
-    let friction = worst(ladder, |r| r.friction_excess);
-    checks.record(
-        &label("friction resultant never above mu N"),
-        friction.is_some_and(|v| v <= FRICTION_TOLERANCE),
-        format!(
-            "max (|F_t| - mu N) / (mu max N) {} (limit {})",
-            friction.map_or("missing".into(), |v| Sig(v).to_string()),
-            Sig(FRICTION_TOLERANCE)
-        ),
+    let mut bound = |what: &str, measure: &str, value: Option<f64>, limit: f64, unit: &str| {
+        let scale = if unit == " %" { 100.0 } else { 1.0 };
+        checks.record(
+            &format!("{what}, over the {completed} completed runs"),
+            value.is_some_and(|v| v <= limit),
+            format!(
+                "{measure} {}{unit} (limit {}{unit})",
+                value.map_or("missing".into(), |v| Sig(scale * v).to_string()),
+                Sig(scale * limit)
+            ),
+        );
+    };
+    bound(
+        "friction resultant never above mu N",
+        "max (|F_t| - mu N) / (mu max N)",
+        worst(ladder, |r| r.friction_excess),
+        FRICTION_TOLERANCE,
+        "",
     );
-    let momentum = worst(ladder, |r| r.momentum_residual);
-    checks.record(
-        &label("drum's angular momentum balanced by the contact impulses"),
-        momentum.is_some_and(|v| v <= MOMENTUM_TOLERANCE),
-        format!(
-            "max |I (omega - omega0) - sum h T| / (I omega0) {} (limit {})",
-            momentum.map_or("missing".into(), |v| Sig(v).to_string()),
-            Sig(MOMENTUM_TOLERANCE)
-        ),
+    bound(
+        "drum's angular momentum balanced by the contact impulses",
+        "max |I (omega - omega0) - sum h T| / (I omega0)",
+        worst(ladder, |r| r.momentum_residual),
+        MOMENTUM_TOLERANCE,
+        "",
     );
-    let energy = worst(ladder, |r| r.energy_balance_error);
-    checks.record(
-        &label("energy balance"),
-        energy.is_some_and(|v| v <= ENERGY_TOLERANCE),
-        format!(
-            "max error {} % (limit {} %)",
-            energy.map_or("missing".into(), |v| Sig(100.0 * v).to_string()),
-            plain(100.0 * ENERGY_TOLERANCE)
-        ),
+    bound(
+        "energy balance",
+        "max error",
+        worst(ladder, |r| r.energy_balance_error),
+        ENERGY_TOLERANCE,
+        " %",
     );
     out.push_str(&checks.text);
     (out, checks.counts)
