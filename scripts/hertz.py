@@ -69,14 +69,14 @@ def graded(fine, fine_extent, extent):
     return coords
 
 
-def scene(level, size, a_over_r):
+def scene(level, size, a_over_r, poisson=POISSON, element="CPE4R"):
     """The model file (a dict) of mesh level `level` for a block of half-width and depth `size`
-    times a, a = `a_over_r` R."""
-    e_star = YOUNG / (1.0 - POISSON ** 2)
+    times a, a = `a_over_r` R, of Poisson's ratio `poisson` and element type `element`."""
+    e_star = YOUNG / (1.0 - poisson ** 2)
     a = a_over_r * RADIUS
     load = math.pi * e_star * a * a / (4.0 * RADIUS)
-    shear = YOUNG / (2.0 * (1.0 + POISSON))
-    bulk = YOUNG / (3.0 * (1.0 - 2.0 * POISSON))
+    shear = YOUNG / (2.0 * (1.0 + poisson))
+    bulk = YOUNG / (3.0 * (1.0 - 2.0 * poisson))
     h = a / (level + 0.5)
     half = graded(h, FINE_ZONE * a, size * a)
     xs = [-x for x in reversed(half[1:])] + half
@@ -95,7 +95,7 @@ def scene(level, size, a_over_r):
     description = (
         f"Verification (2D, plane strain): Hertz contact of a rigid cylinder (R = {RADIUS} m) "
         f"pressed frictionlessly on an elastic block ({2 * size:g} a wide, {size:g} a deep, "
-        f"bottom held; neo-Hookean, E = {YOUNG:g} Pa, nu = {POISSON}) by P = {load:.6g} N per "
+        f"bottom held; neo-Hookean, E = {YOUNG:g} Pa, nu = {poisson}) by P = {load:.6g} N per "
         f"metre of thickness, ramped over a static step. Hertz: E* = E / (1 - nu^2), "
         f"a = sqrt(4 P R / (pi E*)) = {a:g} m, p0 = 2 P / (pi a) = {2 * load / (math.pi * a):.6g} "
         f"Pa, p(x) = p0 sqrt(1 - x^2 / a^2). Mesh level N = {level}: elements of "
@@ -110,7 +110,7 @@ def scene(level, size, a_over_r):
         "part": {
             "name": "block",
             "nodes": nodes,
-            "elements": [{"type": "CPE4R", "connectivity": connectivity}],
+            "elements": [{"type": element, "connectivity": connectivity}],
             "node_sets": {"bottom": bottom, "top": top},
             "section": {
                 "material": {"type": "polynomial_n1", "c10": shear / 2.0, "c01": 0.0,

@@ -74,17 +74,28 @@ impl HertzScene {
         let [skid_cases::model_spec::ModelStepSpec::Static { .. }] = spec.steps.as_slice() else {
             return None;
         };
+        if spec.dimension != 2 || pair.mu != 0.0 || *loaded != body.name {
+            return None;
+        }
+        let load = force.iter().map(|f| f * f).sum::<f64>().sqrt();
+        Self::of_block(spec, &pair.name, radius, load)
+    }
+
+    /// The Hertz scene of the contact pair `pair` between a cylinder of radius `radius` and the
+    /// part of the 2D model `spec` under the total normal load `load` (N): the small-strain
+    /// moduli of the part's polynomial material; `None` for a non-positive thickness.
+    pub fn of_block(spec: &ModelSpec, pair: &str, radius: f64, load: f64) -> Option<Self> {
         let MaterialSpec::PolynomialN1 { c10, c01, d1 } = spec.part.section.material;
         let thickness = spec.part.section.thickness;
-        if spec.dimension != 2 || pair.mu != 0.0 || *loaded != body.name || thickness <= 0.0 {
+        if thickness <= 0.0 {
             return None;
         }
         let shear = 2.0 * (c10 + c01);
         let bulk = 2.0 / d1;
         Some(Self {
-            pair: pair.name.clone(),
+            pair: pair.to_string(),
             radius,
-            load: force.iter().map(|f| f * f).sum::<f64>().sqrt() / thickness,
+            load: load / thickness,
             thickness,
             young: 9.0 * bulk * shear / (3.0 * bulk + shear),
             poisson: (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear)),
@@ -122,6 +133,8 @@ pub struct CandidateNode {
     pub reference_x: f64,
     /// Normal force, N.
     pub normal_force: f64,
+    /// Tangential force along the contact's first tangent (2D: its only one), N.
+    pub tangential_force: f64,
 }
 
 /// Reads the candidates of the pair `pair` from `contact_nodes.csv` text (2D); `path` is only
@@ -135,9 +148,17 @@ pub fn read_candidates(
     pair: &str,
 ) -> Result<Vec<CandidateNode>, ReportError> {
     let table = CsvTable::new(text, path)?;
-    let [name, x, y, ux, uy, force] =
-        ["pair", "x", "y", "u_x", "u_y", "normal_force"].map(|c| table.column(c));
-    let (name, x, y, ux, uy, force) = (name?, x?, y?, ux?, uy?, force?);
+    let [name, x, y, ux, uy, force, tangential] = [
+        "pair",
+        "x",
+        "y",
+        "u_x",
+        "u_y",
+        "normal_force",
+        "tangential_force_1",
+    ]
+    .map(|c| table.column(c));
+    let (name, x, y, ux, uy, force, tangential) = (name?, x?, y?, ux?, uy?, force?, tangential?);
     let mut nodes = Vec::new();
     for row in table {
         let row = row?;
@@ -150,6 +171,7 @@ pub fn read_candidates(
             position: [x0 + dx, y0 + dy],
             reference_x: x0,
             normal_force: row.number(force)?,
+            tangential_force: row.number(tangential)?,
         });
     }
     Ok(nodes)
@@ -190,19 +212,19 @@ pub fn measure(nodes: &[CandidateNode], thickness: f64) -> Result<HertzMeasure, 
     if n < 3 {
         return Err(format!("{n} contact candidates, expected at least 3"));
     }
-    let current = |i: usize, j: usize| {
-        let (p, q) = (nodes[i].position, nodes[j].position);
-        (p[0] - q[0]).hypot(p[1] - q[1])
-    };
     let reference = |i: usize, j: usize| (nodes[j].reference_x - nodes[i].reference_x).abs();
-    // The pressure of node i with segment lengths `length`.
-    let pressure = |i: usize, length: &dyn Fn(usize, usize) -> f64| {
-        let left = if i > 0 { length(i - 1, i) } else { 0.0 };
-        let right = if i + 1 < n { length(i, i + 1) } else { 0.0 };
+    // The nominal pressure of node i: over its reference tributary area.
+    let nominal = |i: usize| {
+        let left = if i > 0 { reference(i - 1, i) } else { 0.0 };
+        let right = if i + 1 < n { reference(i, i + 1) } else { 0.0 };
         nodes[i].normal_force / (thickness * 0.5 * (left + right))
     };
+    let tributary = tributary_lengths(&nodes);
     let profile: Vec<(f64, f64)> = (0..n)
-        .map(|i| (nodes[i].reference_x, pressure(i, &current)))
+        .map(|i| {
+            let p = nodes[i].normal_force / (thickness * tributary[i]);
+            (nodes[i].reference_x, p)
+        })
         .collect();
     let closed: Vec<usize> = (0..n).filter(|&i| nodes[i].normal_force > 0.0).collect();
     let (Some(&first), Some(&last)) = (closed.first(), closed.last()) else {
@@ -228,12 +250,29 @@ pub fn measure(nodes: &[CandidateNode], thickness: f64) -> Result<HertzMeasure, 
         centre_element: reference(centre, next),
         closed: closed.len(),
         peak_pressure: profile[centre].1,
-        nominal_peak_pressure: pressure(centre, &reference),
+        nominal_peak_pressure: nominal(centre),
         half_width: 0.5 * reference(first, last),
         edge_element: reference(first - 1, first).max(reference(last, last + 1)),
         resultant: nodes.iter().map(|c| c.normal_force).sum::<f64>() / thickness,
         profile,
     })
+}
+
+/// The tributary length of each of `nodes` (sorted along x): half the deformed segments to its
+/// two neighbours (one at either end), m.
+pub fn tributary_lengths(nodes: &[CandidateNode]) -> Vec<f64> {
+    let segment = |i: usize| {
+        let (p, q) = (nodes[i].position, nodes[i + 1].position);
+        (p[0] - q[0]).hypot(p[1] - q[1])
+    };
+    let n = nodes.len();
+    (0..n)
+        .map(|i| {
+            let left = if i > 0 { segment(i - 1) } else { 0.0 };
+            let right = if i + 1 < n { segment(i) } else { 0.0 };
+            0.5 * (left + right)
+        })
+        .collect()
 }
 
 /// Root mean square of `(p_FE - p) / p0` over the nodes with `|x| <= a`.
@@ -286,6 +325,7 @@ mod tests {
                     position: [x, 0.0],
                     reference_x: x,
                     normal_force: scale * s.pressure(x) * s.thickness * h,
+                    tangential_force: 0.0,
                 }
             })
             .collect()
@@ -331,6 +371,7 @@ mod tests {
         assert_eq!(nodes.len(), 1);
         assert_eq!(nodes[0].position, [0.001 + 1e-6, -2e-5]);
         assert_eq!(nodes[0].normal_force, 5.5);
+        assert_eq!(nodes[0].tangential_force, 0.0);
         let e = read_candidates("pair,x\np,1\n", Path::new("c.csv"), "p").expect_err("columns");
         assert!(e.to_string().contains("no column 'y'"), "{e}");
     }

@@ -20,6 +20,8 @@ pub const NEWTON_SVG: &str = "newton.svg";
 pub const SCALING_SVG: &str = "scaling.svg";
 /// File name of the Hertz contact pressure plot of the verification section.
 pub const HERTZ_SVG: &str = "hertz-pressure.svg";
+/// The Cattaneo–Mindlin traction profile against the closed form.
+pub const MINDLIN_SVG: &str = "mindlin-traction.svg";
 /// File name of the stress sweep's plot of energy balance against time step.
 pub const STRESS_SVG: &str = "stress-energy.svg";
 
@@ -469,6 +471,44 @@ pub fn plot_hertz_pressure(
         path,
         title,
         ("|x| / a (a, p0: Hertz)", "p / p0"),
+        &curves,
+        SeriesLabelPosition::UpperRight,
+    )
+}
+
+/// The Cattaneo–Mindlin traction `q / (mu p0)` against `x / a`: the FE nodes `fe`, Mindlin's
+/// `mindlin` (dashed) and the slip bound `mu p / (mu p0)` of Hertz's pressure, `bound`.
+///
+/// # Errors
+/// [`ReportError::Plot`] if it cannot be drawn or written.
+pub fn plot_mindlin_traction(
+    title: &str,
+    fe: Vec<(f64, f64)>,
+    mindlin: Vec<(f64, f64)>,
+    bound: Vec<(f64, f64)>,
+    path: &Path,
+) -> Result<(), ReportError> {
+    let curves = [
+        Curve {
+            label: "FE".into(),
+            points: fe,
+            dashed: false,
+        },
+        Curve {
+            label: "slip bound mu p (Hertz)".into(),
+            points: bound,
+            dashed: false,
+        },
+        Curve {
+            label: "Mindlin q(x)".into(),
+            points: mindlin,
+            dashed: true,
+        },
+    ];
+    draw(
+        path,
+        title,
+        ("x / a (a, p0: Hertz)", "q / (mu p0)"),
         &curves,
         SeriesLabelPosition::UpperRight,
     )

@@ -11,6 +11,10 @@
 //!   pressure's change from one level to the next shrinks too, so that it converges, to
 //!   whatever the finite block and finite strain make of Hertz's answer), and the pressure
 //!   plot of the finest level;
+//! - Cattaneo–Mindlin ([`cattaneo_mindlin`]): the Hertz scene with friction, then pushed
+//!   sideways: the stick zone's width and traction against Mindlin's, per element type and
+//!   mesh, with a measure of node-to-node alternation, its limit on the finest mesh and its
+//!   decay under refinement, and the traction plot of the finest CPE4R mesh;
 //! - Coulomb friction (any other scene with a frictional pair, [`coulomb`]): the friction
 //!   resultant never exceeds `mu N` and equals it while every contact slides; a block on a
 //!   fixed flat sticks or slides as its held loads say, and the runs of a scene that stick and
@@ -29,6 +33,7 @@
 //!   increment, to 50 % compression (the incompatible-mode elements as far as they carry, a
 //!   known gap), and its Newton iterations per increment.
 
+pub mod cattaneo_mindlin;
 pub mod compression;
 pub mod cook;
 pub mod coulomb;
@@ -45,6 +50,7 @@ use super::format::{Checks, Counts, Sig, percent};
 use super::hertz::{self, HertzMeasure, HertzScene};
 use super::plot::{HERTZ_SVG, plot_hertz_pressure};
 use super::{ReportError, read};
+use cattaneo_mindlin::MindlinScene;
 use compression::CompressionScene;
 use cook::CookScene;
 use free_rotation::FreeBody;
@@ -190,6 +196,7 @@ pub fn section(
     let mut files = Vec::new();
     let mut unchecked = Vec::new();
     let mut hertz_runs = Vec::new();
+    let mut mindlin_runs = Vec::new();
     let mut coulomb_runs = Vec::new();
     let mut free_runs = Vec::new();
     let mut ball_runs = Vec::new();
@@ -198,6 +205,8 @@ pub fn section(
     for run in runs {
         if let Some(scene) = HertzScene::recognise(&run.spec) {
             hertz_runs.push((run, scene));
+        } else if let Some(scene) = MindlinScene::recognise(&run.spec) {
+            mindlin_runs.push((run, scene));
         } else if let Some(ball) = RollingBall::recognise(&run.spec) {
             ball_runs.push((run, ball));
         } else if run.spec.contact.iter().any(|p| p.mu > 0.0) {
@@ -214,6 +223,11 @@ pub fn section(
     }
     if !hertz_runs.is_empty() {
         let (text, file) = hertz_section(&hertz_runs, plots, &mut checks)?;
+        out.push_str(&text);
+        files.extend(file);
+    }
+    if !mindlin_runs.is_empty() {
+        let (text, file) = cattaneo_mindlin::section(&mindlin_runs, plots, &mut checks)?;
         out.push_str(&text);
         files.extend(file);
     }
