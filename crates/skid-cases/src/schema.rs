@@ -181,6 +181,33 @@ pub enum PadFormulation {
 }
 
 impl PadFormulation {
+    /// Every formulation.
+    pub const ALL: [Self; 4] = [Self::Reduced, Self::Full, Self::Hybrid, Self::Incompatible];
+
+    /// Its name in case files (`pad.formulation`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Reduced => "reduced",
+            Self::Full => "full",
+            Self::Hybrid => "hybrid",
+            Self::Incompatible => "incompatible",
+        }
+    }
+
+    /// The formulation of a name of [`Self::name`].
+    ///
+    /// # Errors
+    /// A message listing the names.
+    pub fn parse(name: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|f| f.name() == name)
+            .ok_or_else(|| {
+                let names: Vec<_> = Self::ALL.iter().map(|f| f.name()).collect();
+                format!("expected one of {}, got {name:?}", names.join(", "))
+            })
+    }
+
     /// The element kernels' formulation.
     pub fn formulation(self) -> Formulation {
         match self {

@@ -27,7 +27,10 @@ pub fn run(cases: &[PathBuf], settings: &BenchSettings, out: &Path) -> ExitCode 
         }
     }
     let terminal = std::io::stderr().is_terminal();
-    let total = loaded.len() * (settings.levels + settings.meshes) * settings.methods.len();
+    let total = loaded.len()
+        * (settings.levels + settings.meshes)
+        * settings.methods.len()
+        * settings.elements.len().max(1);
     let mut done = 0;
     let progress = |r: &skid_report::bench::BenchRecord| {
         done += 1;
@@ -35,7 +38,7 @@ pub fn run(cases: &[PathBuf], settings: &BenchSettings, out: &Path) -> ExitCode 
             eprintln!(
                 "[{done}/{total}] {} {} dt {:.3e}, pad {}: {} in {:.3} s ({} runs)",
                 r.case,
-                r.method,
+                r.variant(),
                 r.dt,
                 r.pad_mesh.as_deref().unwrap_or("?"),
                 r.status,

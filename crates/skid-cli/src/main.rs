@@ -16,6 +16,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use skid_cases::reference::Format;
+use skid_cases::schema::PadFormulation;
 use skid_report::ReportSources;
 use skid_report::bench::{BenchMethod, BenchSettings, Isolation};
 
@@ -192,6 +193,11 @@ enum Command {
         /// direction; errors against the finest.
         #[arg(long, default_value_t = 0)]
         meshes: usize,
+        /// Pad elements to compare (comma-separated `pad.formulation` names: reduced, full,
+        /// hybrid, incompatible; absent: the cases' own): every ladder runs with each, measured
+        /// against the first element's references.
+        #[arg(long, value_delimiter = ',')]
+        elements: Vec<String>,
     },
     /// Check case files, model files, decks and sweep files without running them: each (each
     /// run of a sweep) is read, validated and built into its model (mesh, bodies, contact
@@ -316,6 +322,7 @@ fn main() -> ExitCode {
             repeats,
             methods,
             meshes,
+            elements,
         } => {
             let mut solves = Vec::new();
             for method in &methods {
@@ -323,6 +330,16 @@ fn main() -> ExitCode {
                     Ok(method) => solves.push(method),
                     Err(message) => {
                         eprintln!("skid: --methods: {message}");
+                        return ExitCode::from(2);
+                    }
+                }
+            }
+            let mut pads = Vec::new();
+            for element in &elements {
+                match PadFormulation::parse(element) {
+                    Ok(element) => pads.push(element),
+                    Err(message) => {
+                        eprintln!("skid: --elements: {message}");
                         return ExitCode::from(2);
                     }
                 }
@@ -342,6 +359,7 @@ fn main() -> ExitCode {
                 repeats,
                 methods: solves,
                 meshes,
+                elements: pads,
                 isolation: Isolation::Process {
                     skid,
                     threads: cli.threads,

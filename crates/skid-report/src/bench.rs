@@ -13,6 +13,11 @@
 //! - `t_stop`, relative, which the pad vibration left at the stop moves by up to 1 %: a
 //!   difference inside that band is not a discretisation error.
 //!
+//! With an element axis ([`BenchSettings::elements`]) every method's ladders run once per pad
+//! element formulation, and every element's levels are measured against the first element's
+//! references: the errors then say what each element costs for the drum's accuracy, not how
+//! close it comes to its own finest level.
+//!
 //! A bench of one level (`levels = 1`, `coarser = 0`) runs each case at its own time step only,
 //! with no reference and no errors: the cost of a set of cases as they are written, reported
 //! with its total (the cases run one after another).
@@ -35,7 +40,7 @@ use skid_cases::atomic::write_atomic;
 use skid_cases::model_file::summary::RunCost;
 use skid_cases::peak_memory;
 use skid_cases::runner::run_case_with;
-use skid_cases::schema::{AdaptiveSpec, Case, ContactSolveSpec, StepSpec};
+use skid_cases::schema::{AdaptiveSpec, Case, ContactSolveSpec, PadFormulation, StepSpec};
 use skid_cases::validate::CaseError;
 
 /// Runs shorter than this (s) are repeated and their median taken.
@@ -90,6 +95,9 @@ pub struct BenchSettings {
     /// pad, then each level's element counts [`MESH_RATIO`] times the last's in every
     /// direction, the finest being the reference (at most [`MAX_MESH_LEVELS`]).
     pub meshes: usize,
+    /// The pad elements to compare (empty: the case's own): every method's ladders are run
+    /// with each, and the later elements' levels are measured against the first's references.
+    pub elements: Vec<PadFormulation>,
     /// Which process runs each run.
     pub isolation: Isolation,
 }
@@ -123,6 +131,7 @@ impl Default for BenchSettings {
             repeats: 5,
             methods: vec![BenchMethod::Reduced, BenchMethod::Global],
             meshes: 0,
+            elements: Vec::new(),
             isolation: Isolation::InProcess,
         }
     }
@@ -226,6 +235,10 @@ pub struct BenchRecord {
     pub case: String,
     /// Method ([`BenchMethod::label`]).
     pub method: String,
+    /// The pad's element (its Abaqus name) where the bench has an element axis (absent:
+    /// the case's own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub element: Option<String>,
     /// Time step of the dynamic steps, s.
     pub dt: f64,
     /// `dt` over the case's own time step (absent in records written before it was kept).
@@ -288,6 +301,17 @@ pub struct BenchRecord {
     pub t_stop_difference: Option<f64>,
     /// Whether this level is the reference of its case and method.
     pub reference: bool,
+}
+
+impl BenchRecord {
+    /// What the report tells its ladders apart by within a case: the method, and the pad
+    /// element where the bench has an element axis (`global, CPE4H`).
+    pub fn variant(&self) -> String {
+        match &self.element {
+            Some(element) => format!("{}, {element}", self.method),
+            None => self.method.clone(),
+        }
+    }
 }
 
 /// Why a bench could not be completed.
@@ -432,11 +456,94 @@ pub fn run_bench(
                 source.display()
             )));
         };
-        let mut finest: Vec<(BenchMethod, PathBuf, BenchRecord)> = Vec::new();
+        let variants: Vec<Option<PadFormulation>> = if settings.elements.is_empty() {
+            vec![None]
+        } else {
+            settings.elements.iter().copied().map(Some).collect()
+        };
+        // the references of the first element's ladders, shared by the others
+        let mut shared: Option<Vec<References>> = None;
+        for element in variants {
+            let mut variant = case.clone();
+            let dir = match element {
+                Some(e) => {
+                    variant.pad.formulation = e;
+                    out.join("runs").join(&case.name).join(e.name())
+                }
+                None => out.join("runs").join(&case.name),
+            };
+            let bench = Variant {
+                case: &variant,
+                element,
+                source,
+                dt,
+                dir,
+            };
+            let (mut measured, references) =
+                bench.run(settings, shared.as_deref(), &mut progress)?;
+            records.append(&mut measured);
+            shared.get_or_insert(references);
+        }
+    }
+    let path = out.join(BENCH_JSON);
+    let text = serde_json::to_string_pretty(&records).unwrap_or_default();
+    std::fs::create_dir_all(out)
+        .and_then(|()| write_atomic(&path, &text))
+        .map_err(|source| BenchError::Write { path, source })?;
+    Ok(records)
+}
+
+/// A run directory and the record of its level.
+type RunDir = (BenchRecord, PathBuf);
+
+/// The levels one method's ladders were measured against, for the later elements of a bench
+/// with an element axis to share.
+struct References {
+    /// The method.
+    method: BenchMethod,
+    /// The time-step ladder's reference.
+    time_step: Option<RunDir>,
+    /// The pad-mesh ladder's reference.
+    pad_mesh: Option<RunDir>,
+}
+
+/// One case with one pad element (or as written): every method's ladders.
+struct Variant<'a> {
+    /// The case, its pad's formulation set.
+    case: &'a Case,
+    /// The pad element the bench sets, if it has an element axis.
+    element: Option<PadFormulation>,
+    /// The case file.
+    source: &'a Path,
+    /// The case's smallest dynamic time step, s.
+    dt: f64,
+    /// Where its methods' runs go (`<dir>/<method>/...`).
+    dir: PathBuf,
+}
+
+impl Variant<'_> {
+    /// Runs every method's ladders, calling `progress` with a line per level (the finer pads
+    /// after every method's time-step ladder), and measures each ladder against `shared`'s
+    /// reference of its method where given (the first element's), else against its own finest
+    /// level (or, for an adaptive method, its fixed counterpart's); returns the records, each
+    /// method's ladders in order, and the references used.
+    ///
+    /// # Errors
+    /// As [`run_level`] and [`measure_against`].
+    fn run(
+        &self,
+        settings: &BenchSettings,
+        shared: Option<&[References]>,
+        progress: &mut impl FnMut(&BenchRecord),
+    ) -> Result<(Vec<BenchRecord>, Vec<References>), BenchError> {
+        let (case, dt) = (self.case, self.dt);
+        let shared_of =
+            |method: BenchMethod| shared.and_then(|s| s.iter().find(|r| r.method == method));
+        let mut references: Vec<References> = Vec::new();
         // per method: its run directory, its time-step levels and its pad-mesh levels
         let mut ladders = Vec::new();
         for &method in &settings.methods {
-            let dir = out.join("runs").join(&case.name).join(method.label());
+            let dir = self.dir.join(method.label());
             let mut runs = Vec::new();
             for k in 0..settings.levels {
                 let exponent = i32::try_from(settings.coarser).unwrap_or(i32::MAX)
@@ -446,12 +553,13 @@ pub fn run_bench(
                     case: level_case(case, factor, method),
                     dir: dir.join(k.to_string()),
                     method,
+                    element: self.element,
                     ladder: Ladder::TimeStep,
                     dt: dt * factor,
                     dt_factor: factor,
                     reference: settings.levels > 1 && k + 1 == settings.levels,
                 };
-                let record = run_level(&level, source, settings)?;
+                let record = run_level(&level, self.source, settings)?;
                 progress(&record);
                 runs.push((record, level.dir));
             }
@@ -467,22 +575,24 @@ pub fn run_bench(
                 progress(&record);
                 meshes.push((record, dir));
             }
+            let mut time_step = None;
             if settings.levels > 1 {
-                let counterpart = method
-                    .fixed_counterpart()
-                    .and_then(|c| finest.iter().find(|(m, _, _)| *m == c));
-                if let Some((_, dir, record)) = counterpart {
-                    for (r, _) in &mut runs {
-                        r.reference = false;
-                    }
-                    measure_against(&mut runs, record, dir)?;
-                } else if let Some((record, dir)) = runs.last().cloned() {
-                    measure_against(&mut runs, &record, &dir)?;
-                }
-                if let Some((record, dir)) = runs.last() {
-                    finest.push((method, dir.clone(), record.clone()));
-                }
+                let counterpart = method.fixed_counterpart().and_then(|c| {
+                    references
+                        .iter()
+                        .find(|r| r.method == c)
+                        .and_then(|r| r.time_step.clone())
+                });
+                let other = shared_of(method)
+                    .and_then(|r| r.time_step.clone())
+                    .or(counterpart);
+                time_step = measure_ladder(&mut runs, other)?;
             }
+            references.push(References {
+                method,
+                time_step,
+                pad_mesh: None,
+            });
             ladders.push((method, dir, runs, meshes));
         }
         // The finer pads run after every method's smaller ones, so that no level follows a
@@ -493,32 +603,53 @@ pub fn run_bench(
                     case: mesh_case(&level_case(case, 1.0, *method), MESH_RATIO.pow(k as u32)),
                     dir: dir.join(format!("mesh-{k}")),
                     method: *method,
+                    element: self.element,
                     ladder: Ladder::PadMesh,
                     dt,
                     dt_factor: 1.0,
                     reference: k + 1 == settings.meshes,
                 };
-                let record = run_level(&level, source, settings)?;
+                let record = run_level(&level, self.source, settings)?;
                 progress(&record);
                 meshes.push((record, level.dir));
             }
         }
-        for (_, _, runs, mut meshes) in ladders {
+        let mut records = Vec::new();
+        for ((method, _, runs, mut meshes), refs) in ladders.into_iter().zip(&mut references) {
             records.extend(runs.into_iter().map(|(r, _)| r));
-            if settings.meshes > 1
-                && let Some((record, dir)) = meshes.last().cloned()
-            {
-                measure_against(&mut meshes, &record, &dir)?;
+            if settings.meshes > 1 {
+                let other = shared_of(method).and_then(|r| r.pad_mesh.clone());
+                refs.pad_mesh = measure_ladder(&mut meshes, other)?;
             }
             records.extend(meshes.into_iter().map(|(r, _)| r));
         }
+        Ok((records, references))
     }
-    let path = out.join(BENCH_JSON);
-    let text = serde_json::to_string_pretty(&records).unwrap_or_default();
-    std::fs::create_dir_all(out)
-        .and_then(|()| write_atomic(&path, &text))
-        .map_err(|source| BenchError::Write { path, source })?;
-    Ok(records)
+}
+
+/// Measures the levels `runs` of a ladder against `other` where given (none of them is then
+/// its reference), else against their finest (the last); returns the reference used.
+///
+/// # Errors
+/// As [`measure_against`].
+fn measure_ladder(
+    runs: &mut [RunDir],
+    other: Option<RunDir>,
+) -> Result<Option<RunDir>, BenchError> {
+    let reference = match other {
+        Some(other) => {
+            for (r, _) in runs.iter_mut() {
+                r.reference = false;
+            }
+            other
+        }
+        None => match runs.last() {
+            Some(last) => last.clone(),
+            None => return Ok(None),
+        },
+    };
+    measure_against(runs, &reference.0, &reference.1)?;
+    Ok(Some(reference))
 }
 
 /// A level of a ladder: the case it runs, where, and what its record says of it.
@@ -529,6 +660,8 @@ struct Level {
     dir: PathBuf,
     /// The method it is run by.
     method: BenchMethod,
+    /// The pad element the bench set, if it has an element axis.
+    element: Option<PadFormulation>,
     /// The ladder it belongs to.
     ladder: Ladder,
     /// Its dynamic time step, s.
@@ -702,6 +835,9 @@ fn run_level(
     Ok(BenchRecord {
         case: level.case.name.clone(),
         method: level.method.label().into(),
+        element: level
+            .element
+            .map(|e| e.formulation().abaqus_name(level.case.dimension).into()),
         dt: level.dt,
         dt_factor: Some(level.dt_factor),
         ladder: level.ladder,
@@ -780,7 +916,7 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
                 ("deceleration", r.deceleration_error),
                 ("e_slide", r.e_slide),
             ] {
-                let label = format!("{} ({}): {quantity}", r.case, r.method);
+                let label = format!("{} ({}): {quantity}", r.case, r.variant());
                 let point = (r.wall_time_s, error.unwrap_or(f64::NAN));
                 match series.iter_mut().find(|(l, _)| *l == label) {
                     Some((_, points)) => points.push(point),
@@ -811,7 +947,8 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
          solve; `quasi-static-adaptive`: the same with adaptive increments), and, where asked, \
          at a ladder of pad meshes at its own time step (each level with twice the elements of \
          the last in every direction); the finest level of a case, method and ladder is its \
-         reference, and the adaptive methods' time steps are measured against the finest \
+         reference (with several pad elements, the method's `, CPE4H` etc.: that of the first \
+         element, against which the others are measured), and the adaptive methods' time steps are measured against the finest \
          `case` and `quasi-static` levels where the bench runs them. Wall time: the \
          solver's, median of the timed runs (runs under 2 s: one warm-up, then the repeats). \
          Errors against the reference: the deceleration (relative), e_slide (max |omega - \
@@ -853,7 +990,7 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
             md,
             "| {} | {} | {} | {}{} | {}{} | {} | {} | {:.4} | {} | {:.3} / {:.3} ({}) / {:.3} / {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.case,
-            r.method,
+            r.variant(),
             r.ladder.label(),
             show(Some(r.dt)),
             marked(Ladder::TimeStep),
@@ -961,10 +1098,10 @@ fn within_target(records: &[BenchRecord]) -> String {
             .filter(|r| meets_target(r))
             .map(|r| r.wall_time_s)
             .fold(f64::INFINITY, f64::min);
-        let mut methods: Vec<&str> = of_case.iter().map(|r| r.method.as_str()).collect();
+        let mut methods: Vec<String> = of_case.iter().map(|r| r.variant()).collect();
         methods.dedup();
         for method in methods {
-            let levels = of_case.iter().filter(|r| r.method == method);
+            let levels = of_case.iter().filter(|r| r.variant() == method);
             let cheapest = levels
                 .clone()
                 .filter(|r| meets_target(r))
@@ -1023,11 +1160,11 @@ fn own_time_step(records: &[BenchRecord]) -> String {
          | method | case | status | wall [s] | increments | Newton iterations | t_stop [s] |\n\
          |---|---|---|---|---|---|---|\n",
     );
-    let mut methods: Vec<&str> = own.iter().map(|r| r.method.as_str()).collect();
+    let mut methods: Vec<String> = own.iter().map(|r| r.variant()).collect();
     methods.sort_unstable();
     methods.dedup();
     for method in methods {
-        let rows: Vec<&&BenchRecord> = own.iter().filter(|r| r.method == method).collect();
+        let rows: Vec<&&BenchRecord> = own.iter().filter(|r| r.variant() == method).collect();
         for r in &rows {
             let _ = writeln!(
                 md,
@@ -1117,6 +1254,7 @@ mod tests {
         BenchRecord {
             case: "a".into(),
             method: method.into(),
+            element: None,
             dt,
             dt_factor: None,
             ladder: Ladder::TimeStep,
@@ -1208,6 +1346,7 @@ mod tests {
             repeats: 3,
             methods: vec![BenchMethod::Reduced],
             meshes: 0,
+            elements: Vec::new(),
             isolation: Isolation::InProcess,
         };
         let mut lines = 0;
@@ -1275,6 +1414,47 @@ mod tests {
         ));
     }
 
+    /// With an element axis every method's ladder runs with each pad element, and the later
+    /// elements are measured against the first's reference: none of theirs is one.
+    #[test]
+    fn later_elements_are_measured_against_the_first_elements_reference() {
+        let (case, file) = short_2d_case();
+        let dir = tempfile::tempdir().expect("tempdir");
+        let settings = BenchSettings {
+            levels: 2,
+            ratio: 4.0,
+            coarser: 1,
+            repeats: 1,
+            methods: vec![BenchMethod::Reduced],
+            elements: vec![PadFormulation::Reduced, PadFormulation::Hybrid],
+            ..BenchSettings::default()
+        };
+        let records = run_bench(&[(case, file)], &settings, dir.path(), |_| ()).expect("bench");
+        let elements: Vec<_> = records.iter().map(|r| r.element.as_deref()).collect();
+        assert_eq!(
+            elements,
+            [Some("CPE4R"), Some("CPE4R"), Some("CPE4H"), Some("CPE4H")]
+        );
+        let references: Vec<bool> = records.iter().map(|r| r.reference).collect();
+        assert_eq!(references, [false, true, false, false]);
+        // the hybrid pad's finest level differs from the one-point pad's reference
+        let hybrid_finest = &records[3];
+        assert!(hybrid_finest.deceleration_error.is_some_and(|e| e > 0.0));
+        assert_eq!(hybrid_finest.variant(), "reduced, CPE4H");
+        assert!(
+            dir.path()
+                .join("runs/2d-analytic/hybrid/reduced/1/summary.json")
+                .is_file()
+        );
+        write_bench_report(&records, dir.path()).expect("report");
+        let md = std::fs::read_to_string(dir.path().join(BENCH_MD)).expect("bench.md");
+        let (_, target) = md
+            .split_once("## The cheapest level within the error target")
+            .expect("error-target section");
+        assert!(target.contains("| 2d-analytic | reduced, CPE4R |"), "{md}");
+        assert!(target.contains("| 2d-analytic | reduced, CPE4H |"), "{md}");
+    }
+
     /// The adaptive method runs the case as it is with adaptive increments, and is measured
     /// against the finest level of the case run as written: none of its levels is a reference.
     #[test]
@@ -1301,6 +1481,7 @@ mod tests {
             repeats: 1,
             methods: vec![BenchMethod::Case, BenchMethod::Adaptive],
             meshes: 0,
+            elements: Vec::new(),
             isolation: Isolation::InProcess,
         };
         let records = run_bench(&[(case, file)], &settings, dir.path(), |_| ()).expect("bench");
@@ -1345,6 +1526,7 @@ mod tests {
             repeats: 3,
             methods: vec![BenchMethod::parse("case").expect("method")],
             meshes: 0,
+            elements: Vec::new(),
             isolation: Isolation::InProcess,
         };
         let records = run_bench(&cases, &settings, dir.path(), |_| ()).expect("bench");
@@ -1395,6 +1577,7 @@ mod tests {
             coarser: 0,
             repeats: 1,
             methods: vec![BenchMethod::Reduced],
+            elements: Vec::new(),
             isolation: Isolation::Process {
                 skid: dir.path().join("no-such-skid"),
                 threads: 1,
@@ -1439,6 +1622,7 @@ mod tests {
             repeats: 1,
             methods: vec![BenchMethod::Reduced, BenchMethod::Global],
             meshes: 2,
+            elements: Vec::new(),
             isolation: Isolation::InProcess,
         };
         let mut order = Vec::new();
