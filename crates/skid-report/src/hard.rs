@@ -23,12 +23,16 @@
 //!   with one element through its thickness bends around the drum only through its hourglass
 //!   modes, so there the ratio is the pad's bending (reported, not checked); that its
 //!   stabilisation does not drive the spin-down is checked by varying `pad.hourglass_scale`
-//!   (`scripts/check_drum.py`).
+//!   (`scripts/check_drum.py`);
+//! - **profile**: on a run with field frames, the node-to-node alternation of the pad's contact
+//!   pressure and friction profiles stays below [`PROFILE_ALTERNATION_LIMIT`] of their peak
+//!   ([`crate::pad_profile`]).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::format::{Counts, Sig, percent, plain, show};
+use super::pad_profile::{self, ProfileAlternation};
 use super::plot::{HARD_OMEGA_SVG, plot_normalized_spin_down};
 use super::{ReportError, Run};
 use skid_cases::runner::CASE_JSON;
@@ -68,7 +72,7 @@ pub const FRICTION_TOLERANCE: f64 = 1e-6;
 /// history's ten significant digits leave about 1e-10 per increment.
 pub const MOMENTUM_TOLERANCE: f64 = 1e-6;
 /// The names of the checks, in table order.
-pub const CHECKS: [&str; 8] = [
+pub const CHECKS: [&str; 9] = [
     "outcome",
     "contact",
     "friction",
@@ -77,7 +81,16 @@ pub const CHECKS: [&str; 8] = [
     "drum",
     "post-stop",
     "hourglass",
+    "profile",
 ];
+/// Largest node-to-node alternation of the pad's contact pressure and friction profiles, of
+/// their peak ([`crate::pad_profile`]). Measured: 0.6-1.2 % of the peak pressure on the 40 x 8
+/// pad, all of it the smooth profile's curvature at the contact's edges, where an alternating
+/// pattern of the nodes measures its amplitude.
+pub const PROFILE_ALTERNATION_LIMIT: f64 = 0.03;
+/// Fewest nodes in contact along a row of the face for the profile check: a row shorter than a
+/// few stencils of five cannot tell an alternation from the profile's own shape.
+pub const PROFILE_MIN_NODES: usize = 9;
 
 /// The drum's rocking after the stop, estimated from the pad's shear spring: the friction force
 /// `F = mu p A` has sheared the pad (stiffness `k = G A / h`, initial shear modulus
@@ -213,7 +226,7 @@ pub struct Assessment {
     /// The energy error the energy check used (relative).
     pub energy_error: Option<f64>,
     /// The checks, in the order of [`CHECKS`].
-    pub checks: [Check; 8],
+    pub checks: [Check; 9],
 }
 
 fn outcome(run: &Run, expected: Option<ExpectedFailure>) -> Check {
@@ -375,6 +388,38 @@ fn hourglass(run: &Run, case: &Case) -> Check {
     )
 }
 
+/// The profile check of the pad's contact pressure and friction, from the run's field frames.
+fn profile(measured: Option<&ProfileAlternation>) -> Check {
+    let limit = plain(100.0 * PROFILE_ALTERNATION_LIMIT);
+    let Some(m) = measured else {
+        return Check {
+            verdict: Verdict::NotApplicable,
+            detail: "no field frames (the case sets no output.field_interval)".into(),
+        };
+    };
+    let measured = format!(
+        "over {} frames of the spin-down, rows of up to {} nodes in contact: alternation of the \
+         pressure {} %, of the friction {} % of their peak (limit {limit} %)",
+        m.frames,
+        m.row_nodes,
+        percent(m.pressure),
+        percent(m.friction)
+    );
+    if m.row_nodes < PROFILE_MIN_NODES {
+        return Check {
+            verdict: Verdict::NotApplicable,
+            detail: format!(
+                "{measured}; too few nodes in contact to tell an alternation from the profile's \
+                 shape (checked from {PROFILE_MIN_NODES})"
+            ),
+        };
+    }
+    let ok = [m.pressure, m.friction]
+        .iter()
+        .all(|a| a.is_some_and(|a| within(a, PROFILE_ALTERNATION_LIMIT)));
+    check(ok, measured)
+}
+
 /// The energy check and the relative error it used.
 fn energy(run: &Run, e: &Estimates) -> (Check, Option<f64>) {
     let s = &run.summary;
@@ -501,8 +546,9 @@ fn post_stop(run: &Run, e: &Estimates) -> Check {
     )
 }
 
-/// Assesses `run` against `case`.
-pub fn assess(run: &Run, case: &Case) -> Assessment {
+/// Assesses `run` against `case`, with the alternation of its pad's contact profiles where its
+/// field frames gave them.
+pub fn assess(run: &Run, case: &Case, profiles: Option<&ProfileAlternation>) -> Assessment {
     let e = estimates(case);
     let tolerance = case
         .expect
@@ -533,6 +579,7 @@ pub fn assess(run: &Run, case: &Case) -> Assessment {
             drum_check,
             post_stop_check,
             hourglass(run, case),
+            profile(profiles),
         ],
     }
 }
@@ -598,7 +645,10 @@ pub fn section(
                       skid run writes there; run the case again"
                 .into(),
         })?;
-        assessed.push((run, case, assess(run, case)));
+        let fields = dir.join(&run.name).join("fields");
+        let until = run.summary.t_stop.unwrap_or(f64::INFINITY);
+        let profiles = pad_profile::measure(&fields, until)?;
+        assessed.push((run, case, assess(run, case, profiles.as_ref())));
     }
     let plot = plot_dir.join(HARD_OMEGA_SVG);
     let normalized: Vec<(&Run, f64)> = assessed
@@ -657,7 +707,14 @@ pub fn section(
          energy already in the frictionless preload, in proportion to the stabilisation \
          stiffness), so there the ratio is reported, not checked (n/a); instead \
          `scripts/check_drum.py` checks that halving or doubling `pad.hourglass_scale` leaves \
-         the 2D and 3D spin-down unchanged.\n\n\
+         the 2D and 3D spin-down unchanged;\n\
+         - **profile**: on a run with field frames (`output.field_interval`), along every row \
+         of the pad's front face in each frame of the spin-down, the node-to-node alternation \
+         of the contact pressure and friction, max |f_(i-2) - 4 f_(i-1) + 6 f_i - 4 f_(i+1) + \
+         f_(i+2)| / 16 over five consecutive nodes in contact, is at most {profile} % of the \
+         frame's peak (an alternating +A, -A, ... measures A; the smooth profile its fourth \
+         derivative's share); not applicable to rows of fewer than {profile_nodes} nodes in \
+         contact.\n\n\
          ![omega / omega0 against t / t_est: every run with friction, and the estimate \
          1 - t / t_est]({HARD_OMEGA_SVG})\n\n",
         dir = dir.display(),
@@ -669,6 +726,8 @@ pub fn section(
         spin = Sig(OMEGA_CONSTANCY),
         hourglass = plain(100.0 * HOURGLASS_LIMIT),
         layers = HOURGLASS_MIN_LAYERS,
+        profile = plain(100.0 * PROFILE_ALTERNATION_LIMIT),
+        profile_nodes = PROFILE_MIN_NODES,
     );
     table(&assessed, &mut out);
     out.push_str("\n### The cases\n");
@@ -746,10 +805,48 @@ mod tests {
         assert_eq!(estimates(&case(&["back_plate.pressure=0"])).t_stop, None);
     }
 
+    /// The profiles of a refined pad: rows of 27 nodes in contact, alternation 1 % of the peak.
+    fn smooth_profile() -> ProfileAlternation {
+        ProfileAlternation {
+            frames: 4,
+            row_nodes: 27,
+            pressure: Some(0.012),
+            friction: Some(0.011),
+        }
+    }
+
+    #[test]
+    fn the_profile_check_fails_an_alternating_profile_and_skips_short_rows() {
+        assert_eq!(profile(None).verdict, Verdict::NotApplicable);
+        assert_eq!(profile(Some(&smooth_profile())).verdict, Verdict::Pass);
+        let zigzag = ProfileAlternation {
+            friction: Some(0.08),
+            ..smooth_profile()
+        };
+        let c = profile(Some(&zigzag));
+        assert_eq!(c.verdict, Verdict::Fail);
+        assert!(c.detail.contains("of the friction 8.000 %"), "{}", c.detail);
+        let unmeasured = ProfileAlternation {
+            pressure: None,
+            ..smooth_profile()
+        };
+        assert_eq!(profile(Some(&unmeasured)).verdict, Verdict::Fail);
+        let short = ProfileAlternation {
+            row_nodes: 6,
+            pressure: Some(0.2),
+            ..smooth_profile()
+        };
+        assert_eq!(profile(Some(&short)).verdict, Verdict::NotApplicable);
+    }
+
     #[test]
     fn a_run_that_behaves_as_estimated_passes_every_check() {
         let run = spin_down("2d-x", 600.0 / 1.007);
-        let a = assess(&run, &case(&["pad.elements.radial=8"]));
+        let a = assess(
+            &run,
+            &case(&["pad.elements.radial=8"]),
+            Some(&smooth_profile()),
+        );
         assert_eq!(verdicts(&a), vec![Verdict::Pass; CHECKS.len()], "{a:#?}");
         assert!((a.deviation.expect("stops") - 0.007).abs() < 1e-9);
     }
@@ -758,7 +855,7 @@ mod tests {
     fn each_check_fails_on_its_own_defect() {
         let c = case(&["pad.elements.radial=8"]);
         let failing = |run: &Run| -> Vec<&'static str> {
-            let a = assess(run, &c);
+            let a = assess(run, &c, None);
             CHECKS
                 .iter()
                 .zip(&a.checks)
@@ -789,7 +886,7 @@ mod tests {
             "expect.t_stop_estimate_tolerance=0.03",
         ]);
         assert!(
-            assess(&run, &loose)
+            assess(&run, &loose, Some(&smooth_profile()))
                 .checks
                 .iter()
                 .all(|c| c.verdict == Verdict::Pass)
@@ -810,7 +907,7 @@ mod tests {
         let mut run = spin_down("x", 600.0);
         run.history.contact[10].normal_force *= 1.0 + 1e-5;
         assert!(failing(&run).is_empty());
-        let a = assess(&run, &c);
+        let a = assess(&run, &c, None);
         assert!(
             named(&a, "friction")
                 .detail
@@ -830,7 +927,7 @@ mod tests {
     fn the_hourglass_limit_applies_from_two_elements_through_the_thickness() {
         let mut run = spin_down("x", 600.0);
         run.summary.max_hourglass_ratio = Some(0.011);
-        let single = assess(&run, &case(&[]));
+        let single = assess(&run, &case(&[]), None);
         assert_eq!(named(&single, "hourglass").verdict, Verdict::NotApplicable);
         assert!(
             named(&single, "hourglass").detail.contains("1.100 %"),
@@ -838,12 +935,12 @@ mod tests {
         );
         let layered = case(&["pad.elements.radial=2"]);
         assert_eq!(
-            named(&assess(&run, &layered), "hourglass").verdict,
+            named(&assess(&run, &layered, None), "hourglass").verdict,
             Verdict::Fail
         );
         run.summary.max_hourglass_ratio = Some(0.009);
         assert_eq!(
-            named(&assess(&run, &layered), "hourglass").verdict,
+            named(&assess(&run, &layered, None), "hourglass").verdict,
             Verdict::Pass
         );
     }
@@ -856,7 +953,7 @@ mod tests {
         run.summary.error = Some("element 0 inverted (J = -1e-7 at corner 3)".into());
         run.summary.failure = Some("inverted element".into());
         run.summary.t_stop = None;
-        let a = assess(&run, &expects);
+        let a = assess(&run, &expects, None);
         // outcome, contact, friction, momentum, energy; drum, post-stop, hourglass n/a
         let expected = [
             Verdict::Pass,
@@ -867,12 +964,13 @@ mod tests {
             Verdict::NotApplicable,
             Verdict::NotApplicable,
             Verdict::NotApplicable,
+            Verdict::NotApplicable,
         ];
         assert_eq!(verdicts(&a), expected, "{a:#?}");
         assert!(named(&a, "outcome").detail.contains("corner 3"), "{a:#?}");
         // Another failure, a completed run, or NaN in the history fail the outcome.
         run.summary.failure = Some("newton not converged".into());
-        let a = assess(&run, &expects);
+        let a = assess(&run, &expects, None);
         assert_eq!(named(&a, "outcome").verdict, Verdict::Fail);
         assert!(
             named(&a, "outcome")
@@ -880,7 +978,7 @@ mod tests {
                 .contains("expected to stop with inverted element")
         );
         let completed = spin_down("x", 600.0);
-        let a = assess(&completed, &expects);
+        let a = assess(&completed, &expects, None);
         assert_eq!(named(&a, "outcome").verdict, Verdict::Fail);
         assert!(
             named(&a, "outcome").detail.contains("out of date"),
@@ -889,14 +987,14 @@ mod tests {
         run.summary.failure = Some("inverted element".into());
         run.history.non_finite = 2;
         assert_eq!(
-            named(&assess(&run, &expects), "outcome").verdict,
+            named(&assess(&run, &expects, None), "outcome").verdict,
             Verdict::Fail
         );
         // The run's energy balance is still checked.
         run.history.non_finite = 0;
         run.summary.energy_balance_error = Some(0.02);
         assert_eq!(
-            named(&assess(&run, &expects), "energy").verdict,
+            named(&assess(&run, &expects, None), "energy").verdict,
             Verdict::Fail
         );
     }
@@ -906,13 +1004,13 @@ mod tests {
         let c = case(&[]);
         let mut run = spin_down("x", 300.0);
         run.summary.t_stop = None;
-        let a = assess(&run, &c);
+        let a = assess(&run, &c, None);
         assert_eq!(named(&a, "drum").verdict, Verdict::Fail);
         assert!(named(&a, "drum").detail.contains("did not stop"), "{a:#?}");
         assert_eq!(named(&a, "post-stop").verdict, Verdict::Fail);
         // Stops at 0.14 s of a 0.15 s run: 10 ms of rocking, less than a period.
         let run = spin_down("x", 60.0 / 0.14);
-        let a = assess(&run, &c);
+        let a = assess(&run, &c, None);
         assert_eq!(named(&a, "post-stop").verdict, Verdict::Fail);
         assert!(
             named(&a, "post-stop").detail.contains("rocking period"),
@@ -926,7 +1024,7 @@ mod tests {
         let mut run = spin_down("x", 0.0);
         run.summary.energy_balance_error = None;
         run.summary.energy_balance_residual_j = Some(1e-8);
-        let a = assess(&run, &c);
+        let a = assess(&run, &c, None);
         // outcome, contact, friction, momentum, energy, drum; post-stop, hourglass n/a
         let expected = [
             Verdict::Pass,
@@ -937,13 +1035,14 @@ mod tests {
             Verdict::Pass,
             Verdict::NotApplicable,
             Verdict::NotApplicable,
+            Verdict::NotApplicable,
         ];
         assert_eq!(verdicts(&a), expected, "{a:#?}");
         assert!((a.energy_error.expect("energy") - 1e-8 / 315.0).abs() < 1e-18);
         // A drift of 1e-8 relative, and a residual of 4 J (1.3 % of 315 J), fail.
         run.history.omega[100] = 60.0 * (1.0 + 1e-8);
         run.summary.energy_balance_residual_j = Some(-4.0);
-        let a = assess(&run, &c);
+        let a = assess(&run, &c, None);
         assert_eq!(named(&a, "energy").verdict, Verdict::Fail);
         assert_eq!(named(&a, "drum").verdict, Verdict::Fail);
     }
@@ -980,7 +1079,8 @@ mod tests {
             row("2d-good")
         );
         assert!(
-            row("2d-late").ends_with("| PASS | PASS | PASS | PASS | PASS | FAIL | PASS | n/a |")
+            row("2d-late")
+                .ends_with("| PASS | PASS | PASS | PASS | PASS | FAIL | PASS | n/a | n/a |")
         );
         assert!(text.contains("Expectation: why it differs"), "{text}");
         assert!(

@@ -25,6 +25,7 @@
 //! This module: reading runs, and the comparison math (interpolation, `e_slide`); [`mod@format`]:
 //! number formatting and check lists shared by the sections.
 
+pub mod alternation;
 pub mod bench;
 pub mod block_on_flat;
 pub mod convergence;
@@ -34,6 +35,7 @@ pub mod hertz;
 pub mod markdown;
 pub mod model_run;
 pub mod moved_block;
+pub mod pad_profile;
 pub mod plot;
 pub mod pressure_limit;
 pub mod scaling;

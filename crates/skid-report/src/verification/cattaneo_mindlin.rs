@@ -17,7 +17,7 @@
 //!   the contact totals); `c_FE` is half the reference distance between the outermost sticking
 //!   nodes, short of or beyond the discrete stick edge by up to the element there, `h_c`;
 //! - profile error: the RMS of `(q_i - q(x_i)) / (mu p0)` over the nodes with `|x| <= a`;
-//! - alternation ([`alternation`]): the node-to-node (checkerboard) part of the error
+//! - alternation ([`second_difference`]): the node-to-node (checkerboard) part of the error
 //!   `e_i = q_i - q(x_i)`, `A_q = max |e_(i-1) - 2 e_i + e_(i+1)| / 4` over the nodes that stick
 //!   with both neighbours, all three inside `|x| < c`, over `mu p0`. A pattern `+A, -A, +A, ...`
 //!   measures `A`; a smooth error measures its second difference `h^2 e'' / 4`; the kinks of
@@ -38,6 +38,7 @@ use std::path::Path;
 
 use super::SceneRun;
 use crate::ReportError;
+use crate::alternation::second_difference;
 use crate::format::{Checks, Sig, percent};
 use crate::hertz::{self, CandidateNode, HertzScene};
 use crate::plot::{MINDLIN_SVG, plot_mindlin_traction};
@@ -241,16 +242,6 @@ pub fn measure(nodes: &[CandidateNode], thickness: f64, mu: f64) -> Result<Mindl
     })
 }
 
-/// The node-to-node part of `errors`: `max |e_(i-1) - 2 e_i + e_(i+1)| / 4` over the `i` with
-/// `counted` at `i - 1`, `i` and `i + 1`; `None` if there is none. An alternating
-/// `+A, -A, +A, ...` gives `A`, an affine error 0.
-pub fn alternation(errors: &[f64], counted: &[bool]) -> Option<f64> {
-    (1..errors.len().saturating_sub(1))
-        .filter(|&i| counted[i - 1] && counted[i] && counted[i + 1])
-        .map(|i| (errors[i - 1] - 2.0 * errors[i] + errors[i + 1]).abs() / 4.0)
-        .reduce(f64::max)
-}
-
 impl MindlinMeasure {
     /// RMS of `(q_FE - q) / (mu p0)` over the nodes with `|x| <= a`.
     pub fn profile_error(&self, scene: &MindlinScene) -> Option<f64> {
@@ -281,7 +272,7 @@ impl MindlinMeasure {
             .iter()
             .map(|s| s.sticks && s.x.abs() < c)
             .collect();
-        alternation(&errors, &sticks).map(|v| v / (scene.mu * scene.hertz.peak_pressure()))
+        second_difference(&errors, &sticks).map(|v| v / (scene.mu * scene.hertz.peak_pressure()))
     }
 
     /// `A_p`, of `p0`.
@@ -292,7 +283,7 @@ impl MindlinMeasure {
             .map(|s| s.pressure - scene.hertz.pressure(s.x))
             .collect();
         let closed: Vec<bool> = self.nodes.iter().map(|s| s.closed).collect();
-        alternation(&errors, &closed).map(|v| v / scene.hertz.peak_pressure())
+        second_difference(&errors, &closed).map(|v| v / scene.hertz.peak_pressure())
     }
 }
 
@@ -583,16 +574,6 @@ mod tests {
             .collect();
         let m = measure(&flipped, s.hertz.thickness, s.mu).expect("measurable");
         assert!((m.traction_alternation(&s).expect("sticks") - 0.04).abs() < 1e-9);
-    }
-
-    #[test]
-    fn alternation_ignores_affine_errors_and_uncounted_nodes() {
-        let affine: Vec<f64> = (0..6).map(|i| 0.5 + 0.1 * f64::from(i)).collect();
-        assert!(alternation(&affine, &[true; 6]).expect("counted") < 1e-15);
-        let zigzag = [1.0, -1.0, 1.0, -1.0];
-        assert_eq!(alternation(&zigzag, &[true; 4]), Some(1.0));
-        assert_eq!(alternation(&zigzag, &[true, true, false, true]), None);
-        assert_eq!(alternation(&[1.0], &[true]), None);
     }
 
     #[test]
