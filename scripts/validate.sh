@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The drum validation: builds skid (release); runs every drum idealization of cases/drum and
 # every hard case of cases/hard in parallel, and the convergence study (scripts/convergence.sh);
-# runs the verification scenes of cases/verification (block on a flat and an incline, Hertz);
+# runs the verification scenes of cases/verification (blocks on a flat and an incline, Hertz,
+# Cattaneo-Mindlin, Cook's membrane, compression);
 # writes the report validation/report.md (benchmark, hard cases, convergence, verification, and
 # the last measured scaling study, stress sweep and pad failure loads of validation/) with its
 # plots;
