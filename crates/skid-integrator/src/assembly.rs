@@ -19,7 +19,10 @@ use crate::loads::LoadInstant;
 use crate::mixed::MixedPressures;
 use crate::model::Model;
 use crate::orientation::{Orientation, orientation};
-use crate::sparse::{Factorization, PatternBuilder, SparsePattern, diagonal, symmetric_times};
+use crate::sparse::{
+    Factorization, IndefiniteFactorization, PatternBuilder, SparsePattern, diagonal,
+    symmetric_times,
+};
 
 /// Below this many elements the element loop runs sequentially (threads cost more than they
 /// save on tiny meshes).
@@ -423,11 +426,44 @@ impl Assembler {
         factor
     }
 
-    /// Whether the current matrix `K` (held equations already identity rows) is positive
-    /// definite and holds every motion: it factorizes, and the lowest eigenvalue of
-    /// `K y = lambda M y` on the equations not held, estimated by [`INVERSE_ITERATIONS`] steps of
-    /// inverse iteration (`y <- K^{-1} M y`, then the Rayleigh quotient `y.K y / y.M y`), is
-    /// above [`SINGULAR_RATIO`] times the largest `K_ii / M_ii`.
+    /// Factorizes the current effective tangent as `L D L^T`, which may be indefinite (see
+    /// [`SparsePattern::factorize_indefinite`]).
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] if it is singular or not finite.
+    pub fn factorize_indefinite(&mut self) -> Result<IndefiniteFactorization, IncrementFailure> {
+        self.factorizations += 1;
+        let clock = Instant::now();
+        self.pattern.compress(&self.values, &mut self.compressed)?;
+        let factor = self.pattern.factorize_indefinite(&self.compressed);
+        self.factorization_time += clock.elapsed();
+        factor
+    }
+
+    /// Factorizes the current effective tangent by Cholesky, or where it is not positive
+    /// definite by `L D L^T` (two factorizations then).
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] if it is singular or not finite.
+    pub fn factorize_symmetric(&mut self) -> Result<Solver, IncrementFailure> {
+        match self.factorize() {
+            Ok(factor) => Ok(Solver::Definite(factor)),
+            Err(e) if is_not_factorized(&e) => self.factorize_indefinite().map(Solver::Indefinite),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// Whether the current matrix `K` (held equations already identity rows) holds every
+    /// motion: it factorizes (by Cholesky, or where it is indefinite by `L D L^T`), and the
+    /// eigenvalue of least magnitude of `K y = lambda M y` on the equations not held, estimated
+    /// by [`INVERSE_ITERATIONS`] steps of inverse iteration (`y <- K^{-1} M y`, then the Rayleigh
+    /// quotient `y.K y / y.M y`), is above [`SINGULAR_RATIO`] times the largest `K_ii / M_ii` in
+    /// magnitude.
+    ///
+    /// An indefinite `K` that holds every motion is a compressed solid's tangent at an iterate
+    /// that has not relaxed yet (the top of a block moved down, the rest still in place, a
+    /// volumetric stress far above the shear modulus): Newton's step with it is the consistent
+    /// one, which converges quadratically once the iterate is near the solution.
     ///
     /// A motion no support or stiffness holds (a pad held only by its contacts, a body on
     /// rollers free to slide) is an eigenvalue of round-off size, `eps max K_ii / M_ii`; Cholesky
@@ -446,12 +482,9 @@ impl Assembler {
         mass: &DVector<f64>,
         held: &[bool],
     ) -> Result<bool, IncrementFailure> {
-        let factor = match self.factorize() {
+        let factor = match self.factorize_symmetric() {
             Ok(factor) => factor,
-            Err(IncrementFailure::LinearSolve {
-                failure: LinearFailure::NotPositiveDefinite | LinearFailure::Singular,
-                ..
-            }) => return Ok(false),
+            Err(e) if is_not_factorized(&e) => return Ok(false),
             Err(e) => return Err(e),
         };
         let k = self.lower_triangle()?;
@@ -496,7 +529,7 @@ impl Assembler {
             symmetric_times(k, y.as_slice(), &mut k_y);
             lowest = y.iter().zip(&k_y).map(|(a, b)| a * b).sum::<f64>();
         }
-        Ok(lowest > SINGULAR_RATIO * scale)
+        Ok(lowest.abs() > SINGULAR_RATIO * scale)
     }
 
     /// Runs `solve` (which factorizes the current matrix) on `K + c_k M` (the current values
@@ -532,10 +565,11 @@ impl Assembler {
         loop {
             match solve(self) {
                 Ok(result) => return Ok((result, c)),
-                Err(IncrementFailure::LinearSolve {
-                    failure: LinearFailure::NotPositiveDefinite | LinearFailure::Singular,
-                    ..
-                }) if decades < MAX_SHIFT_DECADES && c.max(first) > 0.0 => {
+                Err(e)
+                    if is_not_factorized(&e)
+                        && decades < MAX_SHIFT_DECADES
+                        && c.max(first) > 0.0 =>
+                {
                     let next = if c > 0.0 { 10.0 * c } else { first };
                     self.add_diagonal(&(mass * (next - c)));
                     self.hold(held);
@@ -544,6 +578,36 @@ impl Assembler {
                 }
                 Err(e) => return Err(e),
             }
+        }
+    }
+}
+
+/// Whether a failure is a matrix that has no factor of the kind asked for (not positive
+/// definite, or singular), rather than one that is not finite.
+pub fn is_not_factorized(e: &IncrementFailure) -> bool {
+    matches!(
+        e,
+        IncrementFailure::LinearSolve {
+            failure: LinearFailure::NotPositiveDefinite | LinearFailure::Singular,
+            ..
+        }
+    )
+}
+
+/// A factorization of the tangent, by Cholesky or, where it is indefinite, `L D L^T`.
+pub enum Solver {
+    /// `K = L L^T`.
+    Definite(Factorization),
+    /// `K = L D L^T`.
+    Indefinite(IndefiniteFactorization),
+}
+
+impl Solver {
+    /// Solves `K x = b`.
+    pub fn solve(&self, b: &DVector<f64>) -> DVector<f64> {
+        match self {
+            Self::Definite(f) => f.solve(b),
+            Self::Indefinite(f) => f.solve(b),
         }
     }
 }

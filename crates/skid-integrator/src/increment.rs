@@ -28,10 +28,13 @@
 //! [`Assembler::is_held`]), so that Newton converges quadratically; otherwise `K_T + M/h_s^2`.
 //! That mass term only regularises the Newton step (it keeps a pad that is not yet held by
 //! contact from being singular, at the price of a linear rate); it is not in the residual, so
-//! the converged state is exactly static. Where the tangent without contact is indefinite, the
-//! mass term of either matrix grows tenfold at a time (from `M/h_s^2` for a static tangent
-//! without one) until it can be factorized (see [`Assembler::with_mass_shift`]), which again
-//! changes only Newton's path.
+//! the converged state is exactly static. A static increment on the consistent tangent without
+//! contacts keeps that tangent where it is indefinite (a compressed solid's iterate that has
+//! not relaxed yet), factored as `L D L^T`, so that its rate stays quadratic. Elsewhere, where
+//! the tangent without contact is indefinite (the Cholesky-based contact reduction needs a
+//! definite one) or singular, the mass term of either matrix grows tenfold at a time (from
+//! `M/h_s^2` for a static tangent without one) until it can be factorized (see
+//! [`Assembler::with_mass_shift`]), which again changes only Newton's path.
 //!
 //! Stiffness damping (a section's `beta`, see [`crate::assembly::Damping`]) is part of `F` in
 //! a dynamic increment, `F = f_int + beta K_T (x - x_n)/h - f_ext`, weighted and stored as the
@@ -58,7 +61,9 @@ use std::time::{Duration, Instant};
 use nalgebra::{DVector, Vector2};
 use skid_contact::SurfacePoint;
 
-use crate::assembly::{Assembler, Damping, InternalState, external_forces};
+use crate::assembly::{
+    Assembler, Damping, InternalState, Solver, external_forces, is_not_factorized,
+};
 use crate::contact_rows::{ContactRows, RowStart, contact_rows};
 use crate::cost::{SolveCounts, Timings};
 use crate::coupling::contact_step;
@@ -636,8 +641,26 @@ fn solve_increment_with<const D: usize>(
         // indefinite. The residual keeps the true inertia, so only Newton's path changes.
         let dx = if rows.is_empty() {
             let clock = Instant::now();
-            let (factor, _) =
-                assembler.with_mass_shift(shift_mass, shift, held, |a| a.factorize())?;
+            // A static step on the consistent tangent keeps it where it is indefinite (see
+            // `Assembler::is_held`); the mass shift is left for a singular one.
+            let consistent = matches!(kind, IncrementKind::Static { .. }) && m_factor == 0.0;
+            let symmetric = if consistent {
+                match assembler.factorize_symmetric() {
+                    Ok(factor) => Some(factor),
+                    Err(e) if is_not_factorized(&e) => None,
+                    Err(e) => return Err(e),
+                }
+            } else {
+                None
+            };
+            let factor = match symmetric {
+                Some(factor) => factor,
+                None => Solver::Definite(
+                    assembler
+                        .with_mass_shift(shift_mass, shift, held, |a| a.factorize())?
+                        .0,
+                ),
+            };
             let dx = factor.solve(&(-&residual));
             timings.linear_solve += clock.elapsed();
             last = Some(LastForces::Linearised {

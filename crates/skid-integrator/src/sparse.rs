@@ -11,16 +11,21 @@
 //! Cholesky factor of the Schur complement `S = K_CC - K_CI K_II^{-1} K_IC`, and by the block
 //! inverse formula `(K^{-1})_CC = S^{-1} = L_CC^{-T} L_CC^{-1}`: a dense inverse of the size of
 //! `C`, instead of `|C|` sparse solves with the whole factor.
+//!
+//! A symmetric indefinite matrix (a compressed solid's tangent before its iterate has relaxed)
+//! has no Cholesky factor; [`SparsePattern::factorize_indefinite`] factors it as
+//! `P K P^T = L D L^T` (`D` diagonal of either sign, no pivoting) on the same analysis.
 
 use std::sync::{Arc, OnceLock};
 
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
-    factorize_symbolic_cholesky,
+    CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
+    SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, MatMut, MatRef, Side};
@@ -211,6 +216,70 @@ impl SparsePattern {
             n: self.n,
             trailing_inverse: OnceLock::new(),
         })
+    }
+
+    /// Numeric `K = L D L^T` factorization without pivoting (`D` diagonal, of either sign) of
+    /// the matrix of compressed values `compressed`, for a symmetric matrix that may be
+    /// indefinite, reusing the symbolic analysis.
+    ///
+    /// # Errors
+    /// [`IncrementFailure::LinearSolve`] with [`LinearFailure::Singular`] for a zero pivot or a
+    /// factor that is not finite.
+    pub fn factorize_indefinite(
+        &self,
+        compressed: &[f64],
+    ) -> Result<IndefiniteFactorization, IncrementFailure> {
+        let matrix = self.matrix(compressed);
+        let par = faer::get_global_parallelism();
+        let mut factor = vec![0.0; self.analysis.len_val()];
+        let mut scratch = MemBuffer::new(
+            self.analysis
+                .factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
+        );
+        let singular = || IncrementFailure::linear(TANGENT, LinearFailure::Singular);
+        self.analysis
+            .factorize_numeric_ldlt(
+                &mut factor,
+                matrix,
+                Side::Lower,
+                LdltRegularization::default(),
+                par,
+                MemStack::new(&mut scratch),
+                Default::default(),
+            )
+            .map_err(|_| singular())?;
+        if factor.iter().any(|v| !v.is_finite()) {
+            return Err(singular());
+        }
+        Ok(IndefiniteFactorization {
+            analysis: Arc::clone(&self.analysis),
+            factor,
+            n: self.n,
+        })
+    }
+}
+
+/// A numeric `L D L^T` factorization of a symmetric, possibly indefinite matrix (see
+/// [`SparsePattern::factorize_indefinite`]).
+pub struct IndefiniteFactorization {
+    analysis: Arc<SymbolicCholesky<usize>>,
+    factor: Vec<f64>,
+    n: usize,
+}
+
+impl IndefiniteFactorization {
+    /// Solves `K x = b`.
+    pub fn solve(&self, b: &DVector<f64>) -> DVector<f64> {
+        let mut rhs = Mat::<f64>::from_fn(self.n, 1, |i, _| b[i]);
+        let par = faer::get_global_parallelism();
+        let mut scratch = MemBuffer::new(self.analysis.solve_in_place_scratch::<f64>(1, par));
+        LdltRef::new(&self.analysis, &self.factor).solve_in_place_with_conj(
+            Conj::No,
+            rhs.as_mut(),
+            par,
+            MemStack::new(&mut scratch),
+        );
+        DVector::from_fn(self.n, |i, _| rhs[(i, 0)])
     }
 }
 
@@ -482,5 +551,55 @@ mod tests {
         ));
         values[b] = f64::NAN;
         assert!(factorize_slots(&pattern, &values).is_err());
+    }
+
+    /// A symmetric indefinite tridiagonal matrix (diagonal alternating in sign) has no Cholesky
+    /// factor but an `L D L^T` one, which solves it; a zero matrix is singular for it too.
+    #[test]
+    fn indefinite_matrix_factors_as_ldlt_and_solves() {
+        let n = 6;
+        let mut builder = PatternBuilder::default();
+        let mut slots = Vec::new();
+        for i in 0..n {
+            slots.push((i, i, builder.push(i, i)));
+            if i + 1 < n {
+                slots.push((i + 1, i, builder.push(i + 1, i)));
+            }
+        }
+        let pattern = SparsePattern::new(n, builder, &[]).expect("pattern");
+        let entry = |i: usize, j: usize| {
+            if i == j {
+                if i.is_multiple_of(2) { 3.0 } else { -2.0 }
+            } else {
+                1.0
+            }
+        };
+        let mut values = vec![0.0; pattern.slots()];
+        for &(i, j, slot) in &slots {
+            values[slot] = entry(i, j);
+        }
+        assert!(factorize_slots(&pattern, &values).is_err());
+        let mut compressed = Vec::new();
+        pattern.compress(&values, &mut compressed).expect("finite");
+        let factor = pattern.factorize_indefinite(&compressed).expect("LDL^T");
+        let b = DVector::from_fn(n, |i, _| 1.0 + i as f64);
+        let x = factor.solve(&b);
+        let k = DMatrix::from_fn(n, n, |i, j| {
+            if i.abs_diff(j) <= 1 {
+                entry(i.max(j), i.min(j))
+            } else {
+                0.0
+            }
+        });
+        assert!((&k * &x - &b).amax() < 1e-12 * b.amax(), "{x}");
+        let zero = vec![0.0; pattern.slots()];
+        pattern.compress(&zero, &mut compressed).expect("finite");
+        assert!(matches!(
+            pattern.factorize_indefinite(&compressed),
+            Err(IncrementFailure::LinearSolve {
+                failure: LinearFailure::Singular,
+                ..
+            })
+        ));
     }
 }
