@@ -30,8 +30,7 @@
 //!   incompressible;
 //! - a neo-Hookean block on rollers compressed homogeneously ([`compression`]), one run per
 //!   element formulation: its reaction and lateral stretch against the closed form in every
-//!   increment, to 50 % compression (the incompatible-mode elements as far as they carry, a
-//!   known gap), and its Newton iterations per increment.
+//!   increment, to 50 % compression, and its Newton iterations per increment.
 
 pub mod cattaneo_mindlin;
 pub mod compression;
