@@ -29,7 +29,7 @@ use std::path::Path;
 use super::ReportError;
 use skid_cases::csv_out::CsvTable;
 use skid_cases::model_spec::ModelSpec;
-use skid_cases::model_spec::{LoadSpec, RigidSurfaceSpec};
+use skid_cases::model_spec::{ContactPairSpec, LoadSpec, RigidBodySpec, RigidSurfaceSpec};
 use skid_cases::schema::MaterialSpec;
 
 /// A Hertz scene: what its analytic answer needs.
@@ -54,13 +54,7 @@ impl HertzScene {
     /// is a rigid cylinder, that cylinder loaded by one concentrated force and no other load,
     /// one static step, a polynomial material.
     pub fn recognise(spec: &ModelSpec) -> Option<Self> {
-        let [pair] = spec.contact.as_slice() else {
-            return None;
-        };
-        let body = spec.rigid_bodies.iter().find(|b| b.name == pair.master)?;
-        let Some(RigidSurfaceSpec::Cylinder { radius, .. }) = body.surface else {
-            return None;
-        };
+        let (pair, body, radius) = cylinder_pair(spec)?;
         let [
             LoadSpec::Concentrated {
                 body: Some(loaded),
@@ -122,6 +116,19 @@ impl HertzScene {
         let s = x / self.half_width();
         self.peak_pressure() * (1.0 - s * s).max(0.0).sqrt()
     }
+}
+
+/// The model's only contact pair, if its master is a rigid cylinder: the pair, the body and
+/// the cylinder's radius.
+pub fn cylinder_pair(spec: &ModelSpec) -> Option<(&ContactPairSpec, &RigidBodySpec, f64)> {
+    let [pair] = spec.contact.as_slice() else {
+        return None;
+    };
+    let body = spec.rigid_bodies.iter().find(|b| b.name == pair.master)?;
+    let Some(RigidSurfaceSpec::Cylinder { radius, .. }) = body.surface else {
+        return None;
+    };
+    Some((pair, body, radius))
 }
 
 /// A contact candidate at the end of the run, from `contact_nodes.csv`.

@@ -44,7 +44,7 @@ use crate::hertz::{self, CandidateNode, HertzScene};
 use crate::plot::{MINDLIN_SVG, plot_mindlin_traction};
 use crate::read;
 use skid_cases::model_file::contact_nodes::CONTACT_NODES_CSV;
-use skid_cases::model_spec::{LoadSpec, ModelSpec, ModelStepSpec, RigidSurfaceSpec};
+use skid_cases::model_spec::{LoadSpec, ModelSpec, ModelStepSpec};
 
 /// Largest RMS of `(q_FE - q) / (mu p0)` over the contact. Measured: 1.7-2.3 % on CPE4R,
 /// CPE4H and CPE4I at 8 and 16 elements per half-width; what remains is mostly the finite
@@ -79,13 +79,7 @@ impl MindlinScene {
     /// y (the normal `P`) in both steps at full value, one along x (`Q`) only in the second,
     /// with `Q < mu P`.
     pub fn recognise(spec: &ModelSpec) -> Option<Self> {
-        let [pair] = spec.contact.as_slice() else {
-            return None;
-        };
-        let body = spec.rigid_bodies.iter().find(|b| b.name == pair.master)?;
-        let Some(RigidSurfaceSpec::Cylinder { radius, .. }) = body.surface else {
-            return None;
-        };
+        let (pair, body, radius) = hertz::cylinder_pair(spec)?;
         let [ModelStepSpec::Static { .. }, ModelStepSpec::Static { .. }] = spec.steps.as_slice()
         else {
             return None;
