@@ -37,6 +37,7 @@ pub mod compression;
 pub mod cook;
 pub mod coulomb;
 pub mod free_rotation;
+mod friction_rows;
 mod reactions;
 pub mod rolling;
 

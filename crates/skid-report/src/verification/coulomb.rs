@@ -23,43 +23,21 @@
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::path::Path;
 
 use super::SceneRun;
+use super::friction_rows::{BALANCE_TOLERANCE, FrictionRow, friction_rows};
 use super::reactions::{self, MovedRun};
 use crate::ReportError;
 use crate::block_on_flat::BlockOnFlat;
 use crate::format::{Checks, percent, show};
 use crate::moved_block::MovedBlock;
 use crate::read;
-use skid_cases::csv_out::CsvTable;
 use skid_cases::model_spec::{ContactPairSpec, ModelSpec};
 
 /// Relative tolerance of the Coulomb checks (the history carries 10 significant digits).
 pub const COULOMB_TOLERANCE: f64 = 1e-6;
-/// Largest difference between the resultants of a sticking block and its held loads, as a
-/// fraction of `mu N` (measured: 6e-7 on the pushed block at half of `mu N`, 4e-10 on the
-/// incline at 0.995 of its threshold).
-pub const BALANCE_TOLERANCE: f64 = 1e-5;
 /// Largest distance from `r = 1` of the runs that bracket a family's stick/slip threshold.
 pub const THRESHOLD_BRACKET: f64 = 0.01;
-
-/// A pair's resultants in one increment of the history.
-pub(super) struct FrictionRow {
-    pub time: f64,
-    pub normal: f64,
-    /// The friction resultant's components in the surface's tangent directions.
-    pub tangential: Vec<f64>,
-    pub active: usize,
-    pub sliding: usize,
-}
-
-impl FrictionRow {
-    /// `|T|`.
-    pub fn friction(&self) -> f64 {
-        self.tangential.iter().map(|t| t * t).sum::<f64>().sqrt()
-    }
-}
 
 /// What a block on a flat did over its settled hold, against what its loads predict.
 struct HeldState {
@@ -353,40 +331,4 @@ fn bracket_check(out: &mut String, checks: &mut Checks, members: &[(&str, HeldSt
             },
         ),
     );
-}
-
-/// The rows of `pair` in a model run's `history.csv` text of dimension `dimension`.
-pub(super) fn friction_rows(
-    text: &str,
-    path: &Path,
-    pair: &str,
-    dimension: usize,
-) -> Result<Vec<FrictionRow>, ReportError> {
-    let table = CsvTable::new(text, path)?;
-    let names: Vec<String> = (1..dimension)
-        .map(|k| format!("{pair}.tangential_force_{k}"))
-        .chain(["normal_force", "active", "sliding"].map(|what| format!("{pair}.{what}")))
-        .chain(["time".to_string()])
-        .collect();
-    let columns = names
-        .iter()
-        .map(|n| table.column(n))
-        .collect::<Result<Vec<_>, _>>()?;
-    let (tangential, rest) = columns.split_at(dimension - 1);
-    let [normal, active, sliding, time] = [rest[0], rest[1], rest[2], rest[3]];
-    let mut rows = Vec::new();
-    for row in table {
-        let row = row?;
-        rows.push(FrictionRow {
-            time: row.number(time)?,
-            normal: row.number(normal)?,
-            tangential: tangential
-                .iter()
-                .map(|&c| row.number(c))
-                .collect::<Result<_, _>>()?,
-            active: row.number(active)?,
-            sliding: row.number(sliding)?,
-        });
-    }
-    Ok(rows)
 }

@@ -8,7 +8,7 @@
 use std::fmt::Write as _;
 
 use super::SceneRun;
-use super::coulomb::{BALANCE_TOLERANCE, FrictionRow};
+use super::friction_rows::{BALANCE_TOLERANCE, FrictionRow};
 use crate::ReportError;
 use crate::format::{Checks, show};
 use crate::moved_block::MovedBlock;

@@ -26,7 +26,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::SceneRun;
-use super::coulomb::{FrictionRow, friction_rows};
+use super::friction_rows::{FrictionRow, friction_rows};
 use crate::ReportError;
 use crate::format::{Checks, Sig, percent};
 use crate::read;
