@@ -6,6 +6,8 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use serde::Serialize;
+
 /// The temporary sibling `path` is written under: `path` + `.partial`.
 pub fn partial_path(path: &Path) -> PathBuf {
     let mut partial = path.as_os_str().to_owned();
@@ -23,6 +25,25 @@ pub fn write_atomic(path: &Path, bytes: impl AsRef<[u8]>) -> std::io::Result<()>
     file.write_all(bytes.as_ref())?;
     file.sync_all()?;
     std::fs::rename(&partial, path)
+}
+
+/// The pretty JSON text of `value`.
+///
+/// # Errors
+/// The serializer's (a map whose keys are not strings, a type's own `Serialize` refusing).
+pub fn json_text(value: &impl Serialize) -> serde_json::Result<String> {
+    serde_json::to_string_pretty(value)
+}
+
+/// Writes the pretty JSON text of `value` to `path` as [`write_atomic`] does; a value that
+/// cannot be serialized writes nothing.
+///
+/// # Errors
+/// I/O errors, and a serialization error as one of kind `InvalidData`; `path` is then untouched.
+pub fn write_json_atomic(path: &Path, value: &impl Serialize) -> std::io::Result<()> {
+    let text =
+        json_text(value).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))?;
+    write_atomic(path, text)
 }
 
 #[cfg(test)]

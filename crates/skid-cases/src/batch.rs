@@ -17,7 +17,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::atomic::write_atomic;
+use crate::atomic::{write_atomic, write_json_atomic};
 use crate::deck::is_deck;
 use crate::model_file::parse_model;
 use crate::model_spec::{ModelSpec, declares_model};
@@ -386,9 +386,7 @@ fn run_one(file: &Path, input: &Input, sweep: Option<&SweepRun>, out: &Path) -> 
     let dir = out.join(&name);
     if let Some(run) = sweep {
         let path = dir.join(PARAMETERS_JSON);
-        let written = std::fs::create_dir_all(&dir).and_then(|()| {
-            write_atomic(&path, serde_json::to_string_pretty(run).unwrap_or_default())
-        });
+        let written = std::fs::create_dir_all(&dir).and_then(|()| write_json_atomic(&path, run));
         if let Err(e) = written {
             let message = format!("{}: cannot write: {e}", path.display());
             return error_entry(file, name, message, Some(run.clone()), started);

@@ -44,6 +44,9 @@ pub fn parse_model(text: &str, path: &Path, overrides: &[String]) -> Result<Mode
 }
 
 /// The model file's text: pretty JSON whose numbers read back to the same bits.
-pub fn to_json(spec: &ModelSpec) -> String {
-    serde_json::to_string_pretty(spec).unwrap_or_default()
+///
+/// # Errors
+/// The serializer's, should the model not serialize.
+pub fn to_json(spec: &ModelSpec) -> serde_json::Result<String> {
+    crate::atomic::json_text(spec)
 }

@@ -91,9 +91,8 @@ pub fn json_schema(format: Format) -> Value {
 
 /// The schema as shipped: pretty JSON ending in a newline.
 pub fn schema_text(format: Format) -> String {
-    let mut text = serde_json::to_string_pretty(&json_schema(format)).unwrap_or_default();
-    text.push('\n');
-    text
+    // a JSON value always serializes: its alternate display is the pretty text
+    format!("{:#}\n", json_schema(format))
 }
 
 /// The markdown reference of a format, rendered from its schema: the root type, then every

@@ -23,7 +23,7 @@ use skid_integrator::{Model, RunError, State};
 use serde::Serialize;
 
 use crate::append_file::FileMark;
-use crate::atomic::write_atomic;
+use crate::atomic::{json_text, write_atomic, write_json_atomic};
 use crate::deck::is_deck;
 use crate::fields::{self, FieldMemory, FieldWriter};
 use crate::fingerprint::Fnv1a;
@@ -108,17 +108,20 @@ impl Input {
     }
 
     /// The file the input is written to in the output directory, and its text there.
-    fn as_run(&self) -> (&'static str, String) {
-        match self {
-            Self::Case(case) => (CASE_JSON, case_text(case)),
-            Self::Model(spec, _) => (MODEL_JSON, model_file::to_json(spec)),
-        }
+    ///
+    /// # Errors
+    /// The serializer's, should the input not serialize.
+    fn as_run(&self) -> serde_json::Result<(&'static str, String)> {
+        Ok(match self {
+            Self::Case(case) => (CASE_JSON, case_text(case)?),
+            Self::Model(spec, _) => (MODEL_JSON, model_file::to_json(spec)?),
+        })
     }
 }
 
 /// The text of `case.json`: the case as run.
-fn case_text(case: &Case) -> String {
-    serde_json::to_string_pretty(case).unwrap_or_default()
+fn case_text(case: &Case) -> serde_json::Result<String> {
+    json_text(case)
 }
 
 /// Runs a case file, a model file (one that declares `skid_model`) or a deck into `out_dir`
@@ -196,7 +199,9 @@ pub fn resume_run(
         source: e,
     })?;
     if let Some((path, overrides)) = input {
-        let (given_file, given_text) = Input::read(path, overrides)?.as_run();
+        let (given_file, given_text) = Input::read(path, overrides)?
+            .as_run()
+            .map_err(|e| refuse(format!("{}: cannot be written back: {e}", path.display())))?;
         if given_file != file || given_text != text {
             return Err(refuse(format!(
                 "{} (with its --set overrides) is not the input this run was started with \
@@ -235,7 +240,10 @@ pub fn resume_run(
             Vec::new(),
         )
     };
-    if stored.as_run().1 != text {
+    let read_back = stored
+        .as_run()
+        .map_err(|e| refuse(format!("{file}: cannot be written back: {e}")))?;
+    if read_back.1 != text {
         return Err(refuse(format!(
             "{file} does not read back as the input it was written from"
         )));
@@ -407,11 +415,8 @@ fn run_in<const D: usize>(
         writer.finish(&scene.model).map_err(output(fields_dir))?;
     }
     let summary = summarize(case, &samples, &stats, result.err().as_ref());
-    write_atomic(
-        &dir.join("summary.json"),
-        serde_json::to_string_pretty(&summary).unwrap_or_default(),
-    )
-    .map_err(output(dir.join("summary.json")))?;
+    write_json_atomic(&dir.join("summary.json"), &summary)
+        .map_err(output(dir.join("summary.json")))?;
     Ok(summary)
 }
 
@@ -447,7 +452,14 @@ fn field_writer(
 
 /// Writes the input as run, `text`, into `dir/file`, and returns its identity for the restart
 /// files.
-fn write_input(dir: &Path, file: &str, text: String) -> Result<InputIdentity, CaseError> {
+fn write_input(
+    dir: &Path,
+    file: &str,
+    text: serde_json::Result<String>,
+) -> Result<InputIdentity, CaseError> {
+    let text = text
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+        .map_err(output(dir.join(file)))?;
     let identity = InputIdentity {
         file: file.into(),
         fnv1a: Fnv1a::of(text.as_bytes()),
@@ -602,11 +614,8 @@ fn run_model_in<const D: usize>(
         &stats,
         result.err().as_ref(),
     );
-    write_atomic(
-        &dir.join("summary.json"),
-        serde_json::to_string_pretty(&summary).unwrap_or_default(),
-    )
-    .map_err(output(dir.join("summary.json")))?;
+    write_json_atomic(&dir.join("summary.json"), &summary)
+        .map_err(output(dir.join("summary.json")))?;
     Ok(summary)
 }
 

@@ -25,7 +25,11 @@ pub fn read_deck_model(
     if overrides.is_empty() {
         return Ok((deck.model, deck.notes));
     }
-    let model = model_file::parse_model(&model_file::to_json(&deck.model), path, overrides)?;
+    let text = model_file::to_json(&deck.model).map_err(|e| CaseError::Read {
+        path: path.to_path_buf(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidData, e),
+    })?;
+    let model = model_file::parse_model(&text, path, overrides)?;
     Ok((model, deck.notes))
 }
 

@@ -82,7 +82,7 @@ fn every_shipped_case_reads_back_from_its_model_file_to_the_same_bits() {
     for path in files {
         let case = load_case(&path, &[]).expect("shipped case");
         let spec = model_spec(&case).expect("model of the case");
-        let text = to_json(&spec);
+        let text = to_json(&spec).expect("serializes");
         let back = parse_model(&text, Path::new("model.json"), &[]).expect("model file parses");
         assert!(
             back == spec,
@@ -115,7 +115,7 @@ fn a_case_and_its_model_file_give_bit_identical_runs() {
         run_case_file(&path, &overrides, Some(&dir.path().join("case"))).expect("case runs");
         let spec = model_spec(&load_case(&path, &overrides).expect("case")).expect("model");
         let model_path = dir.path().join("model.json");
-        std::fs::write(&model_path, to_json(&spec)).expect("write model");
+        std::fs::write(&model_path, to_json(&spec).expect("serializes")).expect("write model");
         let summary = run_file(
             &model_path,
             &[],

@@ -51,7 +51,7 @@ fn convert(input: &Path, overrides: &[String], to_deck: bool) -> Result<String, 
         for note in notes {
             eprintln!("skid: note: {note}");
         }
-        return Ok(to_json(&spec));
+        return to_json(&spec).map_err(|e| format!("{shown}: cannot be written as JSON: {e}"));
     }
     let text = std::fs::read_to_string(input).map_err(|e| format!("{shown}: cannot read: {e}"))?;
     if declares_model(&text) {
@@ -68,8 +68,7 @@ fn convert(input: &Path, overrides: &[String], to_deck: bool) -> Result<String, 
     if to_deck {
         deck(&case).map_err(|m| format!("{shown}: cannot be written as a deck: {m}"))
     } else {
-        model_spec(&case)
-            .map(|spec| to_json(&spec))
-            .map_err(|m| format!("{shown}: model: {m}"))
+        let spec = model_spec(&case).map_err(|m| format!("{shown}: model: {m}"))?;
+        to_json(&spec).map_err(|e| format!("{shown}: cannot be written as JSON: {e}"))
     }
 }

@@ -36,7 +36,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::{ReportError, e_slide, load_run, read_json};
-use skid_cases::atomic::write_atomic;
+use skid_cases::atomic::{write_atomic, write_json_atomic};
 use skid_cases::model_file::summary::RunCost;
 use skid_cases::peak_memory;
 use skid_cases::runner::run_case_with;
@@ -486,9 +486,8 @@ pub fn run_bench(
         }
     }
     let path = out.join(BENCH_JSON);
-    let text = serde_json::to_string_pretty(&records).unwrap_or_default();
     std::fs::create_dir_all(out)
-        .and_then(|()| write_atomic(&path, &text))
+        .and_then(|()| write_json_atomic(&path, &records))
         .map_err(|source| BenchError::Write { path, source })?;
     Ok(records)
 }

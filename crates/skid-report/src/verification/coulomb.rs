@@ -32,7 +32,7 @@ use crate::block_on_flat::BlockOnFlat;
 use crate::format::{Checks, percent, show};
 use crate::moved_block::MovedBlock;
 use crate::read;
-use skid_cases::model_spec::{ContactPairSpec, ModelSpec};
+use skid_cases::model_spec::ContactPairSpec;
 
 /// Relative tolerance of the Coulomb checks (the history carries 10 significant digits).
 pub const COULOMB_TOLERANCE: f64 = 1e-6;
@@ -158,7 +158,7 @@ pub(super) fn section(runs: &[&SceneRun], checks: &mut Checks) -> Result<String,
             if let Some(held) = held {
                 held_checks(checks, &format!("{} ({})", run.name, pair.name), &held);
                 families
-                    .entry(family(&run.spec))
+                    .entry(family(run)?)
                     .or_default()
                     .push((run.name.as_str(), held));
             }
@@ -268,8 +268,14 @@ fn held_checks(checks: &mut Checks, label: &str, held: &HeldState) {
 }
 
 /// The family of a run: its model without names, descriptions and the values of its loads.
-fn family(spec: &ModelSpec) -> String {
-    let mut value = serde_json::to_value(spec).unwrap_or_default();
+///
+/// # Errors
+/// [`ReportError::Parse`] should its model not serialize.
+fn family(run: &SceneRun) -> Result<String, ReportError> {
+    let mut value = serde_json::to_value(&run.spec).map_err(|e| ReportError::Parse {
+        path: run.dir.clone(),
+        message: format!("its model does not serialize: {e}"),
+    })?;
     if let Some(map) = value.as_object_mut() {
         map.remove("name");
         map.remove("description");
@@ -281,7 +287,7 @@ fn family(spec: &ModelSpec) -> String {
             }
         }
     }
-    value.to_string()
+    Ok(value.to_string())
 }
 
 /// The threshold check of a family with runs that stick and runs that slide (see the module
