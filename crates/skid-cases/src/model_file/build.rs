@@ -12,6 +12,7 @@ use skid_contact::surface::{AnalyticCylinder, RigidSurface};
 use skid_contact::triangles::{CylinderChart, SurfaceChart, TriangulatedSurface};
 use skid_fem::cell::{embed, face_corners};
 use skid_fem::element::Formulation;
+use skid_fem::hourglass::Hourglass;
 use skid_fem::material::{Hyperelastic, PolynomialN1};
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::{RigidBody, Rotation};
@@ -301,7 +302,9 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         sections,
         element_sections,
         thickness: section.thickness,
-        hourglass_scale: section.hourglass_scale,
+        hourglass: Hourglass::Stiffness {
+            scale: section.hourglass_scale,
+        },
         element_formulations: element_formulations(spec),
         quasi_static: section.quasi_static,
         fixed: fixed_nodes,
