@@ -126,7 +126,7 @@ impl<const D: usize> HourglassStiffness<D> {
                 for (x_j, b_j) in coordinates.iter().zip(&gradients) {
                     gamma.axpy(-h.dot(x_j), b_j, 1.0);
                 }
-                gamma / n as f64
+                gamma.map(|gamma_a| gamma_a / n as f64)
             })
             .collect();
         let volume = geometry.measure * thickness;
@@ -201,46 +201,49 @@ impl<const D: usize> HourglassStiffness<D> {
             }
         }
         let mut energy = 0.0;
-        for (alpha, gamma) in self.vectors.iter().enumerate() {
-            for i in 0..D {
+        for i in 0..D {
+            let mut f_i = [0.0; MAX_NODES];
+            for (alpha, gamma) in self.vectors.iter().enumerate() {
                 let r = alpha * D + i;
                 let generalized: f64 = self.row(r).iter().zip(&q).map(|(h, q_s)| h * q_s).sum();
                 energy += 0.5 * generalized * q[r];
-                for (a, gamma_a) in gamma.iter().enumerate().take(u.len()) {
-                    force[a * D + i] += generalized * gamma_a;
+                for (f_ia, gamma_a) in f_i.iter_mut().zip(gamma) {
+                    *f_ia += generalized * gamma_a;
                 }
+            }
+            for (a, f_ia) in f_i.iter().enumerate().take(u.len()) {
+                force[a * D + i] += f_ia;
             }
         }
         energy
     }
 
     /// Adds the constant tangent `K_{(I i)(J k)} = sum_{alpha beta} gamma_{alpha I}
-    /// H_{(alpha i)(beta k)} gamma_{beta J}` to the `c x c` matrix `k` (`c = D 2^D`, node-major,
-    /// column-major storage), each entry evaluated once for `(J k) >= (I i)` and written to both
-    /// halves, so that it adds an exactly symmetric matrix.
+    /// H_{(alpha i)(beta k)} gamma_{beta J}` (the terms of nonzero `H` only) to the `c x c`
+    /// matrix `k` (`c = D nodes`, node-major, column-major storage), each entry evaluated once
+    /// for `(J k) >= (I i)` and written to both halves, so that it adds an exactly symmetric
+    /// matrix.
     pub(crate) fn add_tangent(&self, nodes: usize, k: &mut [f64]) {
         let components = D * nodes;
-        let amplitudes = self.amplitude_count();
-        // w[r][(J k)] = sum_beta H_{r (beta k)} gamma_{beta J}
-        let mut w = [[0.0; MAX_NODES * 3]; MAX_AMPLITUDES];
-        for (r, w_r) in w.iter_mut().enumerate().take(amplitudes) {
-            let h_r = self.row(r);
-            for (column, w_rc) in w_r.iter_mut().enumerate().take(components) {
-                let (b, l) = (column / D, column % D);
-                *w_rc = (self.vectors.iter().enumerate())
-                    .map(|(beta, gamma)| h_r[beta * D + l] * gamma[b])
-                    .sum();
-            }
-        }
         for row in 0..components {
             let (a, i) = (row / D, row % D);
             for column in row..components {
-                let value: f64 = (self.vectors.iter().enumerate())
-                    .map(|(alpha, gamma)| gamma[a] * w[alpha * D + i][column])
-                    .sum();
-                k[column * components + row] += value;
-                if column != row {
-                    k[row * components + column] += value;
+                let (b, l) = (column / D, column % D);
+                let mut value = 0.0;
+                for (alpha, gamma_alpha) in self.vectors.iter().enumerate() {
+                    let h_row = self.row(alpha * D + i);
+                    for (beta, gamma_beta) in self.vectors.iter().enumerate() {
+                        let h = h_row[beta * D + l];
+                        if h != 0.0 {
+                            value += h * gamma_alpha[a] * gamma_beta[b];
+                        }
+                    }
+                }
+                if value != 0.0 {
+                    k[column * components + row] += value;
+                    if column != row {
+                        k[row * components + column] += value;
+                    }
                 }
             }
         }
