@@ -6,13 +6,15 @@
 //! - [`read`]: the keyword subset read into definitions with the deck's labels and names
 //!   ([`fields`] reads typed parameters and fields, [`mesh`] nodes, elements and sets,
 //!   [`rigid`] analytical and faceted rigid surfaces, [`loads`] amplitudes and loads).
+//!   ([`controls`] the hourglass control of `*SECTION CONTROLS`).
 //! - [`assemble`]: the definitions turned into a model; [`write`]: a model written as a deck.
 //!
 //! The subset: `*HEADING`, `*NODE`, `*ELEMENT` (CPE4R, C3D8R; R2D2, R3D3, R3D4, M3D4R, S4R,
 //! C3D4 made rigid; MASS, ROTARYI), `*NSET` / `*ELSET` (GENERATE), `*SURFACE` (ELEMENT, NODE,
 //! SEGMENTS, CYLINDER, REVOLUTION with FILLET RADIUS), `*RIGID BODY` (REF NODE, ELSET, ANALYTICAL SURFACE,
 //! TIE NSET), `*MATERIAL` with `*HYPERELASTIC` (POLYNOMIAL N=1, MOONEY-RIVLIN, NEO HOOKE),
-//! `*ELASTIC` and `*DENSITY`, `*SOLID SECTION`, `*MEMBRANE SECTION`, `*SHELL SECTION`,
+//! `*ELASTIC` and `*DENSITY`, `*SOLID SECTION` (CONTROLS=), `*SECTION CONTROLS`
+//! (HOURGLASS=ENHANCED|STIFFNESS, see [`controls`]), `*MEMBRANE SECTION`, `*SHELL SECTION`,
 //! `*MASS`, `*ROTARY INERTIA`, `*SURFACE INTERACTION` with `*FRICTION`, `*CONTACT PAIR`,
 //! `*CONTACT` with `*CONTACT INCLUSIONS, ALL EXTERIOR` and `*CONTACT PROPERTY ASSIGNMENT`,
 //! `*BOUNDARY` (OP=MOD/NEW and, on rigid bodies and part nodes, magnitudes with AMPLITUDE= in
@@ -73,6 +75,7 @@
 //!   history it always writes).
 
 pub mod assemble;
+pub mod controls;
 pub mod fields;
 pub mod instances;
 pub mod keywords;

@@ -138,6 +138,7 @@ fn model_spec_in<const D: usize>(case: &Case) -> Result<ModelSpec, String> {
             stiffness_damping: pad.stiffness_damping,
             thickness: if D == 2 { pad.width } else { 1.0 },
             hourglass_scale: pad.hourglass_scale,
+            hourglass: pad.hourglass,
             quasi_static: pad.quasi_static,
             massless_contact_nodes: pad.massless_contact_nodes,
         },

@@ -13,8 +13,8 @@ use serde::{Deserialize, Serialize};
 use skid_fem::element::Formulation;
 
 use crate::schema::{
-    AdaptiveSpec, MaterialSpec, OutputSpec, SolverSpec, default_alpha, default_regularization_time,
-    one,
+    AdaptiveSpec, HourglassControl, MaterialSpec, OutputSpec, SolverSpec, default_alpha,
+    default_regularization_time, one,
 };
 
 /// Format version a model file must declare in `skid_model`.
@@ -290,9 +290,15 @@ pub struct SectionSpec {
     /// Out-of-plane thickness in 2D, m (must be 1 in 3D).
     #[serde(default = "one")]
     pub thickness: f64,
-    /// Factor on the hourglass stabilisation stiffness.
+    /// Factor on the hourglass stabilisation stiffness of the one-point elements, with the
+    /// `stiffness` hourglass control.
     #[serde(default = "one")]
     pub hourglass_scale: f64,
+    /// Hourglass control of the one-point elements (CPE4R / C3D8R): `stiffness` (the default)
+    /// or `enhanced`; `enhanced` needs at least one block of one-point elements and the
+    /// default `hourglass_scale`.
+    #[serde(default, skip_serializing_if = "HourglassControl::is_default")]
+    pub hourglass: HourglassControl,
     /// No inertia: in dynamic steps the part is in equilibrium with the mean contact forces of
     /// each increment; rigid bodies tied to it must then be massless.
     #[serde(default)]

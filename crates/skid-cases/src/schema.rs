@@ -11,6 +11,7 @@
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use skid_fem::element::Formulation;
+use skid_fem::hourglass::Hourglass;
 use skid_integrator::settings::ContactSolve;
 
 /// Index of the drum among the rigid bodies of a drum case's model.
@@ -137,9 +138,14 @@ pub struct PadSpec {
     pub density: f64,
     /// Hyperelastic material.
     pub material: MaterialSpec,
-    /// Factor on the hourglass stabilisation stiffness (of the one-point element).
+    /// Factor on the hourglass stabilisation stiffness (of the one-point element, with the
+    /// `stiffness` control).
     #[serde(default = "one")]
     pub hourglass_scale: f64,
+    /// Hourglass control of the one-point element: `stiffness` (the default) or `enhanced`;
+    /// `enhanced` only with `formulation = "reduced"`.
+    #[serde(default, skip_serializing_if = "HourglassControl::is_default")]
+    pub hourglass: HourglassControl,
     /// The pad's element formulation: `reduced` (one-point with hourglass control: CPE4R /
     /// C3D8R, the default), `full` (CPE4 / C3D8), `hybrid` (CPE4H / C3D8H) or `incompatible`
     /// (CPE4I / C3D8I).
@@ -215,6 +221,58 @@ impl PadFormulation {
             Self::Full => Formulation::Full,
             Self::Hybrid => Formulation::Hybrid,
             Self::Incompatible => Formulation::Incompatible,
+        }
+    }
+}
+
+/// The hourglass control of the one-point elements (CPE4R / C3D8R).
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, JsonSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum HourglassControl {
+    /// A stiffness on each hourglass mode from the material's initial shear modulus
+    /// (Flanagan-Belytschko), times the hourglass scale.
+    #[default]
+    Stiffness,
+    /// Abaqus' enhanced hourglass control: the hourglass modes have the small-strain stiffness
+    /// of the incompatible-mode element (CPE4I / C3D8I) of the same geometry, so that in the
+    /// linear limit the one-point element is that element; it takes no hourglass scale.
+    Enhanced,
+}
+
+impl HourglassControl {
+    /// Whether it is the default, [`Self::Stiffness`] (left out when written).
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
+
+    /// Its name in model and case files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Stiffness => "stiffness",
+            Self::Enhanced => "enhanced",
+        }
+    }
+
+    /// The element kernels' control; `scale` is the stiffness control's factor.
+    pub fn hourglass(self, scale: f64) -> Hourglass {
+        match self {
+            Self::Stiffness => Hourglass::Stiffness { scale },
+            Self::Enhanced => Hourglass::Enhanced,
+        }
+    }
+
+    /// Checks the hourglass scale `scale` that goes with the control: the enhanced control
+    /// takes none, so its scale must be the default 1.
+    ///
+    /// # Errors
+    /// A message for the scale's field.
+    pub fn check_scale(self, scale: f64) -> Result<(), String> {
+        if self == Self::Enhanced && scale != 1.0 {
+            Err(format!(
+                "the enhanced hourglass control takes no scale: expected 1, got {scale}"
+            ))
+        } else {
+            Ok(())
         }
     }
 }

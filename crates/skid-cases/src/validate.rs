@@ -7,7 +7,8 @@ use serde_json::Value;
 use thiserror::Error;
 
 use crate::schema::{
-    BODY_NAMES, Case, ContactFormulation, DrumSurfaceSpec, FacetElement, MaterialSpec, StepSpec,
+    BODY_NAMES, Case, ContactFormulation, DrumSurfaceSpec, FacetElement, HourglassControl,
+    MaterialSpec, PadFormulation, PadSpec, StepSpec,
 };
 
 mod json;
@@ -254,6 +255,23 @@ fn positive(field: &str, v: f64) -> Result<(), Problem> {
     }
 }
 
+/// The enhanced hourglass control only on the one-point element, and without a scale.
+fn check_hourglass(p: &PadSpec) -> Result<(), Problem> {
+    if p.hourglass == HourglassControl::Enhanced && p.formulation != PadFormulation::Reduced {
+        return Err((
+            "pad.hourglass".into(),
+            format!(
+                "the enhanced hourglass control is for the one-point element: expected \
+                 pad.formulation = \"reduced\", got \"{}\"",
+                p.formulation.name()
+            ),
+        ));
+    }
+    p.hourglass
+        .check_scale(p.hourglass_scale)
+        .map_err(|message| ("pad.hourglass_scale".into(), message))
+}
+
 fn non_negative(field: &str, v: f64) -> Result<(), Problem> {
     if v.is_finite() && v >= 0.0 {
         Ok(())
@@ -401,6 +419,7 @@ pub fn validate(case: &Case) -> Result<(), Problem> {
     positive("pad.thickness", p.thickness)?;
     positive("pad.density", p.density)?;
     positive("pad.hourglass_scale", p.hourglass_scale)?;
+    check_hourglass(p)?;
     non_negative("pad.standoff", p.standoff)?;
     if p.length >= 2.0 * d.radius {
         return Err((

@@ -4,6 +4,7 @@
 use nalgebra::SVector;
 
 use crate::error::FemError;
+use crate::hourglass::Hourglass;
 use crate::integrated::{IntegratedSolid, Technology};
 use crate::material::Hyperelastic;
 use crate::solid::{ElementResponse, MAX_NODES, OnePointSolid, Tangent};
@@ -62,9 +63,9 @@ pub enum SolidElement<const D: usize> {
 
 impl<const D: usize> SolidElement<D> {
     /// Builds the element: `x_ref`, the `2^D` reference nodal coordinates in the cell corner
-    /// order; `thickness`, the plane-strain thickness (2D; ignored in 3D); `shear_modulus` and
-    /// `hourglass_scale`, the hourglass stiffness parameters of [`OnePointSolid::new`] (used
-    /// only by [`Formulation::Reduced`]).
+    /// order; `thickness`, the plane-strain thickness (2D; ignored in 3D); `material` and
+    /// `hourglass`, the hourglass control's parameters of [`OnePointSolid::new`] (used only by
+    /// [`Formulation::Reduced`]).
     ///
     /// # Errors
     /// Those of [`OnePointSolid::new`] or [`IntegratedSolid::new`].
@@ -72,16 +73,11 @@ impl<const D: usize> SolidElement<D> {
         formulation: Formulation,
         x_ref: &[SVector<f64, D>],
         thickness: f64,
-        shear_modulus: f64,
-        hourglass_scale: f64,
+        material: &dyn Hyperelastic,
+        hourglass: Hourglass,
     ) -> Result<Self, FemError> {
         Ok(match formulation.technology() {
-            None => Self::Reduced(OnePointSolid::new(
-                x_ref,
-                thickness,
-                shear_modulus,
-                hourglass_scale,
-            )?),
+            None => Self::Reduced(OnePointSolid::new(x_ref, thickness, material, hourglass)?),
             Some(technology) => {
                 Self::Integrated(IntegratedSolid::new(technology, x_ref, thickness)?)
             }
@@ -187,7 +183,7 @@ mod tests {
             .map(|x| x * 0.1 + x.map(|c| c * c) * 0.02)
             .collect();
         for formulation in Formulation::ALL {
-            let element = SolidElement::new(formulation, &x, 0.4, m.initial_shear_modulus(), 1.0)?;
+            let element = SolidElement::new(formulation, &x, 0.4, &m, Hourglass::default())?;
             assert_eq!(element.formulation(), formulation);
             assert_eq!(element.node_count(), 1 << D);
             let n = D * element.node_count();
@@ -195,9 +191,7 @@ mod tests {
             let r = element.respond_with_tangent(&m, &u, Tangent::Consistent, &mut k)?;
             assert_eq!(r.force(), element.respond(&m, &u)?.force());
             let direct = match formulation.technology() {
-                None => {
-                    OnePointSolid::new(&x, 0.4, m.initial_shear_modulus(), 1.0)?.respond(&m, &u)?
-                }
+                None => OnePointSolid::new(&x, 0.4, &m, Hourglass::default())?.respond(&m, &u)?,
                 Some(t) => IntegratedSolid::new(t, &x, 0.4)?.respond(&m, &u)?,
             };
             assert_eq!(r.force(), direct.force());

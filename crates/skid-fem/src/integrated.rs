@@ -28,7 +28,8 @@
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 use crate::cell::{
-    ReferenceGeometry, corner_count, embed, gauss_points, jacobian, restrict, shape_functions,
+    MAX_COMPONENTS, MAX_NODES, ReferenceGeometry, corner_count, embed, gauss_points, jacobian,
+    restrict, shape_functions,
 };
 use crate::error::FemError;
 use crate::kinematics::{
@@ -36,7 +37,7 @@ use crate::kinematics::{
     check_parameter, corner_gradients, gradient_of, reference_gradients,
 };
 use crate::material::Hyperelastic;
-use crate::solid::{ElementResponse, MAX_COMPONENTS, MAX_NODES, Tangent};
+use crate::response::{ElementResponse, Tangent};
 
 /// Most incompatible-mode parameters of an element: D modes of D components each.
 const MAX_MODE_PARAMETERS: usize = 9;

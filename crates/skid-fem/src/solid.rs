@@ -1,22 +1,22 @@
-//! One-point (reduced-integration) solid element with Flanagan-Belytschko hourglass stiffness:
-//! the CPE4R role in 2D plane strain (D = 2) and the C3D8R role in 3D (D = 3), one code path.
+//! One-point (reduced-integration) solid element with hourglass control: the CPE4R role in 2D
+//! plane strain (D = 2) and the C3D8R role in 3D (D = 3), one code path.
 //!
 //! An evaluation allocates nothing: its results live in fixed arrays sized for the largest
 //! element (3D), and the tangent goes into a buffer of the caller's.
 
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, SVector, Vector3};
+use nalgebra::{Matrix3, Matrix6, SVector, Vector3};
 
-use crate::cell::{
-    ReferenceGeometry, corner_count, embed, hourglass_base_vectors, hourglass_mode_axes,
-};
+use crate::cell::{ReferenceGeometry, embed};
 use crate::error::FemError;
+use crate::hourglass::{Hourglass, HourglassStiffness};
 use crate::kinematics::{
     CornerGradients, add_pair_stiffness, check_corners, check_inputs, check_parameter,
-    corner_gradients, gradient_of, inverse_jacobian,
+    corner_gradients, gradient_of,
 };
 use crate::material::Hyperelastic;
 
 pub use crate::cell::{MAX_COMPONENTS, MAX_NODES};
+pub use crate::response::{ElementResponse, Tangent};
 
 /// A reduced-integration solid element: reference volume, mean gradients and hourglass data.
 #[derive(Clone, Debug)]
@@ -25,63 +25,12 @@ pub struct OnePointSolid<const D: usize> {
     volume: f64,
     /// Mean gradients `b_I = (1/V0) int dN_I/dX dV`.
     mean_gradients: Vec<SVector<f64, D>>,
-    /// Hourglass shape vectors `gamma_alpha`, one per mode (node values; the first `2^D` used).
-    hourglass_vectors: Vec<[f64; MAX_NODES]>,
-    /// Hourglass stiffness `k_{alpha i}`, one vector over the displacement directions i per mode.
-    hourglass_stiffness: Vec<SVector<f64, D>>,
-    /// Per displacement direction i, the constant stabilisation stiffness on the nodes'
-    /// i-components: `[i][I][J] = sum_alpha k_{alpha i} gamma_{alpha I} gamma_{alpha J}`.
-    hourglass_matrices: [[[f64; MAX_NODES]; MAX_NODES]; D],
+    /// The constant hourglass stiffness of the element's control.
+    hourglass: HourglassStiffness<D>,
     /// Per corner of the cell, the reference gradients `grad_X N_I` there that do not vanish
     /// (those of the corner's node and of its D neighbours along the edges), with their node
     /// `I`, for the corner check of [`Self::respond`].
     corner_gradients: CornerGradients<D>,
-}
-
-/// Response of one element at a given displacement. Vectors are node-major (index `a * D + i`)
-/// with `D * 2^D` components.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct ElementResponse {
-    /// `D * 2^D`, the length of [`Self::force`] and [`Self::volume_ratio_gradient`].
-    pub(crate) components: usize,
-    /// Internal nodal forces in the first `components` entries.
-    pub(crate) force: [f64; MAX_COMPONENTS],
-    /// `dJ/du` in the first `components` entries.
-    pub(crate) volume_ratio_gradient: [f64; MAX_COMPONENTS],
-    /// Material strain energy `V0 W(F)`.
-    pub strain_energy: f64,
-    /// Hourglass stabilisation energy.
-    pub hourglass_energy: f64,
-    /// Cauchy stress `sigma = tau / J` (3D; in plane strain `sigma33` included).
-    pub cauchy_stress: Matrix3<f64>,
-    /// Volume ratio `J = det F`.
-    pub volume_ratio: f64,
-}
-
-impl ElementResponse {
-    /// Internal nodal forces, length `D * 2^D`, node-major (index `a * D + i`).
-    pub fn force(&self) -> &[f64] {
-        &self.force[..self.components]
-    }
-
-    /// `dJ/du`, same ordering as the force: `J g_a` for node `a` (`g_a = F^{-T} b_a`).
-    pub fn volume_ratio_gradient(&self) -> &[f64] {
-        &self.volume_ratio_gradient[..self.components]
-    }
-}
-
-/// Which tangent stiffness [`OnePointSolid::respond_with_tangent`] returns.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Tangent {
-    /// The consistent tangent `d force / d u` of the displacement formulation.
-    Consistent,
-    /// The tangent of the condensed one-point mixed (u-p) formulation at the element pressure
-    /// `pressure` (see [`Hyperelastic::mixed_stress_and_tangent`]); equal to the consistent one
-    /// when `pressure = U'(J)`. The force is the displacement formulation's in every case.
-    Mixed {
-        /// The element's mixed pressure `p_m` (Pa).
-        pressure: f64,
-    },
 }
 
 impl<const D: usize> OnePointSolid<D> {
@@ -89,44 +38,21 @@ impl<const D: usize> OnePointSolid<D> {
     ///
     /// `x_ref`: the 2^D reference nodal coordinates in the cell corner order. `thickness`:
     /// out-of-plane thickness in 2D (plane strain; volume = area * thickness); ignored in 3D
-    /// (pass 1.0). `shear_modulus`: mu0 of the material. `hourglass_scale`: dimensionless factor
-    /// (1.0 = default, 0.0 = no stabilisation) on the stabilisation stiffness.
-    ///
-    /// Hourglass vectors: `gamma_alpha = (1/n) [h_alpha - sum_j (h_alpha . X_j) b_j]` with
-    /// `n = 2^D`, `X_j` the reference nodal coordinates in direction j and `b_j` the mean
-    /// gradient components; thus `gamma . X_j = 0` and `gamma . 1 = 0` (affine fields, rigid
-    /// motions included, produce no hourglass strain) and `gamma . u_i` is the amplitude `q` of
-    /// the mode `u_i = q h(xi)`.
-    ///
-    /// Hourglass stiffness per mode and direction, `k_{alpha i}`: the energy `2 mu0 int eps:eps dV`
-    /// of the mode's strain on a brick, without the parasitic shear of a bending mode. With
-    /// `g_m = grad xi_m` at the centre (`|g_m| = 1/a_m` on a brick of half-widths `a_m`), the
-    /// mode `h_alpha = prod_{k in S} xi_k` and `<.>` the mean over the parent cube, along the
-    /// parametric axis m:
-    /// - `m in S` (bending: `u_m = q h` stretches along m, `eps_mm = q |g_m| dh/dxi_m`):
-    ///   `k = 2 mu0 V0 |g_m|^2 <(dh/dxi_m)^2>`, i.e. `(2/3) mu0 V0 / a_m^2` for `xi eta`;
-    /// - `m not in S` (`u_m = q h` only shears, `eps_ml = q |g_l| dh/dxi_l / 2`):
-    ///   `k = mu0 V0 sum_{l in S} |g_l|^2 <(dh/dxi_l)^2>`, i.e. `mu0 V0 (1/a_j^2 + 1/a_k^2)/3`
-    ///   for `xi_j xi_k`.
-    ///
-    /// A Cartesian direction i takes the mean over the axes weighted by
-    /// `w_mi = (g_m . e_i)^2 / |g_m|^2` (normalised), exact on a brick aligned with the axes.
-    /// Giving every mode of a direction the bending value instead made the twisting mode
-    /// `u_x ~ eta zeta` of a thin pad element (5 x 25 x 50 mm) 20 times too stiff and
-    /// `u_y ~ xi zeta` 12 times too soft. In 2D the single mode bends along both axes, so
-    /// `k_i = (2/3) mu0 V0 / a_i^2` as before. Only `mu0` enters, so the stabilisation does not
-    /// stiffen with the bulk modulus; `s` (`hourglass_scale`) multiplies all of it.
+    /// (pass 1.0). `material`: the element's material, whose small-strain stiffness sets the
+    /// hourglass stiffness of the control `hourglass` (see [`Hourglass`] and the
+    /// [`crate::hourglass`] module for the equations).
     ///
     /// # Errors
     /// [`FemError::UnsupportedDimension`] unless D is 2 or 3, [`FemError::LengthMismatch`],
     /// [`FemError::DegenerateElement`] for a reference Jacobian `det J <= 0`,
-    /// [`FemError::InvalidParameter`] for a non-positive thickness (2D), a negative or
-    /// non-finite shear modulus or hourglass scale.
+    /// [`FemError::InvalidParameter`] for a non-positive thickness (2D) or a negative or
+    /// non-finite hourglass scale; for [`Hourglass::Enhanced`], those of the incompatible-mode
+    /// element of the same geometry.
     pub fn new(
         x_ref: &[SVector<f64, D>],
         thickness: f64,
-        shear_modulus: f64,
-        hourglass_scale: f64,
+        material: &dyn Hyperelastic,
+        hourglass: Hourglass,
     ) -> Result<Self, FemError> {
         let geometry = ReferenceGeometry::new(x_ref)?;
         let thickness = if D == 2 {
@@ -134,61 +60,11 @@ impl<const D: usize> OnePointSolid<D> {
         } else {
             1.0
         };
-        check_parameter(
-            "shear_modulus",
-            shear_modulus,
-            shear_modulus >= 0.0,
-            "finite and >= 0",
-        )?;
-        check_parameter(
-            "hourglass_scale",
-            hourglass_scale,
-            hourglass_scale >= 0.0,
-            "finite and >= 0",
-        )?;
-        let volume = geometry.measure * thickness;
-        let b = geometry.mean_gradients;
-        let n = corner_count(D);
-        let coordinates: Vec<DVector<f64>> = (0..D)
-            .map(|j| DVector::from_iterator(n, x_ref.iter().map(|x| x[j])))
-            .collect();
-        let gradients: Vec<DVector<f64>> = (0..D)
-            .map(|j| DVector::from_iterator(n, b.iter().map(|g| g[j])))
-            .collect();
-        let hourglass_vectors: Vec<[f64; MAX_NODES]> = hourglass_base_vectors::<D>()?
-            .iter()
-            .map(|h| {
-                let mut gamma = h.clone();
-                for (x_j, b_j) in coordinates.iter().zip(&gradients) {
-                    gamma.axpy(-h.dot(x_j), b_j, 1.0);
-                }
-                let mut values = [0.0; MAX_NODES];
-                for (value, gamma_a) in values.iter_mut().zip(gamma.iter()) {
-                    *value = gamma_a / n as f64;
-                }
-                values
-            })
-            .collect();
-        let hourglass_stiffness = hourglass_stiffness::<D>(
-            &geometry_gradients(x_ref)?,
-            hourglass_scale * shear_modulus * volume,
-        )?;
-        let mut hourglass_matrices = [[[0.0; MAX_NODES]; MAX_NODES]; D];
-        for (i, h) in hourglass_matrices.iter_mut().enumerate() {
-            for (gamma, k) in hourglass_vectors.iter().zip(&hourglass_stiffness) {
-                for (h_a, gamma_a) in h.iter_mut().zip(gamma).take(n) {
-                    for (h_ab, gamma_b) in h_a.iter_mut().zip(gamma).take(n) {
-                        *h_ab += k[i] * gamma_a * gamma_b;
-                    }
-                }
-            }
-        }
+        let hourglass = HourglassStiffness::new(x_ref, &geometry, thickness, material, hourglass)?;
         Ok(Self {
-            volume,
-            mean_gradients: b,
-            hourglass_vectors,
-            hourglass_stiffness,
-            hourglass_matrices,
+            volume: geometry.measure * thickness,
+            mean_gradients: geometry.mean_gradients,
+            hourglass,
             corner_gradients: corner_gradients(x_ref)?,
         })
     }
@@ -215,9 +91,9 @@ impl<const D: usize> OnePointSolid<D> {
     /// ordering: index a*D + i).
     ///
     /// With `g_a = F^{-T} b_a` (the spatial gradient of `N_a`) and the Kirchhoff stress `tau`:
-    /// material force `f_a = V0 tau g_a`. Hourglass: `q_{i alpha} = gamma_alpha . u_i`,
-    /// `E_hg = 1/2 sum_i sum_alpha k_{alpha i} q_{i alpha}^2`,
-    /// `f_{iI} = sum_alpha k_{alpha i} q_{i alpha} gamma_{alpha I}`.
+    /// material force `f_a = V0 tau g_a`. Hourglass (see [`crate::hourglass`]): amplitudes
+    /// `q_{alpha D + i} = gamma_alpha . u_i`, energy `E_hg = 1/2 q^T H q`, force
+    /// `f_{iI} = sum_alpha (H q)_{alpha D + i} gamma_{alpha I}`.
     ///
     /// The single integration point does not see an element folded by its hourglass modes (the
     /// mean `F` stays that of the affine part), so `J` is also checked at every corner of the
@@ -242,7 +118,7 @@ impl<const D: usize> OnePointSolid<D> {
     ///
     /// `K_ab,ik = V0 [sum_jl g_aj c^tau_ijkl g_bl + (g_a . tau g_b) delta_ik]` (material +
     /// geometric), with only in-plane `i, k` in 2D, plus the constant hourglass stiffness
-    /// `delta_ik sum_alpha k_{alpha i} gamma_{alpha a} gamma_{alpha b}`. By the major symmetry of
+    /// `sum_{alpha beta} gamma_{alpha a} H_{(alpha i)(beta k)} gamma_{beta b}`. By the major symmetry of
     /// `c^tau`, `K_ba = K_ab^T`: each node pair is evaluated once.
     ///
     /// With [`Tangent::Mixed`] the stress `tau` of the geometric term and the tangent `c^tau`
@@ -303,25 +179,7 @@ impl<const D: usize> OnePointSolid<D> {
                 response.volume_ratio_gradient[a * D + i] = det_f * g_a[i];
             }
         }
-        for i in 0..D {
-            let mut f_i = [0.0; MAX_NODES];
-            for (gamma, k) in self.hourglass_vectors.iter().zip(&self.hourglass_stiffness) {
-                let q: f64 = gamma
-                    .iter()
-                    .zip(u)
-                    .map(|(gamma_a, u_a)| gamma_a * u_a[i])
-                    .sum();
-                let generalized = k[i] * q;
-                response.hourglass_energy += 0.5 * generalized * q;
-                for (f_ia, gamma_a) in f_i.iter_mut().zip(gamma) {
-                    *f_ia += generalized * gamma_a;
-                }
-            }
-            for (a, f_ia) in f_i.iter().enumerate().take(n) {
-                response.force[a * D + i] += f_ia;
-            }
-        }
-
+        response.hourglass_energy = self.hourglass.add_force(u, &mut response.force);
         if let Some((tangent, k)) = tangent {
             let (tau_k, c) = match tangent {
                 Tangent::Consistent => material.stress_and_tangent(&f),
@@ -335,22 +193,12 @@ impl<const D: usize> OnePointSolid<D> {
     /// The tangent of [`Self::respond_with_tangent`] for the spatial gradients `g` from the
     /// volume-scaled stress `tau = V0 tau` and tangent `c = V0 c^tau` (Voigt, tensor
     /// components): the node-pair blocks of [`add_pair_stiffness`] plus the hourglass stiffness
-    /// `delta_ik sum_alpha k_{alpha i} gamma_{alpha a} gamma_{alpha b}`, evaluated for `b >= a`
-    /// and written to both `K_ab` and `K_ba`, so that `k` is exactly symmetric.
+    /// `sum_{alpha beta} gamma_{alpha a} H_{(alpha i)(beta k)} gamma_{beta b}`, both exactly
+    /// symmetric.
     fn stiffness(&self, g: &[Vector3<f64>], tau: &Matrix3<f64>, c: &Matrix6<f64>, k: &mut [f64]) {
-        let components = D * g.len();
         k.fill(0.0);
         add_pair_stiffness::<D>(g, tau, c, k);
-        for (i, h) in self.hourglass_matrices.iter().enumerate() {
-            for (a, h_a) in h.iter().enumerate().take(g.len()) {
-                for (b, h_ab) in h_a.iter().enumerate().take(g.len()).skip(a) {
-                    k[(b * D + i) * components + a * D + i] += h_ab;
-                    if a != b {
-                        k[(a * D + i) * components + b * D + i] += h_ab;
-                    }
-                }
-            }
-        }
+        self.hourglass.add_tangent(g.len(), k);
     }
 
     /// Lumped (row-sum) mass per node: rho V0 / 2^D.
@@ -359,59 +207,15 @@ impl<const D: usize> OnePointSolid<D> {
     }
 }
 
-/// `g_m = grad_X xi_m` at the cell centre: the rows of the inverse reference Jacobian there.
-///
-/// # Errors
-/// [`FemError::DegenerateElement`] if that Jacobian is singular.
-fn geometry_gradients<const D: usize>(
-    x_ref: &[SVector<f64, D>],
-) -> Result<Vec<SVector<f64, D>>, FemError> {
-    let inverse = inverse_jacobian(x_ref, &SVector::zeros())?;
-    Ok((0..D)
-        .map(|m| SVector::from_fn(|i, _| inverse[(m, i)]))
-        .collect())
-}
-
-/// `k_{alpha i}` of [`OnePointSolid::new`] from the parametric gradients `g_m` and the factor
-/// `c = s mu0 V0`.
-///
-/// # Errors
-/// [`FemError::UnsupportedDimension`] unless D is 2 or 3.
-fn hourglass_stiffness<const D: usize>(
-    g: &[SVector<f64, D>],
-    c: f64,
-) -> Result<Vec<SVector<f64, D>>, FemError> {
-    // w_mi = (g_m . e_i)^2 / |g_m|^2, normalised over m
-    let weights = DMatrix::from_fn(D, D, |m, i| g[m][i] * g[m][i] / g[m].norm_squared());
-    Ok(hourglass_mode_axes::<D>()?
-        .iter()
-        .map(|axes| {
-            // <(dh/dxi_l)^2> = (1/3)^(|S| - 1) for every l in S
-            let mean_square = (1.0_f64 / 3.0).powi(axes.len() as i32 - 1);
-            let along_axis = |m: usize| {
-                if axes.contains(&m) {
-                    2.0 * g[m].norm_squared() * mean_square
-                } else {
-                    axes.iter().map(|&l| g[l].norm_squared()).sum::<f64>() * mean_square
-                }
-            };
-            SVector::from_fn(|i, _| {
-                let column = weights.column(i);
-                c * (0..D).map(|m| column[m] * along_axis(m)).sum::<f64>() / column.sum()
-            })
-        })
-        .collect())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cell::{corners, restrict};
+    use crate::cell::{corners, hourglass_base_vectors, hourglass_mode_axes, restrict};
     use crate::mesh::SolidMesh;
     use crate::test_fixtures::{
         self as fixtures, affine, dense_tangent, distorted, in_plane, jitter, material, perturb,
     };
-    use nalgebra::{Rotation3, SymmetricEigen, Vector2, Vector3 as V3};
+    use nalgebra::{DMatrix, DVector, Rotation3, SymmetricEigen, Vector2, Vector3 as V3};
 
     /// Box element with half-widths `half`.
     fn brick<const D: usize>(half: [f64; 3]) -> Vec<SVector<f64, D>> {
@@ -449,10 +253,13 @@ mod tests {
         DVector::from_column_slice(r.force())
     }
 
-    fn check_tangent_and_energy<const D: usize>() -> Result<(), FemError> {
+    /// Both hourglass controls.
+    const CONTROLS: [Hourglass; 2] = [Hourglass::Stiffness { scale: 1.0 }, Hourglass::Enhanced];
+
+    fn check_tangent_and_energy<const D: usize>(control: Hourglass) -> Result<(), FemError> {
         let m = material()?;
         let x = distorted::<D>();
-        let element = OnePointSolid::new(&x, 0.7, m.initial_shear_modulus(), 1.0)?;
+        let element = OnePointSolid::new(&x, 0.7, &m, control)?;
         let u = general_u(&x);
         let (r, k) = tangent(&element, &m, &u, Tangent::Consistent)?;
         assert!(r.hourglass_energy > 0.0 && (r.volume_ratio - 1.0).abs() > 1e-2);
@@ -466,28 +273,39 @@ mod tests {
             let minus = element.respond(&m, &perturb(&u, dof, -h))?;
             let fd_column = (force(&plus) - force(&minus)) / (2.0 * h);
             let err = (fd_column - k.column(dof)).amax() / k.amax();
-            assert!(err < 1e-6, "D = {D}, dof {dof}: tangent error {err}");
+            assert!(
+                err < 1e-6,
+                "D = {D}, {control:?}, dof {dof}: tangent error {err}"
+            );
             let energy = |r: &ElementResponse| r.strain_energy + r.hourglass_energy;
             let fd_force = (energy(&plus) - energy(&minus)) / (2.0 * h);
             let err = (fd_force - r.force()[dof]).abs() / force(&r).amax();
-            assert!(err < 1e-6, "D = {D}, dof {dof}: force error {err}");
+            assert!(
+                err < 1e-6,
+                "D = {D}, {control:?}, dof {dof}: force error {err}"
+            );
         }
         Ok(())
     }
 
     #[test]
     fn tangent_and_force_match_finite_differences() -> Result<(), FemError> {
-        check_tangent_and_energy::<2>()?;
-        check_tangent_and_energy::<3>()
+        for control in CONTROLS {
+            check_tangent_and_energy::<2>(control)?;
+            check_tangent_and_energy::<3>(control)?;
+        }
+        Ok(())
     }
 
-    /// The tangent, each node pair evaluated once, is the definition entry by entry:
-    /// `K_ab,ik = V0 [sum_jl g_aj c_ijkl g_bl + (g_a . tau g_b) delta_ik]
-    /// + delta_ik sum_alpha k_{alpha i} gamma_{alpha a} gamma_{alpha b}` (here the mixed one).
-    fn check_tangent_against_definition<const D: usize>() -> Result<(), FemError> {
+    /// The tangent, each node pair evaluated once, is the definition entry by entry (here the
+    /// mixed one): `K_ab,ik = V0 [sum_jl g_aj c_ijkl g_bl + (g_a . tau g_b) delta_ik] +
+    /// sum_{alpha beta} gamma_{alpha a} H_{(alpha i)(beta l)} gamma_{beta b}`.
+    fn check_tangent_against_definition<const D: usize>(
+        control: Hourglass,
+    ) -> Result<(), FemError> {
         let m = material()?;
         let x = distorted::<D>();
-        let element = OnePointSolid::new(&x, 0.7, m.initial_shear_modulus(), 1.0)?;
+        let element = OnePointSolid::new(&x, 0.7, &m, control)?;
         let u = general_u(&x);
         let pressure = 3.0e5;
         let (_, k) = tangent(&element, &m, &u, Tangent::Mixed { pressure })?;
@@ -509,19 +327,21 @@ mod tests {
                     material += g[a][j] * c.get(i, j, l, m) * g[b][m];
                 }
             }
-            if i != l {
-                return v0 * material;
+            let gammas = &element.hourglass.vectors;
+            let mut hourglass = 0.0;
+            for (alpha, gamma_alpha) in gammas.iter().enumerate() {
+                for (beta, gamma_beta) in gammas.iter().enumerate() {
+                    let h = element.hourglass.entry(alpha * D + i, beta * D + l);
+                    hourglass += gamma_alpha[a] * h * gamma_beta[b];
+                }
             }
-            let hourglass: f64 = (element.hourglass_vectors.iter())
-                .zip(&element.hourglass_stiffness)
-                .map(|(gamma, k_alpha)| k_alpha[i] * gamma[a] * gamma[b])
-                .sum();
-            v0 * (material + g[a].dot(&(tau * g[b]))) + hourglass
+            let geometric = if i == l { g[a].dot(&(tau * g[b])) } else { 0.0 };
+            v0 * (material + geometric) + hourglass
         });
         let err = (&k - &expected).amax() / expected.amax();
         assert!(
             err < 1e-13,
-            "D = {D}: tangent differs from its definition by {err}"
+            "D = {D}, {control:?}: tangent differs from its definition by {err}"
         );
         assert_eq!(k, k.transpose());
         let mut short = vec![0.0; k.len() - 1];
@@ -534,8 +354,11 @@ mod tests {
 
     #[test]
     fn tangent_is_its_definition() -> Result<(), FemError> {
-        check_tangent_against_definition::<2>()?;
-        check_tangent_against_definition::<3>()
+        for control in CONTROLS {
+            check_tangent_against_definition::<2>(control)?;
+            check_tangent_against_definition::<3>(control)?;
+        }
+        Ok(())
     }
 
     /// The mixed tangent differs from the consistent one by the pressure difference times the
@@ -544,7 +367,7 @@ mod tests {
     fn check_mixed_tangent<const D: usize>() -> Result<(), FemError> {
         let m = material()?;
         let x = distorted::<D>();
-        let element = OnePointSolid::new(&x, 0.7, m.initial_shear_modulus(), 1.0)?;
+        let element = OnePointSolid::new(&x, 0.7, &m, Hourglass::Enhanced)?;
         let u = general_u(&x);
         let (consistent, k) = tangent(&element, &m, &u, Tangent::Consistent)?;
         let p_m = m.volumetric_pressure(consistent.volume_ratio) - 4.0e6;
@@ -575,7 +398,10 @@ mod tests {
 
     /// Patch of distorted elements: affine displacement on the boundary, Newton on the interior
     /// nodes must reproduce the affine field and the homogeneous stress exactly.
-    fn check_patch<const D: usize>(divisions: [usize; D]) -> Result<(), FemError> {
+    fn check_patch<const D: usize>(
+        divisions: [usize; D],
+        control: Hourglass,
+    ) -> Result<(), FemError> {
         let m = material()?;
         let mut mesh =
             SolidMesh::<D>::structured_block(SVector::zeros(), SVector::repeat(3.0), divisions)?;
@@ -590,7 +416,7 @@ mod tests {
             .iter()
             .map(|e| {
                 let x: Vec<_> = e.iter().map(|&id| mesh.nodes[id]).collect();
-                OnePointSolid::new(&x, 1.0, m.initial_shear_modulus(), 1.0)
+                OnePointSolid::new(&x, 1.0, &m, control)
             })
             .collect::<Result<Vec<_>, _>>()?;
         let f = homogeneous_f::<D>();
@@ -639,9 +465,12 @@ mod tests {
                 u[dof / D][dof % D] += step;
             }
         }
-        assert!(converged, "D = {D}: Newton did not converge");
+        assert!(converged, "D = {D}, {control:?}: Newton did not converge");
         for (ui, ei) in u.iter().zip(&exact) {
-            assert!((ui - ei).norm() < 1e-9, "D = {D}: {ui} vs {ei}");
+            assert!(
+                (ui - ei).norm() < 1e-9,
+                "D = {D}, {control:?}: {ui} vs {ei}"
+            );
         }
         let sigma = m.kirchhoff_stress(&f) / f.determinant();
         for (element, nodes) in elements.iter().zip(&mesh.elements) {
@@ -655,14 +484,27 @@ mod tests {
 
     #[test]
     fn patch_of_distorted_elements_reproduces_homogeneous_deformation() -> Result<(), FemError> {
-        check_patch::<2>([3, 3])?;
-        check_patch::<3>([3, 3, 2])
+        for control in CONTROLS {
+            check_patch::<2>([3, 3], control)?;
+            check_patch::<3>([3, 3, 2], control)?;
+        }
+        Ok(())
     }
 
     fn check_rigid_rotation<const D: usize>(rotation: Matrix3<f64>) -> Result<(), FemError> {
+        for control in CONTROLS {
+            check_rigid_rotation_with::<D>(rotation, control)?;
+        }
+        Ok(())
+    }
+
+    fn check_rigid_rotation_with<const D: usize>(
+        rotation: Matrix3<f64>,
+        control: Hourglass,
+    ) -> Result<(), FemError> {
         let m = material()?;
         let x = distorted::<D>();
-        let element = OnePointSolid::new(&x, 1.0, m.initial_shear_modulus(), 1.0)?;
+        let element = OnePointSolid::new(&x, 1.0, &m, control)?;
         let u = affine(&rotation, &x);
         let r = element.respond(&m, &u)?;
         let mu = m.initial_shear_modulus();
@@ -682,10 +524,10 @@ mod tests {
         check_rigid_rotation::<3>(*Rotation3::from_axis_angle(&axis, angle).matrix())
     }
 
-    fn zero_eigenvalues<const D: usize>(scale: f64) -> Result<usize, FemError> {
+    fn zero_eigenvalues<const D: usize>(control: Hourglass) -> Result<usize, FemError> {
         let m = material()?;
         let x = distorted::<D>();
-        let element = OnePointSolid::new(&x, 1.0, m.initial_shear_modulus(), scale)?;
+        let element = OnePointSolid::new(&x, 1.0, &m, control)?;
         let u = vec![SVector::zeros(); element.node_count()];
         let (_, k) = tangent(&element, &m, &u, Tangent::Consistent)?;
         let eigenvalues = SymmetricEigen::new(k).eigenvalues;
@@ -699,11 +541,14 @@ mod tests {
 
     #[test]
     fn stabilised_element_has_only_rigid_zero_modes() -> Result<(), FemError> {
-        assert_eq!(zero_eigenvalues::<2>(1.0)?, 3);
-        assert_eq!(zero_eigenvalues::<3>(1.0)?, 6);
+        for control in CONTROLS {
+            assert_eq!(zero_eigenvalues::<2>(control)?, 3);
+            assert_eq!(zero_eigenvalues::<3>(control)?, 6);
+        }
         // Without stabilisation: 2 hourglass modes in 2D, 12 in 3D.
-        assert_eq!(zero_eigenvalues::<2>(0.0)?, 3 + 2);
-        assert_eq!(zero_eigenvalues::<3>(0.0)?, 6 + 12);
+        let none = Hourglass::Stiffness { scale: 0.0 };
+        assert_eq!(zero_eigenvalues::<2>(none)?, 3 + 2);
+        assert_eq!(zero_eigenvalues::<3>(none)?, 6 + 12);
         Ok(())
     }
 
@@ -711,7 +556,7 @@ mod tests {
         let m = material()?;
         let mu = m.initial_shear_modulus();
         let half = [1.5, 0.5, 0.8];
-        let element = OnePointSolid::new(&brick::<D>(half), 1.0, mu, 1.0)?;
+        let element = OnePointSolid::new(&brick::<D>(half), 1.0, &m, Hourglass::default())?;
         let q = 1e-3;
         let v = element.volume();
         for (h, axes) in hourglass_base_vectors::<D>()?
@@ -750,11 +595,11 @@ mod tests {
                 .iter()
                 .map(|x| restrict(&(turn * embed(x))))
                 .collect();
-            let element = OnePointSolid::new(&turned, 1.0, mu, 1.0)?;
+            let element = OnePointSolid::new(&turned, 1.0, &m, Hourglass::default())?;
             let (a, b) = (half[0], half[1]);
             let mean = mu * v * (1.0 / (a * a) + 1.0 / (b * b)) / 3.0;
             for i in 0..D {
-                let k = element.hourglass_stiffness[0][i];
+                let k = element.hourglass.entry(i, i);
                 assert!((k - mean).abs() < 1e-12 * mean, "{k} vs {mean}");
             }
         }
@@ -769,16 +614,18 @@ mod tests {
 
     #[test]
     fn volume_includes_thickness_and_lumped_mass_sums_to_total() -> Result<(), FemError> {
-        let rect = OnePointSolid::<2>::new(&brick([1.0, 1.5, 0.0]), 0.5, 1.0, 1.0)?;
+        let m = material()?;
+        let control = Hourglass::default();
+        let rect = OnePointSolid::<2>::new(&brick([1.0, 1.5, 0.0]), 0.5, &m, control)?;
         assert!((rect.volume() - 2.0 * 3.0 * 0.5).abs() < 1e-14);
-        let hex = OnePointSolid::<3>::new(&brick([1.0, 1.5, 0.25]), 7.0, 1.0, 1.0)?;
+        let hex = OnePointSolid::<3>::new(&brick([1.0, 1.5, 0.25]), 7.0, &m, control)?;
         assert!((hex.volume() - 2.0 * 3.0 * 0.5).abs() < 1e-14);
         let rho = 7800.0;
-        let quad = OnePointSolid::<2>::new(&distorted(), 0.3, 1.0, 1.0)?;
+        let quad = OnePointSolid::<2>::new(&distorted(), 0.3, &m, control)?;
         let total = quad.lumped_node_mass(rho) * quad.node_count() as f64;
         assert!((total - rho * quad.volume()).abs() < 1e-12 * total);
         assert_eq!(quad.node_count(), 4);
-        let hex = OnePointSolid::<3>::new(&distorted(), 1.0, 1.0, 1.0)?;
+        let hex = OnePointSolid::<3>::new(&distorted(), 1.0, &m, control)?;
         let total = hex.lumped_node_mass(rho) * hex.node_count() as f64;
         assert!((total - rho * hex.volume()).abs() < 1e-12 * total);
         Ok(())
@@ -787,13 +634,14 @@ mod tests {
     #[test]
     fn inverted_and_degenerate_elements_are_errors() -> Result<(), FemError> {
         let m = material()?;
-        let quad = OnePointSolid::<2>::new(&distorted(), 1.0, 1.0, 1.0)?;
+        let control = Hourglass::default();
+        let quad = OnePointSolid::<2>::new(&distorted(), 1.0, &m, control)?;
         let flip = Matrix3::from_diagonal(&V3::new(-0.5, 1.0, 1.0));
         let u = affine(&flip, &distorted::<2>());
         assert!(
             matches!(tangent(&quad, &m, &u, Tangent::Consistent), Err(FemError::InvertedElement { det_f, corner: None }) if det_f < 0.0)
         );
-        let hex = OnePointSolid::<3>::new(&distorted(), 1.0, 1.0, 1.0)?;
+        let hex = OnePointSolid::<3>::new(&distorted(), 1.0, &m, control)?;
         let flip = Matrix3::from_diagonal(&V3::new(1.0, 1.0, -0.5));
         let u = affine(&flip, &distorted::<3>());
         assert!(matches!(
@@ -806,7 +654,7 @@ mod tests {
             .iter()
             .map(|xi| (xi.add_scalar(1.0)) * 0.5)
             .collect();
-        let quad = OnePointSolid::<2>::new(&square, 1.0, 1.0, 1.0)?;
+        let quad = OnePointSolid::<2>::new(&square, 1.0, &m, control)?;
         let fold = |q: f64| -> Vec<Vector2<f64>> {
             corners::<2>()
                 .iter()
@@ -843,28 +691,28 @@ mod tests {
         let mut clockwise = distorted::<2>();
         clockwise.swap(1, 3);
         assert!(matches!(
-            OnePointSolid::new(&clockwise, 1.0, 1.0, 1.0),
+            OnePointSolid::new(&clockwise, 1.0, &m, control),
             Err(FemError::DegenerateElement { det_j }) if det_j < 0.0
         ));
         let mut upside_down = distorted::<3>();
         upside_down.rotate_left(4);
         assert!(matches!(
-            OnePointSolid::new(&upside_down, 1.0, 1.0, 1.0),
+            OnePointSolid::new(&upside_down, 1.0, &m, control),
             Err(FemError::DegenerateElement { .. })
         ));
         assert!(matches!(
-            OnePointSolid::new(&[Vector2::new(1.0, 1.0); 4], 1.0, 1.0, 1.0),
+            OnePointSolid::new(&[Vector2::new(1.0, 1.0); 4], 1.0, &m, control),
             Err(FemError::DegenerateElement { .. })
         ));
         assert!(matches!(
-            OnePointSolid::<2>::new(&distorted(), 0.0, 1.0, 1.0),
+            OnePointSolid::<2>::new(&distorted(), 0.0, &m, control),
             Err(FemError::InvalidParameter {
                 name: "thickness",
                 ..
             })
         ));
         assert!(matches!(
-            OnePointSolid::<3>::new(&distorted(), 1.0, 1.0, -1.0),
+            OnePointSolid::<3>::new(&distorted(), 1.0, &m, Hourglass::Stiffness { scale: -1.0 }),
             Err(FemError::InvalidParameter {
                 name: "hourglass_scale",
                 ..

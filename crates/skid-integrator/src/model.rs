@@ -9,6 +9,7 @@ use skid_contact::kinematics::RotatingFrame;
 use skid_contact::surface::RigidSurface;
 use skid_fem::cell::embed;
 use skid_fem::element::{Formulation, SolidElement};
+use skid_fem::hourglass::Hourglass;
 use skid_fem::material::Hyperelastic;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::{RigidBody, Rotation};
@@ -47,8 +48,8 @@ pub struct SolidPart<const D: usize> {
     pub element_sections: Vec<usize>,
     /// Out-of-plane thickness in 2D (plane strain), m; 1 in 3D.
     pub thickness: f64,
-    /// Factor on the hourglass stabilisation stiffness of the one-point elements (1 = default).
-    pub hourglass_scale: f64,
+    /// Hourglass control of the one-point elements (default: the stiffness control at scale 1).
+    pub hourglass: Hourglass,
     /// Formulation of each element; empty when every element is the one-point
     /// [`Formulation::Reduced`].
     pub element_formulations: Vec<Formulation>,
@@ -212,11 +213,10 @@ impl<const D: usize> Model<D> {
         if !(part.thickness.is_finite() && part.thickness > 0.0) {
             return invalid(format!("thickness must be > 0, got {}", part.thickness));
         }
-        if !(part.hourglass_scale.is_finite() && part.hourglass_scale > 0.0) {
-            return invalid(format!(
-                "hourglass scale must be > 0, got {}",
-                part.hourglass_scale
-            ));
+        if let Hourglass::Stiffness { scale } = part.hourglass
+            && !(scale.is_finite() && scale > 0.0)
+        {
+            return invalid(format!("hourglass scale must be > 0, got {scale}"));
         }
         for body in &bodies {
             body.validate()?;
@@ -301,11 +301,11 @@ impl<const D: usize> Model<D> {
 
         let mut elements = Vec::with_capacity(part.mesh.elements.len());
         for (e, conn) in part.mesh.elements.iter().enumerate() {
-            let mu0 = part.material(e).initial_shear_modulus();
             let x: Vec<SVector<f64, D>> = conn.iter().map(|&n| part.mesh.nodes[n]).collect();
             let formulation = part.formulation(e);
+            let material = part.material(e);
             let element =
-                SolidElement::new(formulation, &x, part.thickness, mu0, part.hourglass_scale)
+                SolidElement::new(formulation, &x, part.thickness, material, part.hourglass)
                     .map_err(|err| ModelError::Invalid(format!("element {e}: {err}")))?;
             elements.push(element);
         }

@@ -2,6 +2,7 @@
 
 use crate::model::Section;
 use nalgebra::{DVector, SVector, Vector2, Vector3};
+use skid_fem::hourglass::Hourglass;
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::{RigidBody, Rotation};
@@ -34,7 +35,7 @@ pub(crate) fn pad_block<const D: usize>(
         }],
         element_sections: Vec::new(),
         thickness: 0.1,
-        hourglass_scale: 1.0,
+        hourglass: Hourglass::default(),
         element_formulations: Vec::new(),
         quasi_static: false,
         fixed: vec![],

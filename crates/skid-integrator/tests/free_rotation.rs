@@ -6,6 +6,7 @@
 //! model is one element held fixed, away from the body.
 
 use nalgebra::{Rotation3, SVector, Vector3};
+use skid_fem::hourglass::Hourglass;
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::{RigidBody, Rotation};
@@ -60,7 +61,7 @@ fn top_with(loads: Loads<3>, axes: Rotation3<f64>) -> Model<3> {
         }],
         element_sections: Vec::new(),
         thickness: 1.0,
-        hourglass_scale: 1.0,
+        hourglass: Hourglass::default(),
         element_formulations: Vec::new(),
         quasi_static: false,
         fixed,

@@ -22,7 +22,7 @@
 use nalgebra::{DMatrix, SVector, Vector2};
 use skid_fem::material::PolynomialN1;
 use skid_fem::solid::Tangent;
-use skid_fem::{Formulation, SolidElement};
+use skid_fem::{Formulation, Hourglass, SolidElement};
 
 /// How the contact nodes and the section are treated.
 #[derive(Clone, Copy)]
@@ -61,8 +61,14 @@ fn growth_rate(n: usize, mu: f64, variant: Variant) -> f64 {
                     )
                 })
                 .collect();
-            let element = SolidElement::<2>::new(Formulation::Reduced, &x, thickness, shear, 1.0)
-                .expect("element");
+            let element = SolidElement::<2>::new(
+                Formulation::Reduced,
+                &x,
+                thickness,
+                &material,
+                Hourglass::default(),
+            )
+            .expect("element");
             let u = [SVector::<f64, 2>::zeros(); 4];
             let mut ke = [0.0; 64];
             element

@@ -2,6 +2,7 @@
 //! bends as beam theory says, for a compressible and a nearly incompressible material alike.
 
 use nalgebra::SVector;
+use skid_fem::hourglass::Hourglass;
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::{RigidBody, Rotation};
@@ -48,7 +49,7 @@ fn tip_deflection(k_over_mu: f64) -> f64 {
         }],
         element_sections: Vec::new(),
         thickness: THICKNESS,
-        hourglass_scale: 1.0,
+        hourglass: Hourglass::default(),
         element_formulations: Vec::new(),
         quasi_static: false,
         fixed: vec![],

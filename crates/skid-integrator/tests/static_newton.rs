@@ -14,6 +14,7 @@
 
 use nalgebra::{Matrix3, SVector, Vector3};
 use skid_fem::element::Formulation;
+use skid_fem::hourglass::Hourglass;
 use skid_fem::material::{Hyperelastic, PolynomialN1};
 use skid_fem::mesh::SolidMesh;
 use skid_integrator::increment::IncrementCounters;
@@ -177,7 +178,7 @@ fn roller_block<const D: usize>(
         }],
         element_sections: Vec::new(),
         thickness: 1.0,
-        hourglass_scale: 1.0,
+        hourglass: Hourglass::default(),
         element_formulations: vec![formulation; n.pow(D as u32)],
         quasi_static: false,
         fixed,
@@ -335,7 +336,7 @@ fn a_nearly_incompressible_solid_converges_under_a_load_of_round_off_size() {
             }],
             element_sections: Vec::new(),
             thickness: 1.0,
-            hourglass_scale: 1.0,
+            hourglass: Hourglass::default(),
             element_formulations: vec![formulation; 16],
             quasi_static: false,
             fixed,

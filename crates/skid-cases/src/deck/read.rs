@@ -4,6 +4,7 @@
 
 use std::collections::HashMap;
 
+use super::controls::read_section_controls;
 use super::fields::{
     allow_parameters, at_most, field, flag, key, label, line_error, real, real_or, required, valued,
 };
@@ -12,7 +13,7 @@ use super::loads::{AmplitudeDef, LoadChange, defined_amplitude, read_amplitude, 
 use super::mesh::Mesh;
 use super::rigid::{AnalyticalKind, AnalyticalSurface, read_analytical};
 use crate::model_spec::DefaultAmplitude;
-use crate::schema::MaterialSpec;
+use crate::schema::{HourglassControl, MaterialSpec};
 
 /// A face of an element-based surface.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -82,6 +83,8 @@ pub struct SectionDef {
     pub material: String,
     /// Thickness (2D out-of-plane, membrane or shell).
     pub thickness: Option<f64>,
+    /// `CONTROLS=`: the name of its `*SECTION CONTROLS` (solid sections).
+    pub controls: Option<String>,
     /// Where.
     pub location: Location,
 }
@@ -247,6 +250,8 @@ pub struct Definitions {
     pub materials: HashMap<String, Named<MaterialDef>>,
     /// Sections in order.
     pub sections: Vec<SectionDef>,
+    /// `*SECTION CONTROLS` by key: their hourglass controls.
+    pub section_controls: HashMap<String, Named<HourglassControl>>,
     /// Rigid bodies in order.
     pub rigid_bodies: Vec<RigidDef>,
     /// `*MASS`: element set and mass.
@@ -369,6 +374,11 @@ fn read_model_block(
         }
         "SOLID SECTION" | "MEMBRANE SECTION" | "SHELL SECTION" => {
             defs.sections.push(read_section(block)?);
+        }
+        "SECTION CONTROLS" => {
+            let control = read_section_controls(block)?;
+            let name = required(block, "NAME")?;
+            insert_named(&mut defs.section_controls, block, name, control)?;
         }
         "MASS" | "ROTARY INERTIA" => read_point_inertia(defs, block)?,
         "SURFACE INTERACTION" => {
@@ -601,7 +611,7 @@ fn read_section(block: &Block) -> Result<SectionDef, DeckError> {
         "MEMBRANE SECTION" => SectionKind::Membrane,
         _ => SectionKind::Shell,
     };
-    allow_parameters(block, &["ELSET", "MATERIAL", "OFFSET"])?;
+    allow_parameters(block, &["ELSET", "MATERIAL", "OFFSET", "CONTROLS"])?;
     if let Some(offset) = valued(block, "OFFSET")?
         && super::fields::parse_real(offset) != Some(0.0)
     {
@@ -612,6 +622,12 @@ fn read_section(block: &Block) -> Result<SectionDef, DeckError> {
     }
     if kind == SectionKind::Solid && block.parameter("OFFSET").is_some() {
         return Err(block.error("OFFSET belongs to membrane and shell sections"));
+    }
+    let controls = valued(block, "CONTROLS")?.map(str::to_string);
+    if kind != SectionKind::Solid && controls.is_some() {
+        return Err(block.error(
+            "CONTROLS belongs to solid sections (the hourglass control of one-point elements)",
+        ));
     }
     let thickness = match block.data.as_slice() {
         [] => None,
@@ -628,6 +644,7 @@ fn read_section(block: &Block) -> Result<SectionDef, DeckError> {
         elset: required(block, "ELSET")?.to_string(),
         material: required(block, "MATERIAL")?.to_string(),
         thickness,
+        controls,
         location: block.location.clone(),
     })
 }
@@ -1262,6 +1279,7 @@ fn is_model_keyword(name: &str) -> bool {
             | "SOLID SECTION"
             | "MEMBRANE SECTION"
             | "SHELL SECTION"
+            | "SECTION CONTROLS"
             | "MASS"
             | "ROTARY INERTIA"
             | "SURFACE INTERACTION"

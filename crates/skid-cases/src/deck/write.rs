@@ -3,8 +3,9 @@
 //! its point mass and inertia and its surface (analytical, or the rigid elements the caller
 //! gives for faceted and triangulated surfaces), contact, boundary and initial conditions, and
 //! the steps, with the field interval as an `*OUTPUT, FIELD, TIME INTERVAL=` request and the
-//! history nodes as `*NODE OUTPUT, NSET=` requests of `U` under `*OUTPUT, HISTORY`. Numbers
-//! are written so that they read back to the same bits.
+//! history nodes as `*NODE OUTPUT, NSET=` requests of `U` under `*OUTPUT, HISTORY`, the
+//! enhanced hourglass control as a `*SECTION CONTROLS` that every `*SOLID SECTION` names.
+//! Numbers are written so that they read back to the same bits.
 //!
 //! Two settings have no keyword and are refused: a static step's regularisation time other
 //! than the default, and an adaptive dynamic step's tolerance other than that of `*DYNAMIC`
@@ -29,7 +30,7 @@ use crate::model_spec::{
     AmplitudeTime, BoundarySpec, DefaultAmplitude, Dof, LoadSpec, ModelSpec, ModelStepSpec,
     RigidBodySpec, RigidSurfaceSpec, SlaveSpec,
 };
-use crate::schema::{MaterialSpec, default_regularization_time};
+use crate::schema::{HourglassControl, MaterialSpec, default_regularization_time};
 
 /// Rigid elements that carry a rigid body's faceted or triangulated surface in a deck.
 #[derive(Clone, Debug)]
@@ -195,9 +196,21 @@ pub fn write_deck(
         let set = m.element_set.as_str();
         (set, &m.material, m.density, m.stiffness_damping)
     });
+    // the part's hourglass control, on every section of it
+    let controls = match part.section.hourglass {
+        HourglassControl::Stiffness => String::new(),
+        HourglassControl::Enhanced => {
+            let name = format!("{}-controls", part.name);
+            let _ = writeln!(out, "*SECTION CONTROLS, NAME={name}, HOURGLASS=ENHANCED");
+            format!(", CONTROLS={name}")
+        }
+    };
     for (elset, law, density, beta) in own.into_iter().chain(others) {
         let material = format!("{elset}-material");
-        let _ = writeln!(out, "*SOLID SECTION, ELSET={elset}, MATERIAL={material}");
+        let _ = writeln!(
+            out,
+            "*SOLID SECTION, ELSET={elset}, MATERIAL={material}{controls}"
+        );
         if dim == 2 {
             let _ = writeln!(out, "{}", num(thickness));
         }

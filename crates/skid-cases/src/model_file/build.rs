@@ -28,7 +28,7 @@ use crate::model_spec::{
     BoundarySpec, ChartSpec, Dof, MODEL_FORMAT_VERSION, ModelSpec, ModelStepSpec, RigidSurfaceSpec,
     SlaveSpec, StepBoundarySpec, profile_polyline,
 };
-use crate::schema::{AdaptiveSpec, MaterialSpec, SolverSpec};
+use crate::schema::{AdaptiveSpec, HourglassControl, MaterialSpec, SolverSpec};
 use crate::validate::check_file_name;
 
 /// A built scene: model, steps and solver settings.
@@ -132,6 +132,7 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         );
     }
     positive("part.section.hourglass_scale", section.hourglass_scale)?;
+    check_hourglass(spec)?;
 
     let body_index = body_names(spec)?;
     let body_of = |field: &str, name: &str| {
@@ -301,7 +302,7 @@ pub fn build<const D: usize>(spec: &ModelSpec) -> Result<Scene<D>, SpecError> {
         sections,
         element_sections,
         thickness: section.thickness,
-        hourglass_scale: section.hourglass_scale,
+        hourglass: section.hourglass.hourglass(section.hourglass_scale),
         element_formulations: element_formulations(spec),
         quasi_static: section.quasi_static,
         fixed: fixed_nodes,
@@ -450,6 +451,37 @@ fn check_field_file_names(spec: &ModelSpec) -> Result<(), SpecError> {
 
 /// The formulation of each element of the part, block by block as [`part_mesh`] numbers them;
 /// empty when every element is the one-point default.
+/// The enhanced hourglass control needs one-point elements and takes no hourglass scale.
+///
+/// # Errors
+/// [`SpecError`] naming `part.section.hourglass` if no element block is of one-point
+/// elements, `part.section.hourglass_scale` if it is not the default.
+fn check_hourglass(spec: &ModelSpec) -> Result<(), SpecError> {
+    let section = &spec.part.section;
+    if section.hourglass != HourglassControl::Enhanced {
+        return Ok(());
+    }
+    let blocks = &spec.part.elements;
+    if !blocks
+        .iter()
+        .any(|b| b.kind.formulation() == Formulation::Reduced)
+    {
+        let kinds: Vec<&str> = blocks.iter().map(|b| b.kind.name()).collect();
+        return fail(
+            "part.section.hourglass",
+            format!(
+                "the enhanced hourglass control is for one-point elements (CPE4R / C3D8R); \
+                 the part has only {}",
+                kinds.join(", ")
+            ),
+        );
+    }
+    section
+        .hourglass
+        .check_scale(section.hourglass_scale)
+        .or_else(|message| fail("part.section.hourglass_scale", message))
+}
+
 fn element_formulations(spec: &ModelSpec) -> Vec<Formulation> {
     let blocks = &spec.part.elements;
     if blocks

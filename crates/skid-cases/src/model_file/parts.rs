@@ -5,8 +5,8 @@
 //! surfaces and element sets are named `<part>.<set>`, and the node set and element set
 //! `<part>` hold all of its nodes and elements. Its material and density become the material of
 //! its element set `<part>` where they differ from the first part's section, and its own
-//! `materials` those of its renamed sets; the section's thickness, hourglass scale and
-//! quasi-static setting hold for the whole mesh, so they must agree with the first part's.
+//! `materials` those of its renamed sets; the section's thickness, hourglass scale and control
+//! and quasi-static setting hold for the whole mesh, so they must agree with the first part's.
 
 use std::collections::BTreeMap;
 
@@ -50,13 +50,14 @@ fn append(merged: &mut PartSpec, part: PartSpec, field: &str) -> Result<(), Spec
             "hourglass_scale",
             base.hourglass_scale != own.hourglass_scale,
         ),
+        ("hourglass", base.hourglass != own.hourglass),
         ("quasi_static", base.quasi_static != own.quasi_static),
     ] {
         if differs {
             return fail(
                 format!("{field}.section.{what}"),
                 "expected the first part's: the section's thickness, hourglass scale and \
-                 quasi-static setting hold for every part",
+                 control and quasi-static setting hold for every part",
             );
         }
     }

@@ -1,6 +1,7 @@
 //! Fixtures shared by the integration tests.
 
 use nalgebra::SVector;
+use skid_fem::hourglass::Hourglass;
 use skid_fem::material::PolynomialN1;
 use skid_fem::mesh::SolidMesh;
 use skid_fem::rigid::{RigidBody, Rotation};
@@ -48,7 +49,7 @@ pub fn block_part(
         }],
         element_sections: Vec::new(),
         thickness,
-        hourglass_scale: 1.0,
+        hourglass: Hourglass::default(),
         element_formulations: Vec::new(),
         quasi_static,
         fixed: vec![],

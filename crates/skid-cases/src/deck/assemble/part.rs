@@ -2,9 +2,11 @@
 //! block, node sets and surfaces of element faces, and the node sets of slave surfaces. Every
 //! deformable element has one `*SOLID SECTION`: the first section listed is the part's, and each
 //! other one's elements become an element set of its ELSET's name with its material
-//! (`part.materials`); all share one thickness.
+//! (`part.materials`); all share one thickness, and those with one-point elements one hourglass
+//! control (`CONTROLS=`, see [`crate::deck::controls`]).
 
 use super::*;
+use crate::deck::controls::part_control;
 use crate::deck::read::SectionDef;
 use crate::model_spec::SetMaterialSpec;
 use crate::schema::MaterialSpec;
@@ -118,6 +120,7 @@ pub(super) fn part_spec(
         thickness,
         stiffness_damping,
     } = read[0].clone();
+    let hourglass = part_control(defs, &solid_sections)?;
     let mut element_sets = BTreeMap::new();
     let mut materials = Vec::new();
     for (k, (section, properties)) in solid_sections.iter().zip(&read).enumerate().skip(1) {
@@ -201,6 +204,7 @@ pub(super) fn part_spec(
             stiffness_damping,
             thickness,
             hourglass_scale: 1.0,
+            hourglass,
             quasi_static: false,
             massless_contact_nodes: false,
         },
