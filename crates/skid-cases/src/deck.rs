@@ -3,10 +3,10 @@
 //! - [`keywords`]: the keyword layer: keyword blocks with parameters and data lines, comments,
 //!   continuation lines and `*INCLUDE`, each with its file and line.
 //! - [`instances`]: parts and their instances flattened into the blocks of one mesh.
-//! - [`read`]: the keyword subset read into definitions with the deck's labels and names
-//!   ([`fields`] reads typed parameters and fields, [`mesh`] nodes, elements and sets,
-//!   [`rigid`] analytical and faceted rigid surfaces, [`loads`] amplitudes and loads).
-//!   ([`controls`] the hourglass control of `*SECTION CONTROLS`).
+//! - [`read`]: the keyword subset read into the [`definitions`], which keep the deck's labels
+//!   and names ([`fields`] reads typed parameters and fields, [`mesh`] nodes, elements and
+//!   sets, [`rigid`] analytical and faceted rigid surfaces, [`loads`] amplitudes and loads,
+//!   [`controls`] the hourglass control of `*SECTION CONTROLS`).
 //! - [`assemble`]: the definitions turned into a model; [`write`]: a model written as a deck.
 //!
 //! The subset: `*HEADING`, `*NODE`, `*ELEMENT` (CPE4R, C3D8R; R2D2, R3D3, R3D4, M3D4R, S4R,
@@ -76,6 +76,7 @@
 
 pub mod assemble;
 pub mod controls;
+pub mod definitions;
 pub mod fields;
 pub mod instances;
 pub mod keywords;

@@ -9,13 +9,13 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use nalgebra::{Matrix3, Vector3};
 use skid_fem::tetra::{TetMesh, compact_triangles};
 
-use super::fields::key;
-use super::keywords::{DeckError, Location};
-use super::mesh::ElementKind;
-use super::read::{
+use super::definitions::{
     BoundaryDef, Change, Definitions, FaceLabel, FieldRequest, InitialDef, Procedure, RigidDef,
     SectionKind, StepDef, SurfaceDef,
 };
+use super::fields::key;
+use super::keywords::{DeckError, Location};
+use super::mesh::ElementKind;
 use super::rigid::{chain, prism, triangles};
 use crate::model_spec::{
     AutomaticIncrementsSpec, BoundarySpec, ContactPairSpec, Dof, ElementBlockSpec, ElementType,

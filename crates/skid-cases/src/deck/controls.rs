@@ -9,10 +9,10 @@ use std::collections::HashMap;
 
 use skid_fem::element::Formulation;
 
+use super::definitions::{Definitions, Named, SectionDef};
 use super::fields::{allow_parameters, key, line_error, required};
 use super::keywords::{Block, DeckError};
 use super::mesh::ElementKind;
-use super::read::{Definitions, Named, SectionDef};
 use crate::schema::HourglassControl;
 
 /// The hourglass control of a `*SECTION CONTROLS` block.

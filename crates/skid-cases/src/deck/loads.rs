@@ -14,89 +14,13 @@
 //!   the loads in force in each step become the model's loads with a factor per step (see
 //!   `assemble::loads::model_loads`).
 
+use super::definitions::{
+    AmplitudeDef, ConcentratedDef, Definitions, GravityDef, LoadChange, LoadDef, LoadKind, Named,
+    PressureDef,
+};
 use super::fields::{allow_parameters, at_most, field, key, label, line_error, real, valued};
-use super::keywords::{Block, DeckError, Location};
-use super::read::{Definitions, Named};
+use super::keywords::{Block, DeckError};
 use crate::model_spec::AmplitudeTime;
-
-/// A distributed pressure: on a surface (`*DSLOAD`) or on face `k` of elements (`*DLOAD`).
-#[derive(Clone, Debug)]
-pub struct PressureDef {
-    /// Surface name (`*DSLOAD`) or element label or set (`*DLOAD`).
-    pub target: String,
-    /// Face of `*DLOAD, Pk` (`None` for a surface).
-    pub face: Option<usize>,
-    /// Pressure.
-    pub magnitude: f64,
-    /// Where.
-    pub location: Location,
-}
-
-/// A `*CLOAD` line: one component on a node, a node set or a reference node.
-#[derive(Clone, Debug)]
-pub struct ConcentratedDef {
-    /// Node label or node set name.
-    pub target: String,
-    /// Degree of freedom 1..=6.
-    pub dof: usize,
-    /// Force or moment.
-    pub magnitude: f64,
-    /// Where.
-    pub location: Location,
-}
-
-/// A `*DLOAD, GRAV` line.
-#[derive(Clone, Debug)]
-pub struct GravityDef {
-    /// Element label or set (`None`: the whole model).
-    pub target: Option<String>,
-    /// Acceleration vector `d (g / |d|)` for the magnitude `g` and the direction `d` as given
-    /// (so that a direction given as the acceleration itself, with its norm as the magnitude,
-    /// reads back to its bits), m/s^2.
-    pub acceleration: [f64; 3],
-    /// Where.
-    pub location: Location,
-}
-
-/// What a load line defines.
-#[derive(Clone, Debug)]
-pub enum LoadKind {
-    /// A pressure.
-    Pressure(PressureDef),
-    /// A concentrated force or moment component.
-    Concentrated(ConcentratedDef),
-    /// Gravity.
-    Gravity(GravityDef),
-}
-
-/// A load line with the amplitude of its keyword.
-#[derive(Clone, Debug)]
-pub struct LoadDef {
-    /// The load.
-    pub kind: LoadKind,
-    /// `AMPLITUDE=` of its keyword, as written.
-    pub amplitude: Option<String>,
-}
-
-/// The loads of one keyword block of a step.
-#[derive(Clone, Debug)]
-pub struct LoadChange {
-    /// The keyword (`CLOAD`, `DLOAD` or `DSLOAD`).
-    pub keyword: &'static str,
-    /// `OP=NEW`: the block replaces the loads of earlier steps given with its keyword.
-    pub replace: bool,
-    /// Its loads.
-    pub items: Vec<LoadDef>,
-}
-
-/// A `*AMPLITUDE` table: `(time, factor)` points, and the time they are read against.
-#[derive(Clone, Debug)]
-pub struct AmplitudeDef {
-    /// The points.
-    pub points: Vec<(f64, f64)>,
-    /// `TIME=STEP TIME` (the default) or `TIME=TOTAL TIME`.
-    pub time: AmplitudeTime,
-}
 
 /// Reads a `*AMPLITUDE` block: `t1, a1, t2, a2, ...`, up to four pairs a line, times from 0
 /// and increasing.

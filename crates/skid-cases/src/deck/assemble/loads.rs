@@ -3,7 +3,7 @@
 //! sets or the whole model, each with the amplitude its keyword names.
 
 use super::*;
-use crate::deck::loads::{LoadChange, LoadKind};
+use crate::deck::definitions::{LoadChange, LoadKind};
 use crate::model_spec::AmplitudeSpec;
 
 /// What a concentrated load acts on.
@@ -263,7 +263,7 @@ fn pressure_surface(
     defs: &Definitions,
     part: &Part,
     part_spec: &mut PartSpec,
-    load: &crate::deck::loads::PressureDef,
+    load: &crate::deck::definitions::PressureDef,
 ) -> Result<String, DeckError> {
     Ok(match load.face {
         None => {

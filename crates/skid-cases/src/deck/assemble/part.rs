@@ -7,7 +7,7 @@
 
 use super::*;
 use crate::deck::controls::part_control;
-use crate::deck::read::SectionDef;
+use crate::deck::definitions::SectionDef;
 use crate::model_spec::SetMaterialSpec;
 use crate::schema::MaterialSpec;
 
