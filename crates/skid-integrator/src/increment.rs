@@ -25,15 +25,10 @@
 //! so Newton converges linearly at that rate on such bodies' equations). Static residual:
 //! `R = F(x)` with `F = f_int - lambda f_ext`; tangent `K_T`, the consistent one, where `K_T`
 //! without the contacts holds every motion (tested on the increment's first tangent, see
-//! [`Assembler::is_held`]), so that Newton converges quadratically; otherwise
-//! `K_T + c_k M/h_s^2`. That mass term only regularises the Newton step (it keeps a pad that is
-//! not yet held by contact from being singular); it is not in the residual, so the converged
-//! state is exactly static. Its factor shrinks with the residual, `c_k = min(1, r_k)` with
-//! `r_k` the last scaled force residual (relative to the largest force in play; floored at
-//! [`MIN_REGULARIZATION`]), as in a Levenberg-Marquardt method whose parameter is the
-//! residual's norm: a fixed term contracts the error by about `s / (s + k)` per iteration
-//! (`s` the term, `k` the stiffness that contact lends the mode it regularises: 1/150-1/400 on
-//! the drum's preload), a vanishing one keeps Newton's quadratic rate. A static increment on the consistent tangent without
+//! [`Assembler::is_held`]), so that Newton converges quadratically; otherwise `K_T + M/h_s^2`.
+//! That mass term only regularises the Newton step (it keeps a pad that is not yet held by
+//! contact from being singular, at the price of a linear rate); it is not in the residual, so
+//! the converged state is exactly static. A static increment on the consistent tangent without
 //! contacts keeps that tangent where it is indefinite (a compressed solid's iterate that has
 //! not relaxed yet), factored as `L D L^T`, so that its rate stays quadratic. Elsewhere, where
 //! the tangent without contact is indefinite (the Cholesky-based contact reduction needs a
@@ -627,16 +622,11 @@ fn solve_increment_with<const D: usize>(
             if !tangent_now {
                 assembler.internal_damped(model, &x, Some(k_factor), damping)?;
             }
-            if let IncrementKind::Static { regularization, .. } = kind {
-                if counters.newton_iterations == 0 {
-                    assembler.hold(held);
-                    if assembler.is_held(shift_mass, held)? {
-                        m_factor = 0.0;
-                        shift.0 = 0.0;
-                    }
-                } else if m_factor > 0.0 {
-                    m_factor = regularization * residual_share(&counters.residuals);
-                    shift = (m_factor, m_factor);
+            if matches!(kind, IncrementKind::Static { .. }) && counters.newton_iterations == 0 {
+                assembler.hold(held);
+                if assembler.is_held(shift_mass, held)? {
+                    m_factor = 0.0;
+                    shift.0 = 0.0;
                 }
             }
             assembler.add_diagonal(&(m_term * m_factor));
@@ -826,21 +816,6 @@ const GLOBAL_MAX_ITERATIONS: usize = 12;
 /// 0.1 to 5 ms steps: 1e-6 converges every increment in about two iterations, 1e-3 takes 50 %
 /// more iterations, 1e-2 and above fail at 0.1 ms (the shifted Newton step crawls).
 const QUASI_STATIC_SHIFT: f64 = 1e-6;
-
-/// Smallest share of a static increment's regularisation `M/h_s^2` that its Newton iterations
-/// keep (see [`residual_share`]): enough to keep the factorization of a pad held only by contact
-/// well away from singular (its rigid motions meet `1e-8 M/h_s^2`, some twelve decades above
-/// the round-off of its stiffness), small enough for Newton's last steps to be quadratic.
-const MIN_REGULARIZATION: f64 = 1e-8;
-
-/// The share `c_k = min(1, r_k)` of a static increment's regularisation at iteration `k`,
-/// floored at [`MIN_REGULARIZATION`], from the scaled (dimensionless) force residuals so far:
-/// `r_k` the last; 1 before the first.
-fn residual_share(residuals: &[(f64, f64)]) -> f64 {
-    residuals
-        .last()
-        .map_or(1.0, |&(last, _)| last.clamp(MIN_REGULARIZATION, 1.0))
-}
 
 /// The round-off of an equation's inertia term, in units of `eps M |x| / (beta h^2)`: the
 /// rounding of `x`, of the predictor and of the differences that form the acceleration.
