@@ -1,6 +1,7 @@
 //! The report's section on the load at which each pad formulation fails: the records of
 //! `scripts/pressure_limit.py` (`pressure-limit.json`: the hard case `<dim>-pressure-x10` run
-//! with each of the four element formulations at a ladder of back-plate pressures), tabled per
+//! with each element formulation, and the one-point element with each hourglass control, at a
+//! ladder of back-plate pressures), tabled per
 //! dimension with the first factor at which each formulation's run fails, and checks that the
 //! record is whole and that every completed run obeys the physics the hard-case section checks:
 //! the friction resultant never above `mu N` ([`FRICTION_TOLERANCE`]), the drum's angular
