@@ -113,15 +113,10 @@ impl Input {
     /// The serializer's, should the input not serialize.
     fn as_run(&self) -> serde_json::Result<(&'static str, String)> {
         Ok(match self {
-            Self::Case(case) => (CASE_JSON, case_text(case)?),
+            Self::Case(case) => (CASE_JSON, json_text(case)?),
             Self::Model(spec, _) => (MODEL_JSON, model_file::to_json(spec)?),
         })
     }
-}
-
-/// The text of `case.json`: the case as run.
-fn case_text(case: &Case) -> serde_json::Result<String> {
-    json_text(case)
 }
 
 /// Runs a case file, a model file (one that declares `skid_model`) or a deck into `out_dir`
@@ -362,7 +357,7 @@ fn run_in<const D: usize>(
     let (mut recorder, mut newton, mut field_writer, input, checkpoint) = match start {
         Start::Fresh => {
             clear_outputs(dir)?;
-            let input = write_input(dir, CASE_JSON, case_text(case))?;
+            let input = write_input(dir, CASE_JSON, json_text(case))?;
             let recorder = DrumRecorder::create(dir, restart_every > 0)
                 .map_err(output(dir.join("history.csv")))?;
             let newton = NewtonRecorder::create(dir).map_err(output(dir.join(NEWTON_CSV)))?;
