@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Kill and resume, the long version of crates/skid-cli/tests/kill_resume.rs.
+"""Kill and resume, the long version of crates/skid-cli/tests/commands/kill_resume.rs.
 
 For each case: an uninterrupted reference run, then KILLS runs killed with SIGKILL at random
 moments over the run (start-up and output phase included), each resumed with

@@ -27,7 +27,7 @@ error at no step above the coarsest step's or 0.01 %, whichever is larger, and n
 scatter under 2 % at every step and mesh: sharp, massless contact nodes for mu <= 0.3 and with
 the damping for mu <= 0.7; rounded, with the damping, every mu); exit status 1 if one fails.
 Steady Coulomb sliding of this block is a flutter instability without damping
-(crates/skid-integrator/tests/frictional_flutter.rs): the undamped rows hold only where HHT's
+(crates/skid-integrator/tests/scenes/frictional_flutter.rs): the undamped rows hold only where HHT's
 numerical damping outweighs the growth.
 
 What the sharp block does at mu = 1 (the section "The sharp corner at mu = 1" of the report,
@@ -424,7 +424,7 @@ def main():
         "Steady Coulomb sliding of this block flutters without damping: linearised about the",
         "sliding state, friction couples the contact nodes' normal reactions into their",
         "tangential rows, and mode pairs turn complex and grow (mode-coupling flutter, the",
-        "mechanism of brake squeal; crates/skid-integrator/tests/frictional_flutter.rs). With",
+        "mechanism of brake squeal; crates/skid-integrator/tests/scenes/frictional_flutter.rs). With",
         "the lumped mass on the contact nodes the 4 x 4 block grows from mu below 0.3; massless",
         "contact nodes raise that to about 0.62 on 4 x 4, but on 8 x 8 it grows at mu = 0.3",
         "already, and faster on finer meshes: without damping the continuum problem is",

@@ -19,9 +19,7 @@ use std::path::{Path, PathBuf};
 
 // this test reads decks but checks no refusal
 #[allow(dead_code)]
-#[path = "support/deck_text.rs"]
-mod deck_text;
-use deck_text::read_deck_text;
+use crate::deck_text::read_deck_text;
 
 use skid_cases::deck::read_model;
 use skid_cases::deck::write::write_deck;

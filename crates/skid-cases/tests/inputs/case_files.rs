@@ -4,7 +4,7 @@ use std::path::Path;
 
 use skid_cases::{CaseError, load_case, parse_case};
 
-const SHIPPED: &str = include_str!("../../../cases/drum/2d-analytic.json");
+const SHIPPED: &str = include_str!("../../../../cases/drum/2d-analytic.json");
 
 fn with(edit: impl Fn(&mut serde_json::Value)) -> String {
     let mut v: serde_json::Value = serde_json::from_str(SHIPPED).expect("shipped case is JSON");

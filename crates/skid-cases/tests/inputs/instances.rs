@@ -5,9 +5,7 @@
 
 use std::path::Path;
 
-#[path = "support/deck_text.rs"]
-mod deck_text;
-use deck_text::{assert_refused_at, read_deck_text};
+use crate::deck_text::{assert_refused_at, read_deck_text};
 
 use skid_cases::model_spec::ModelSpec;
 use skid_cases::runner::run_model;

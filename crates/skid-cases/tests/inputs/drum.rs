@@ -6,11 +6,11 @@ use std::path::Path;
 use skid_cases::csv_out::CsvTable;
 use skid_cases::{Summary, parse_case, run_case};
 
-const CASE_2D: &str = include_str!("../../../cases/drum/2d-analytic.json");
-const CASE_3D: &str = include_str!("../../../cases/drum/3d-analytic.json");
-const CASE_2D_R2D2: &str = include_str!("../../../cases/drum/2d-r2d2.json");
-const CASE_3D_C3D4: &str = include_str!("../../../cases/drum/3d-c3d4.json");
-const CASE_3D_GENERAL: &str = include_str!("../../../cases/drum/3d-analytic-general.json");
+const CASE_2D: &str = include_str!("../../../../cases/drum/2d-analytic.json");
+const CASE_3D: &str = include_str!("../../../../cases/drum/3d-analytic.json");
+const CASE_2D_R2D2: &str = include_str!("../../../../cases/drum/2d-r2d2.json");
+const CASE_3D_C3D4: &str = include_str!("../../../../cases/drum/3d-c3d4.json");
+const CASE_3D_GENERAL: &str = include_str!("../../../../cases/drum/3d-analytic-general.json");
 
 fn run_text(text: &str, overrides: &[&str]) -> (Summary, tempfile::TempDir) {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();

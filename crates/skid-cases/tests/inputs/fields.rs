@@ -9,11 +9,11 @@ use skid_cases::csv_out::CsvTable;
 use skid_cases::{parse_case, run_case};
 use vtkio::model::CellType;
 
-mod common;
-use common::{Vtu, cross, current, norm, sub};
+use crate::common;
+use crate::common::{Vtu, cross, current, norm, sub};
 
-const CASE_2D: &str = include_str!("../../../cases/drum/2d-analytic.json");
-const CASE_3D: &str = include_str!("../../../cases/drum/3d-analytic.json");
+const CASE_2D: &str = include_str!("../../../../cases/drum/2d-analytic.json");
+const CASE_3D: &str = include_str!("../../../../cases/drum/3d-analytic.json");
 /// Drum radius, pad width (the plane-strain thickness in 2D) and drum width of both cases.
 const R: f64 = 0.2;
 const PAD_WIDTH: f64 = 0.1;

@@ -2,7 +2,7 @@
 //! each); every entry of the bad-input corpus fails with exactly the message `skid run` gives
 //! for it (exit 2), and nothing is written.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -10,13 +10,11 @@
 //! exactly mu N; and the reaction's work goes into the frictional dissipation and the strain
 //! energy. Prescriptions the model cannot take are refused with their field. The scene's deck
 //! prescribes the same motion with `*BOUNDARY` magnitudes in its steps, and what a deck cannot
-//! express of a motion is refused at its line (part nodes' motions: `tests/node_motions.rs`).
+//! express of a motion is refused at its line (part nodes' motions: `node_motions.rs`).
 
 use std::path::{Path, PathBuf};
 
-#[path = "support/deck_text.rs"]
-mod deck_text;
-use deck_text::{assert_refused_at, read_deck_text};
+use crate::deck_text::{assert_refused_at, read_deck_text};
 
 use skid_cases::deck::read_model;
 use skid_cases::model_file::{self, parse_model};

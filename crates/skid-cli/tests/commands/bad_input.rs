@@ -2,12 +2,11 @@
 //! message naming the case file and every fragment the entry's `.expect` lists, never panics,
 //! and leaves no output behind.
 
-mod common;
-
 use std::path::Path;
 use std::process::Command;
 
-use common::{Entry, corpus, files_with};
+use crate::common;
+use crate::common::{Entry, corpus, files_with};
 
 fn any_file_named(dir: &Path, name: &str) -> bool {
     std::fs::read_dir(dir)

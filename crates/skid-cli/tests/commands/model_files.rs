@@ -2,8 +2,7 @@
 //! error exits with status 2 naming the file and the field, and `skid batch` says a model file is
 //! not a case file.
 
-mod common;
-use common::{skid, succeeds};
+use crate::common::{skid, succeeds};
 
 const CASE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),

@@ -188,7 +188,7 @@ fn model_file_enhanced_control_needs_one_point_elements_and_no_scale() {
 
 #[test]
 fn case_file_enhanced_control_needs_the_reduced_pad() {
-    let shipped = include_str!("../../../cases/drum/2d-analytic.json");
+    let shipped = include_str!("../../../../cases/drum/2d-analytic.json");
     let parse = |sets: &[&str]| {
         let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
         parse_case(shipped, Path::new("case.json"), &sets)

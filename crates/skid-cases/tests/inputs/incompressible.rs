@@ -8,7 +8,7 @@ use std::path::Path;
 
 use skid_cases::{Summary, parse_case, run_case};
 
-const CASE_2D: &str = include_str!("../../../cases/hard/2d-incompressible.json");
+const CASE_2D: &str = include_str!("../../../../cases/hard/2d-incompressible.json");
 
 fn run_briefly(text: &str) -> (Summary, tempfile::TempDir) {
     let overrides = vec!["steps[1].duration=0.002".to_string()];

@@ -2,7 +2,7 @@
 //! mu N, and slides with a friction force of exactly mu N above it. Every check runs with both
 //! contact solves (global and reduced), which must also agree with each other.
 
-mod common;
+use crate::common;
 
 use nalgebra::Vector3;
 use skid_contact::plane::RigidPlane;

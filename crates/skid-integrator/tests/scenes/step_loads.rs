@@ -4,7 +4,7 @@
 //! the equilibrium of a single step at twice the load, and removing it brings the elastic beam
 //! back to its reference shape.
 
-mod common;
+use crate::common;
 
 use nalgebra::SVector;
 use skid_integrator::settings::Settings;

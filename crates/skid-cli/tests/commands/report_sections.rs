@@ -10,7 +10,7 @@ fn skid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_skid"))
 }
 
-const CASE: &str = include_str!("../../../cases/drum/2d-analytic.json");
+const CASE: &str = include_str!("../../../../cases/drum/2d-analytic.json");
 
 /// The shipped 2D case with `edit` applied.
 fn case(edit: impl Fn(&mut Value)) -> Value {

@@ -6,7 +6,7 @@
 //! (`E(t) = E0 exp(-beta omega^2 t)` averaged over a period), the ledger books what it takes
 //! as damping dissipation and closes, and the undamped run keeps its energy.
 
-mod common;
+use crate::common;
 
 use nalgebra::{SVector, Vector3};
 use skid_contact::plane::RigidPlane;

@@ -2,8 +2,7 @@
 
 use skid_cases::csv_out::CsvTable;
 
-mod common;
-use common::{skid, succeeds};
+use crate::common::{skid, succeeds};
 
 const CASE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),

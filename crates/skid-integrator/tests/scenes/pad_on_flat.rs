@@ -5,7 +5,7 @@
 //!   equilibrium, and the equilibrium must not depend on the Newton matrix's mass regularisation;
 //! - nearly incompressible (K/mu = 1e7): preload and dynamics must run without cutbacks.
 
-mod common;
+use crate::common;
 
 use nalgebra::Vector3;
 use skid_contact::plane::RigidPlane;
@@ -127,7 +127,7 @@ fn pad_pressed_beyond_its_shear_modulus_reaches_the_same_equilibrium() {
 /// K/mu = 1e7 under the drum's pressure: the static preload runs without cutbacks and the nearly
 /// incompressible pad settles to the same contact force, with J = 1 to 1e-6. (This static case
 /// passes with the displacement tangent too; the dynamic case where that tangent turns
-/// indefinite, and the mixed tangent is needed, is `skid-cases/tests/incompressible.rs`.)
+/// indefinite, and the mixed tangent is needed, is `skid-cases/tests/inputs/incompressible.rs`.)
 #[test]
 fn nearly_incompressible_pad_preloads_and_settles_without_cutbacks() {
     let pressure = 0.35e6;

@@ -9,8 +9,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-mod common;
-use common::{shipped, skid, without_timings};
+use crate::common::{shipped, skid, without_timings};
 
 /// The shipped case `relative`, renamed `name`, its last step shortened to `duration` s,
 /// written into `dir`; returns the new file.

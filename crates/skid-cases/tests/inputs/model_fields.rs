@@ -15,8 +15,8 @@ use skid_cases::{RunSummary, run_file};
 use skid_integrator::stepper::{IncrementReport, Observer, run};
 use vtkio::model::CellType;
 
-mod common;
-use common::{Vtu, current, norm, sub, tributary_areas};
+use crate::common;
+use crate::common::{Vtu, current, norm, sub, tributary_areas};
 
 fn shipped(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -13,8 +13,7 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
-mod common;
-use common::{shipped, skid, without_timings};
+use crate::common::{shipped, skid, without_timings};
 
 /// A run to kill: a shipped input with the overrides that shorten it and give it field
 /// output, and the name of the input as run in its directory.

@@ -9,7 +9,7 @@
 //! shift that slows Newton down (at 0.25 ms steps it needs 9 cutbacks and stops at 3.1 ms with a
 //! folded element; the global solve takes 20 increments and 33 iterations).
 
-mod common;
+use crate::common;
 
 use nalgebra::{SVector, Vector3};
 use skid_contact::plane::RigidPlane;

@@ -8,7 +8,7 @@ use skid_cases::{parse_case, run_case};
 use skid_report::convergence::hardest_increment;
 use skid_report::load_run;
 
-const CASE_2D: &str = include_str!("../../../cases/drum/2d-analytic.json");
+const CASE_2D: &str = include_str!("../../../../cases/drum/2d-analytic.json");
 const ODD_NAME: &str = "spin, down \"fast\"";
 
 /// Runs the 2D drum for 5 ms with its dynamic step called `name`.

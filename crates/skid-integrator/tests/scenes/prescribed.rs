@@ -6,7 +6,7 @@
 //! increment); the friction is mu N whenever every contact slips; and the energy ledger closes
 //! with the reaction's work. A prescription the model cannot take is refused.
 
-mod common;
+use crate::common;
 
 use nalgebra::{SVector, Vector3};
 use skid_contact::plane::RigidPlane;

@@ -13,14 +13,11 @@
 
 use std::path::{Path, PathBuf};
 
-#[path = "support/deck_text.rs"]
-mod deck_text;
-use deck_text::{assert_refused_at, read_deck_text};
+use crate::deck_text::{assert_refused_at, read_deck_text};
 
 // this test reads a frame's geometry, not its data
 #[allow(dead_code)]
-mod common;
-use common::Vtu;
+use crate::common::Vtu;
 use vtkio::model::CellType;
 
 use skid_cases::csv_out::CsvTable;

@@ -14,9 +14,7 @@
 
 use std::path::{Path, PathBuf};
 
-#[path = "support/deck_text.rs"]
-mod deck_text;
-use deck_text::{assert_refused_at, read_deck_text};
+use crate::deck_text::{assert_refused_at, read_deck_text};
 
 use skid_cases::deck::read_model;
 use skid_cases::deck::write::write_deck;
