@@ -17,8 +17,6 @@
 
 use std::path::{Path, PathBuf};
 
-// this test reads decks but checks no refusal
-#[allow(dead_code)]
 use crate::deck_text::read_deck_text;
 
 use skid_cases::deck::read_model;

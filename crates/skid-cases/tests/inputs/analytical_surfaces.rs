@@ -15,8 +15,6 @@ use std::path::{Path, PathBuf};
 
 use crate::deck_text::{assert_refused_at, read_deck_text};
 
-// this test reads a frame's geometry, not its data
-#[allow(dead_code)]
 use crate::common::Vtu;
 use vtkio::model::CellType;
 

@@ -1,8 +1,6 @@
 //! What several test files share: the `skid` binary, the shipped cases and the bad-input
 //! corpus (`cases/bad/`, see its README).
 
-#![allow(dead_code)] // Each test file uses its part.
-
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
