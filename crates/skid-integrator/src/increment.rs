@@ -30,10 +30,12 @@
 //! contact from being singular, at the price of a linear rate); it is not in the residual, so
 //! the converged state is exactly static. A static increment on the consistent tangent without
 //! contacts keeps that tangent where it is indefinite (a compressed solid's iterate that has
-//! not relaxed yet), factored as `L D L^T`, so that its rate stays quadratic. Elsewhere, where
-//! the tangent without contact is indefinite (the Cholesky-based contact reduction needs a
-//! definite one) or singular, the mass term of either matrix grows tenfold at a time (from
-//! `M/h_s^2` for a static tangent without one) until it can be factorized (see
+//! not relaxed yet), factored as `L D L^T`, so that its rate stays quadratic. An increment on
+//! the reduced contact path whose tangent without the contacts is indefinite (the
+//! Cholesky-based reduction needs a definite one; the contacts hold the pad) goes on with
+//! global steps on that same tangent, which keeps the rate (see [`solve_increment`]). Where
+//! that fails, or the tangent is singular, the mass term of either matrix grows tenfold at a
+//! time (from `M/h_s^2` for a static tangent without one) until it can be factorized (see
 //! [`Assembler::with_mass_shift`]), which again changes only Newton's path.
 //!
 //! Stiffness damping (a section's `beta`, see [`crate::assembly::Damping`]) is part of `F` in
@@ -150,6 +152,9 @@ pub struct IncrementCounters {
     pub contact_newton_steps: usize,
     /// 1 if the increment was solved by the reduced contact step after the global one failed.
     pub contact_fallbacks: usize,
+    /// 1 if a reduced increment went on with global contact steps because its tangent without
+    /// the contacts was indefinite (see [`solve_increment`]).
+    pub global_switches: usize,
     /// Scaled (force, contact) residuals at each convergence check.
     pub residuals: Vec<(f64, f64)>,
 }
@@ -197,6 +202,15 @@ pub struct Rejection {
 /// [`ContactSolve::Reduced`] (counted in [`IncrementCounters::contact_fallbacks`]), and the
 /// failure reported is that of the second attempt, with its residuals.
 ///
+/// With [`ContactSolve::Reduced`], an iteration whose tangent `K + c M` without the contacts
+/// is indefinite (a compressed pad held only by its contacts) has no Cholesky factor for the
+/// reduction to the contact forces. The contacts make the full system definite on the
+/// motions they hold, so the increment goes on with global steps on that same matrix
+/// (counted in [`IncrementCounters::global_switches`]): Newton keeps the tangent of the
+/// residual and its rate. If that attempt fails, the increment is solved again on the reduced
+/// path with the mass term raised until the tangent factorizes (see
+/// [`Assembler::with_mass_shift`]), which changes only Newton's path.
+///
 /// # Errors
 /// A [`Rejection`] saying why Newton failed; the caller cuts back.
 pub fn solve_increment<const D: usize>(
@@ -208,7 +222,8 @@ pub fn solve_increment<const D: usize>(
     settings: &Settings,
     timings: &mut Timings,
 ) -> Result<(State, IncrementCounters), Rejection> {
-    let mut attempt = |method| {
+    // the state, or the rejection and whether the attempt had switched to global steps
+    let mut attempt = |method, may_switch| {
         let mut counters = IncrementCounters::default();
         match solve_increment_with(
             model,
@@ -217,32 +232,41 @@ pub fn solve_increment<const D: usize>(
             kind,
             (held, prescribed),
             settings,
-            (method, &mut counters),
+            (method, may_switch, &mut counters),
             timings,
         ) {
             Ok(state) => Ok((state, counters)),
-            Err(failure) => Err(Rejection {
-                failure,
-                residuals: counters.residuals,
-            }),
+            Err(failure) => Err((
+                Rejection {
+                    failure,
+                    residuals: counters.residuals,
+                },
+                counters.global_switches > 0,
+            )),
         }
     };
     match settings.contact_solve {
-        ContactSolve::Reduced => attempt(ContactSolve::Reduced),
-        ContactSolve::Global => match attempt(ContactSolve::Global) {
+        ContactSolve::Reduced => match attempt(ContactSolve::Reduced, true) {
+            Ok(solved) => Ok(solved),
+            Err((_, true)) => attempt(ContactSolve::Reduced, false).map_err(|(r, _)| r),
+            Err((rejection, false)) => Err(rejection),
+        },
+        ContactSolve::Global => match attempt(ContactSolve::Global, false) {
             Ok(solved) => Ok(solved),
             Err(_) if !model.contacts().is_empty() => {
-                let (state, mut counters) = attempt(ContactSolve::Reduced)?;
+                let (state, mut counters) =
+                    attempt(ContactSolve::Reduced, false).map_err(|(r, _)| r)?;
                 counters.contact_fallbacks += 1;
                 Ok((state, counters))
             }
-            Err(rejection) => Err(rejection),
+            Err((rejection, _)) => Err(rejection),
         },
     }
 }
 
-/// [`solve_increment`] with the contact forces of every iteration from `method`, counting into
-/// `counters` (which keep the residuals of a failed attempt too).
+/// [`solve_increment`] with the contact forces of every iteration from `method`, or, if
+/// `may_switch`, from global steps once a reduced one finds its tangent indefinite; counting
+/// into `counters` (which keep the residuals of a failed attempt too).
 #[allow(clippy::too_many_arguments)] // solve_increment's inputs and the method
 fn solve_increment_with<const D: usize>(
     model: &Model<D>,
@@ -251,7 +275,7 @@ fn solve_increment_with<const D: usize>(
     kind: IncrementKind,
     (held, prescribed): (&[bool], &[(usize, f64)]),
     settings: &Settings,
-    (method, counters): (ContactSolve, &mut IncrementCounters),
+    (mut method, may_switch, counters): (ContactSolve, bool, &mut IncrementCounters),
     timings: &mut Timings,
 ) -> Result<State, IncrementFailure> {
     let Workspace { assembler, global } = workspace;
@@ -635,11 +659,11 @@ fn solve_increment_with<const D: usize>(
         }
         timings.assembly += clock.elapsed();
 
-        // The mass term of the matrix is raised until `K + c M` can be factorized (see
-        // `Assembler::with_mass_shift`): a static step's regularisation, or a long dynamic
-        // step's `1/(beta h^2)` where the compressed pad's tangent without its contacts is
-        // indefinite. The residual keeps the true inertia, so only Newton's path changes.
-        let dx = if rows.is_empty() {
+        // The step: without contacts on `K + c M` itself (its mass term raised only where it
+        // is singular, see `Assembler::with_mass_shift`); with contacts reduced onto their
+        // forces while `K + c M` factorizes, else (or by request) global on the full system.
+        // The residual keeps the true inertia, so a raised mass term changes only the path.
+        let reduced = if rows.is_empty() {
             let clock = Instant::now();
             // A static step on the consistent tangent keeps it where it is indefinite (see
             // `Assembler::is_held`); the mass shift is left for a singular one.
@@ -668,59 +692,83 @@ fn solve_increment_with<const D: usize>(
                 u: DVector::zeros(0),
                 rho: Vec::new(),
             });
-            dx
-        } else if method == ContactSolve::Global {
-            let clock = Instant::now();
-            let k = assembler.lower_triangle()?;
-            let rho = weights.get_or_insert_with(|| contact_weights(k, &rows));
-            if warm.len() != rows.rows.len() {
-                warm = DVector::zeros(rows.rows.len());
-            }
-            let step = if exact_contact {
-                let limits = (newton.contact_tolerance * length, LINEARISED_MAX_STEPS);
-                global.linearised_solution(model, k, &rows, &residual, &warm, rho, held, limits)
-            } else {
-                global.step(model, k, &rows, &residual, &warm, rho, held)
-            };
-            timings.linear_solve += clock.elapsed();
-            let step = step?;
-            forces_before = Some(std::mem::replace(&mut warm, step.r.clone()));
-            last = Some(LastForces::Law {
-                r: step.r,
-                rho: rho.clone(),
-            });
-            step.dx
-        } else {
+            Some(dx)
+        } else if method == ContactSolve::Reduced {
             let mut reuse = reusable.take().filter(|_| chord);
             if weights.is_none() {
                 let k = assembler.lower_triangle()?;
                 weights = Some(contact_weights(k, &rows));
             }
-            let ((dx, solution, factor), _) =
-                assembler.with_mass_shift(shift_mass, shift, held, |a| {
-                    contact_step(
-                        a,
-                        &rows,
-                        &residual,
-                        &warm,
-                        length,
-                        newton.contact_tolerance * length,
-                        &settings.coulomb,
-                        reuse.take(),
-                        timings,
-                    )
-                })?;
-            reusable = Some(factor);
-            counters.contact_solves += solution.conic_solves;
-            counters.fixed_point_iterations += solution.fixed_point_iterations;
-            counters.contact_newton_steps += solution.newton_steps;
-            warm.clone_from(&solution.r);
-            last = Some(LastForces::Linearised {
-                r: solution.r,
-                u: solution.u,
-                rho: weights.clone().unwrap_or_default(),
-            });
-            dx
+            let mut step = |a: &mut Assembler| {
+                contact_step(
+                    a,
+                    &rows,
+                    &residual,
+                    &warm,
+                    length,
+                    newton.contact_tolerance * length,
+                    &settings.coulomb,
+                    reuse.take(),
+                    timings,
+                )
+            };
+            let stepped = if may_switch {
+                match step(assembler) {
+                    Err(e) if is_not_factorized(&e) => None,
+                    stepped => Some(stepped?),
+                }
+            } else {
+                Some(assembler.with_mass_shift(shift_mass, shift, held, step)?.0)
+            };
+            match stepped {
+                Some((dx, solution, factor)) => {
+                    reusable = Some(factor);
+                    counters.contact_solves += solution.conic_solves;
+                    counters.fixed_point_iterations += solution.fixed_point_iterations;
+                    counters.contact_newton_steps += solution.newton_steps;
+                    warm.clone_from(&solution.r);
+                    last = Some(LastForces::Linearised {
+                        r: solution.r,
+                        u: solution.u,
+                        rho: weights.clone().unwrap_or_default(),
+                    });
+                    Some(dx)
+                }
+                // the tangent without the contacts is indefinite: global steps from here on
+                // (see `solve_increment`)
+                None => {
+                    method = ContactSolve::Global;
+                    counters.global_switches += 1;
+                    None
+                }
+            }
+        } else {
+            None
+        };
+        let dx = match reduced {
+            Some(dx) => dx,
+            None => {
+                let clock = Instant::now();
+                let k = assembler.lower_triangle()?;
+                let rho = weights.get_or_insert_with(|| contact_weights(k, &rows));
+                if warm.len() != rows.rows.len() {
+                    warm = DVector::zeros(rows.rows.len());
+                }
+                let step = if exact_contact {
+                    let limits = (newton.contact_tolerance * length, LINEARISED_MAX_STEPS);
+                    global.linearised_solution(model, k, &rows, &residual, &warm, rho, held, limits)
+                } else {
+                    global.step(model, k, &rows, &residual, &warm, rho, held)
+                };
+                timings.linear_solve += clock.elapsed();
+                let step = step?;
+                forces_before = Some(std::mem::replace(&mut warm, step.r.clone()));
+                last = Some(LastForces::Law {
+                    r: step.r,
+                    rho: rho.clone(),
+                });
+                step.dx
+            }
         };
         counters.newton_iterations += 1;
         if dx.iter().any(|v| !v.is_finite()) {

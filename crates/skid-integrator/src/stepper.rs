@@ -563,6 +563,9 @@ pub struct RunStatistics {
     /// Converged increments whose global contact solve failed and that the reduced one solved
     /// (see [`crate::increment::solve_increment`]).
     pub contact_fallbacks: usize,
+    /// Converged reduced increments that went on with global contact steps where the tangent
+    /// without the contacts was indefinite (see [`crate::increment::solve_increment`]).
+    pub global_switches: usize,
     /// Failed attempts answered by a cutback.
     pub cutbacks: usize,
     /// Converged increments taken again shorter because their local error exceeded the
@@ -1166,6 +1169,7 @@ impl<const D: usize> Run<'_, D> {
                     stats.fixed_point_iterations += counters.fixed_point_iterations;
                     stats.contact_newton_steps += counters.contact_newton_steps;
                     stats.contact_fallbacks += counters.contact_fallbacks;
+                    stats.global_switches += counters.global_switches;
                     let cost = &mut stats.steps[index];
                     cost.increments += 1;
                     cost.newton_iterations += counters.newton_iterations;

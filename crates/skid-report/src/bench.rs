@@ -289,6 +289,10 @@ pub struct BenchRecord {
     pub factorizations: Option<usize>,
     /// Increments the global contact solve handed to the reduced one.
     pub contact_fallbacks: usize,
+    /// Reduced increments that went on with global steps, their tangent without the contacts
+    /// being indefinite (absent in older records).
+    #[serde(default)]
+    pub global_switches: usize,
     /// Stop time, s.
     pub t_stop: Option<f64>,
     /// Sliding deceleration, rad/s^2.
@@ -855,6 +859,7 @@ fn run_level(
         newton_iterations: cost.newton_iterations,
         factorizations: Some(cost.factorizations()),
         contact_fallbacks: cost.contact_fallbacks,
+        global_switches: cost.global_switches,
         t_stop: summary.t_stop,
         deceleration: summary.deceleration,
         deceleration_error: None,
@@ -972,7 +977,7 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
         );
     }
     md.push_str(
-        "| case | method | ladder | dt [s] | pad mesh | equations | status | wall [s] | runs | assembly / linear (factorization) / contact / output [s] | peak memory, at most [MB] | increments | Newton iterations | factorizations | fallbacks | deceleration [rad/s^2] | deceleration error [%] | e_slide [%] | t_stop [s] | t_stop difference [%] |\n\
+        "| case | method | ladder | dt [s] | pad mesh | equations | status | wall [s] | runs | assembly / linear (factorization) / contact / output [s] | peak memory, at most [MB] | increments | Newton iterations | factorizations | fallbacks / switches | deceleration [rad/s^2] | deceleration error [%] | e_slide [%] | t_stop [s] | t_stop difference [%] |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let seconds = |t: Option<f64>| t.map_or_else(|| "n/a".into(), |t| format!("{t:.3}"));
@@ -1010,7 +1015,7 @@ pub fn write_bench_report(records: &[BenchRecord], out: &Path) -> Result<(), Ben
             r.newton_iterations,
             r.factorizations
                 .map_or_else(|| "n/a".into(), |f| f.to_string()),
-            r.contact_fallbacks,
+            format_args!("{} / {}", r.contact_fallbacks, r.global_switches),
             show(r.deceleration),
             percent(r.deceleration_error),
             percent(r.e_slide),
@@ -1272,6 +1277,7 @@ mod tests {
             newton_iterations: 1,
             factorizations: None,
             contact_fallbacks: 0,
+            global_switches: 0,
             t_stop: Some(0.1),
             deceleration: Some(600.0),
             deceleration_error: Some(errors.map_or(0.0, |e| e.0)),

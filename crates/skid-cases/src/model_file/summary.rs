@@ -28,6 +28,10 @@ pub struct RunCost {
     pub contact_newton_steps: usize,
     /// Increments the global contact solve did not converge and the reduced one solved.
     pub contact_fallbacks: usize,
+    /// Reduced increments that went on with global contact steps, their tangent without the
+    /// contacts being indefinite.
+    #[serde(default)]
+    pub global_switches: usize,
     /// Cholesky factorizations of the effective tangent.
     pub tangent_factorizations: usize,
     /// LU factorizations of the global contact system.
@@ -100,6 +104,7 @@ impl From<&RunStatistics> for RunCost {
             fixed_point_iterations: stats.fixed_point_iterations,
             contact_newton_steps: stats.contact_newton_steps,
             contact_fallbacks: stats.contact_fallbacks,
+            global_switches: stats.global_switches,
             tangent_factorizations: stats.solves.tangent_factorizations,
             lu_factorizations: stats.solves.lu_factorizations,
             preconditioner_factorizations: stats.solves.preconditioner_factorizations,
