@@ -58,8 +58,10 @@
 //! other bodies' rows (a drum's, which meets the solid only through contact) keep theirs.
 //! Scaling a row does not move its root; the force residual is measured on the unscaled rows.
 
+use std::borrow::Cow;
 use std::time::{Duration, Instant};
 
+use faer::sparse::SparseColMatRef;
 use nalgebra::{DVector, Vector2};
 use skid_contact::SurfacePoint;
 
@@ -71,7 +73,7 @@ use crate::cost::{SolveCounts, Timings};
 use crate::coupling::contact_step;
 use crate::dof::EquationKind;
 use crate::error::{IncrementFailure, WorstResidual};
-use crate::global_contact::{GlobalContactSolver, contact_weights, law_residuals};
+use crate::global_contact::{GlobalContactSolver, GlobalStep, contact_weights, law_residuals};
 use crate::hht::{Hht, IncrementEnds};
 use crate::loads::LoadInstant;
 use crate::model::Model;
@@ -299,75 +301,20 @@ fn solve_increment_with<const D: usize>(
         IncrementKind::Static { .. } => None,
         IncrementKind::Dynamic { .. } => Some(RowStart::new(model, &start.x)),
     };
-    // The solid's rows of the tangent are `c_K K_T`, the mass term `c_M M` (regularising in a
-    // static increment, inertial in a dynamic one).
-    // With the contact nodes' mass moved off them, a dynamic increment multiplies the rows of
-    // the solid and its tied bodies by `c = 1 / (2 beta (1 + alpha))`, so that the stiffness
-    // enters them as `K / (2 beta)`, as it enters the contact nodes' equilibrium rows: the
-    // tangent stays symmetric (see the module documentation).
-    let row_scale = match (kind, model.solid_rows()) {
-        (IncrementKind::Dynamic { hht, .. }, Some(rows)) => {
-            Some((hht.quasi_static_factor() / (1.0 + hht.alpha), rows))
-        }
-        _ => None,
-    };
-    let scaled_mass;
-    let inertia_mass = match row_scale {
-        Some((c, rows)) => {
-            scaled_mass = DVector::from_fn(n, |i, _| if rows[i] { c * mass[i] } else { mass[i] });
-            &scaled_mass
-        }
-        None => mass,
-    };
-    let (k_factor, mut m_factor, m_term) = match kind {
-        IncrementKind::Static { regularization, .. } => (1.0, regularization, shift_mass),
-        IncrementKind::Dynamic { hht, h, .. } => {
-            let k_factor = if model.part().quasi_static || row_scale.is_some() {
-                hht.quasi_static_factor()
-            } else {
-                1.0 + hht.alpha
-            };
-            (k_factor, hht.mass_factor(h), inertia_mass)
-        }
-    };
-    // A quasi-static solid has no mass term in a dynamic tangent; if the tangent is indefinite
-    // without the contacts, the shift starts far below the inertia its density would give.
-    // A static increment whose tangent holds every motion without the contacts drops its
-    // regularisation (`m_factor = 0` below, decided on the first tangent), so that Newton
-    // takes the consistent tangent of the residual it solves; the regularisation is then the
-    // first shift of a tangent that turns indefinite.
-    let mut shift = match kind {
-        IncrementKind::Dynamic { .. } if model.part().quasi_static => {
-            let first = m_factor * QUASI_STATIC_SHIFT;
-            (first, first)
-        }
-        _ => (m_factor, m_factor),
-    };
+    let Factors {
+        row_scale,
+        k_factor,
+        mut m_factor,
+        m_term,
+        mut shift,
+        damping_rate,
+    } = Factors::new(model, kind);
     // The internal forces are as exact as the stresses they sum: an equation's force is known
     // to `eps` of its elements' stiffness times their size (the round-off of `K (J - 1)` of a
     // nearly incompressible solid: Cook's membrane at nu = 0.4999 under a load of 1e-3
     // stalled at 1e-5 of it), see `Assembler::stiffness_scale`.
     let stiffness_roundoff = assembler.stiffness_scale() * (ROUNDOFF_ULPS * f64::EPSILON);
-    // the sections' stiffness damping acts in a dynamic increment, on the iterate's mean
-    // velocity over it (see `Damping`)
-    let damping_rate = match kind {
-        IncrementKind::Dynamic { h, .. } if model.has_stiffness_damping() => Some(1.0 / h),
-        _ => None,
-    };
-    let mut x = match kind {
-        IncrementKind::Static { .. } => start.x.clone(),
-        IncrementKind::Dynamic { hht, h, .. } => hht.predict(h, &start.x, &start.v),
-    };
-    for (eq, &h) in held.iter().enumerate() {
-        if h {
-            x[eq] = start.x[eq];
-        }
-    }
-    let mut moving = vec![false; n];
-    for &(eq, value) in prescribed {
-        x[eq] = value;
-        moving[eq] = true;
-    }
+    let (mut x, moving) = predictor(start, kind, (held, prescribed));
     assembler.start_mixed_pressures(model, &start.x)?;
     let mut warm = start.warm_forces.clone();
     // The contact forces of the last step and what the next iterate's contact state is
@@ -395,23 +342,7 @@ fn solve_increment_with<const D: usize>(
             return Err(IncrementFailure::NonFinite { iteration });
         }
         let clock = Instant::now();
-        let (v, a) = match kind {
-            IncrementKind::Static { .. } => (start.v.clone(), DVector::zeros(n)),
-            IncrementKind::Dynamic { hht, h, .. } => {
-                let (mut v, mut a) =
-                    hht.velocity_and_acceleration(h, &start.x, &start.v, &start.a, &x);
-                mean_rates(quasi_static, h, &start.x, &x, &mut v, &mut a);
-                // a held equation stands still; a prescribed one moves as Newmark's relations
-                // give for its prescribed path
-                for (eq, &h) in held.iter().enumerate() {
-                    if h && !moving[eq] {
-                        v[eq] = 0.0;
-                        a[eq] = 0.0;
-                    }
-                }
-                (v, a)
-            }
-        };
+        let (v, a) = rates(quasi_static, start, kind, &x, (held, &moving));
         // A convergence check needs the forces alone; the tangent is assembled only if the
         // iterate is not accepted (about half of the checks in a spin-down accept it). The
         // global contact solve's first check rarely accepts (one in twenty on `3d-refined`):
@@ -444,27 +375,9 @@ fn solve_increment_with<const D: usize>(
             };
         let f_ext = external_forces(model, &x, &start.orientations, kind.loads())?;
         let net = &internal.force + &internal.damping_force - &f_ext;
-        let mut inertia = mass.component_mul(&a);
-        if let IncrementKind::Dynamic { hht, .. } = kind
-            && let (Some(end), Some(begin)) = (model.gyroscopic_moments(&v), &start_gyroscopic)
-        {
-            inertia += end * (1.0 + hht.alpha) - begin * hht.alpha;
-        }
-        let mut residual = match kind {
-            IncrementKind::Static { .. } => net.clone(),
-            IncrementKind::Dynamic { hht, .. } => {
-                let mut r = &inertia + &net * (1.0 + hht.alpha) - &start.net_force * hht.alpha;
-                if let Some((c, rows)) = row_scale {
-                    for (eq, _) in rows.iter().enumerate().filter(|(_, s)| **s) {
-                        r[eq] *= c;
-                    }
-                }
-                for (eq, _) in quasi_static.iter().enumerate().filter(|(_, q)| **q) {
-                    r[eq] = net[eq] * hht.quasi_static_factor();
-                }
-                r
-            }
-        };
+        let inertia = inertia_forces(model, kind, (&v, &a), start_gyroscopic.as_ref());
+        let mut residual =
+            residual_without_contact((model, start, kind), row_scale, &inertia, &net);
         let rows = contact_rows(
             model,
             &x,
@@ -473,49 +386,14 @@ fn solve_increment_with<const D: usize>(
             Some(&previous),
             held,
         )?;
-        // what the constraints must balance, before their rows become identities
-        let held_residual: Vec<(usize, f64)> = held
-            .iter()
-            .enumerate()
-            .filter(|(_, h)| **h)
-            .map(|(eq, _)| (eq, residual[eq]))
-            .collect();
-        for (eq, &h) in held.iter().enumerate() {
-            if h {
-                residual[eq] = 0.0;
-            }
-        }
+        let held_residual = take_held(&mut residual, held);
         timings.assembly += clock.elapsed();
 
         if let Some(forces) = &last {
             let r = forces.r();
             let contact_force = rows.transpose_times(r, n);
-            // in force units: the scaled rows of the solid divided by their factor again
-            let mut full = &residual - &contact_force;
-            if let Some((c, rows)) = row_scale {
-                for (eq, _) in rows
-                    .iter()
-                    .enumerate()
-                    .filter(|(eq, s)| **s && !quasi_static[*eq])
-                {
-                    full[eq] /= c;
-                }
-            }
-            // The inertia of a dynamic increment is `M (x - x_pred) / (beta h^2)` plus terms
-            // of the start: the round-off of `x` reaches the residual amplified by
-            // `1 / (beta h^2)`, which on a very short increment exceeds the force tolerance
-            // (2e-5 of the forces on the spinning drum at h = 5e-8 s), so that Newton could
-            // never converge there.
-            let roundoff = match kind {
-                IncrementKind::Static { .. } => stiffness_roundoff.clone(),
-                IncrementKind::Dynamic { hht, h, .. } => {
-                    let factor = ROUNDOFF_ULPS * f64::EPSILON * hht.mass_factor(h);
-                    DVector::from_fn(n, |i, _| {
-                        (factor * mass[i] * x[i].abs().max(start.x[i].abs()))
-                            .max(stiffness_roundoff[i])
-                    })
-                }
-            };
+            let full = in_force_units(&residual - &contact_force, row_scale, quasi_static);
+            let roundoff = force_roundoff(kind, mass, (&start.x, &x), &stiffness_roundoff);
             let (force_residual, force_worst) = scaled_force_residual(
                 model,
                 &full,
@@ -530,53 +408,28 @@ fn solve_increment_with<const D: usize>(
                 &roundoff,
                 length,
             );
-            let d = rows.components;
-            let (contact_residual, contact_worst) = match forces {
-                _ if rows.is_empty() => (0.0, None),
-                LastForces::Linearised { r, u, rho } => largest(
-                    law_residuals(&rows, r, rho)
-                        .zip((&rows.u - u).as_slice().chunks(d.max(1)))
-                        .map(|(law, du)| du.iter().fold(law, |a, v| a.max(v.abs())) / length),
-                ),
-                LastForces::Law { r, rho } => {
-                    largest(law_residuals(&rows, r, rho).map(|law| law / length))
-                }
-            };
+            let (contact_residual, contact_worst) = forces.contact_residual(&rows, length);
             counters.residuals.push((force_residual, contact_residual));
-            worst = if force_residual / newton.force_tolerance
-                >= contact_residual / newton.contact_tolerance
-            {
-                force_worst
-                    .and_then(|eq| model.dofs().owner(eq))
-                    .map(WorstResidual::Equation)
-            } else {
-                contact_worst.and_then(|c| candidate(model, c))
-            };
+            worst = worst_residual(
+                model,
+                newton,
+                (force_residual, force_worst),
+                (contact_residual, contact_worst),
+            );
             if !force_residual.is_finite() || !contact_residual.is_finite() {
                 return Err(IncrementFailure::NonFinite { iteration });
             }
             if force_residual <= newton.force_tolerance
                 && contact_residual <= newton.contact_tolerance
             {
-                // the contact forces on the constrained equations, which their rows leave out
-                let held_contact = if held_residual.is_empty() {
-                    None
-                } else {
-                    let all = contact_rows(
-                        model,
-                        &x,
-                        &start.orientations,
-                        row_start.as_ref(),
-                        Some(&previous),
-                        &vec![false; n],
-                    )?;
-                    Some(all.transpose_times(r, n))
-                };
-                let (mut constrained, mut reaction) = (DVector::zeros(n), DVector::zeros(n));
-                for &(eq, value) in &held_residual {
-                    constrained[eq] = value;
-                    reaction[eq] = value - held_contact.as_ref().map_or(0.0, |c| c[eq]);
-                }
+                let (constrained, reaction) = reactions(
+                    model,
+                    start,
+                    &x,
+                    (row_start.as_ref(), &previous),
+                    &held_residual,
+                    r,
+                )?;
                 let iterate = Iterate {
                     x,
                     v,
@@ -653,7 +506,7 @@ fn solve_increment_with<const D: usize>(
                     shift.0 = 0.0;
                 }
             }
-            assembler.add_diagonal(&(m_term * m_factor));
+            assembler.add_diagonal(&(m_term.as_ref() * m_factor));
             assembler.add_contact_curvature(&rows, &warm);
             assembler.hold(held);
         }
@@ -665,27 +518,9 @@ fn solve_increment_with<const D: usize>(
         // The residual keeps the true inertia, so a raised mass term changes only the path.
         let reduced = if rows.is_empty() {
             let clock = Instant::now();
-            // A static step on the consistent tangent keeps it where it is indefinite (see
-            // `Assembler::is_held`); the mass shift is left for a singular one.
             let consistent = matches!(kind, IncrementKind::Static { .. }) && m_factor == 0.0;
-            let symmetric = if consistent {
-                match assembler.factorize_symmetric() {
-                    Ok(factor) => Some(factor),
-                    Err(e) if is_not_factorized(&e) => None,
-                    Err(e) => return Err(e),
-                }
-            } else {
-                None
-            };
-            let factor = match symmetric {
-                Some(factor) => factor,
-                None => Solver::Definite(
-                    assembler
-                        .with_mass_shift(shift_mass, shift, held, |a| a.factorize())?
-                        .0,
-                ),
-            };
-            let dx = factor.solve(&(-&residual));
+            let dx =
+                step_without_contact(assembler, consistent, (shift_mass, shift), held, &residual)?;
             timings.linear_solve += clock.elapsed();
             last = Some(LastForces::Linearised {
                 r: DVector::zeros(0),
@@ -699,7 +534,7 @@ fn solve_increment_with<const D: usize>(
                 let k = assembler.lower_triangle()?;
                 weights = Some(contact_weights(k, &rows));
             }
-            let mut step = |a: &mut Assembler| {
+            let step = |a: &mut Assembler| {
                 contact_step(
                     a,
                     &rows,
@@ -712,15 +547,7 @@ fn solve_increment_with<const D: usize>(
                     timings,
                 )
             };
-            let stepped = if may_switch {
-                match step(assembler) {
-                    Err(e) if is_not_factorized(&e) => None,
-                    stepped => Some(stepped?),
-                }
-            } else {
-                Some(assembler.with_mass_shift(shift_mass, shift, held, step)?.0)
-            };
-            match stepped {
+            match on_factorized_tangent(assembler, may_switch, (shift_mass, shift), held, step)? {
                 Some((dx, solution, factor)) => {
                     reusable = Some(factor);
                     counters.contact_solves += solution.conic_solves;
@@ -754,12 +581,17 @@ fn solve_increment_with<const D: usize>(
                 if warm.len() != rows.rows.len() {
                     warm = DVector::zeros(rows.rows.len());
                 }
-                let step = if exact_contact {
-                    let limits = (newton.contact_tolerance * length, LINEARISED_MAX_STEPS);
-                    global.linearised_solution(model, k, &rows, &residual, &warm, rho, held, limits)
-                } else {
-                    global.step(model, k, &rows, &residual, &warm, rho, held)
-                };
+                let exact = exact_contact
+                    .then_some((newton.contact_tolerance * length, LINEARISED_MAX_STEPS));
+                let step = global_step(
+                    global,
+                    model,
+                    k,
+                    (&rows, held),
+                    &residual,
+                    (&warm, rho),
+                    exact,
+                );
                 timings.linear_solve += clock.elapsed();
                 let step = step?;
                 forces_before = Some(std::mem::replace(&mut warm, step.r.clone()));
@@ -795,6 +627,88 @@ fn solve_increment_with<const D: usize>(
     })
 }
 
+/// The constant factors of an increment's residual and tangent: the solid's rows of the tangent
+/// are `c_K K_T`, the mass term `c_M M` (regularising in a static increment, inertial in a
+/// dynamic one).
+struct Factors<'m> {
+    /// `(c, rows)`: with the contact nodes' mass moved off them, a dynamic increment multiplies
+    /// the rows of the solid and its tied bodies by `c = 1 / (2 beta (1 + alpha))`, so that the
+    /// stiffness enters them as `K / (2 beta)`, as it enters the contact nodes' equilibrium
+    /// rows: the tangent stays symmetric (see the module documentation).
+    row_scale: Option<(f64, &'m [bool])>,
+    /// `c_K`.
+    k_factor: f64,
+    /// `c_M`: the regularisation of a static increment, `1/(beta h^2)` of a dynamic one.
+    m_factor: f64,
+    /// `M`: the regularisation mass of a static increment, the (row-scaled) inertia of a
+    /// dynamic one.
+    m_term: Cow<'m, DVector<f64>>,
+    /// The mass factors the first shift starts from (see [`Assembler::with_mass_shift`]). A
+    /// quasi-static solid has no mass term in a dynamic tangent; if the tangent is indefinite
+    /// without the contacts, the shift starts far below the inertia its density would give.
+    /// A static increment whose tangent holds every motion without the contacts drops its
+    /// regularisation (`m_factor = 0`, decided on the first tangent), so that Newton takes the
+    /// consistent tangent of the residual it solves; the regularisation is then the first
+    /// shift of a tangent that turns indefinite.
+    shift: (f64, f64),
+    /// `1/h`: the sections' stiffness damping acts in a dynamic increment, on the iterate's
+    /// mean velocity over it (see [`Damping`]).
+    damping_rate: Option<f64>,
+}
+
+impl<'m> Factors<'m> {
+    /// The factors of an increment of `kind` on `model`.
+    fn new<const D: usize>(model: &'m Model<D>, kind: IncrementKind) -> Self {
+        let mass = model.mass();
+        let row_scale = match (kind, model.solid_rows()) {
+            (IncrementKind::Dynamic { hht, .. }, Some(rows)) => {
+                Some((hht.quasi_static_factor() / (1.0 + hht.alpha), rows))
+            }
+            _ => None,
+        };
+        let inertia_mass = match row_scale {
+            Some((c, rows)) => Cow::Owned(DVector::from_fn(mass.len(), |i, _| {
+                if rows[i] { c * mass[i] } else { mass[i] }
+            })),
+            None => Cow::Borrowed(mass),
+        };
+        let (k_factor, m_factor, m_term) = match kind {
+            IncrementKind::Static { regularization, .. } => (
+                1.0,
+                regularization,
+                Cow::Borrowed(model.regularization_mass()),
+            ),
+            IncrementKind::Dynamic { hht, h, .. } => {
+                let k_factor = if model.part().quasi_static || row_scale.is_some() {
+                    hht.quasi_static_factor()
+                } else {
+                    1.0 + hht.alpha
+                };
+                (k_factor, hht.mass_factor(h), inertia_mass)
+            }
+        };
+        let shift = match kind {
+            IncrementKind::Dynamic { .. } if model.part().quasi_static => {
+                let first = m_factor * QUASI_STATIC_SHIFT;
+                (first, first)
+            }
+            _ => (m_factor, m_factor),
+        };
+        let damping_rate = match kind {
+            IncrementKind::Dynamic { h, .. } if model.has_stiffness_damping() => Some(1.0 / h),
+            _ => None,
+        };
+        Self {
+            row_scale,
+            k_factor,
+            m_factor,
+            m_term,
+            shift,
+            damping_rate,
+        }
+    }
+}
+
 /// The contact forces of a Newton step and how the next iterate's contact state is judged.
 enum LastForces {
     /// A reduced step: the forces `r` satisfy the Coulomb law with the linearised local
@@ -817,6 +731,266 @@ impl LastForces {
     fn r(&self) -> &DVector<f64> {
         match self {
             Self::Linearised { r, .. } | Self::Law { r, .. } => r,
+        }
+    }
+
+    /// The contact residual of the iterate whose contact rows are `rows`, in units of the model
+    /// size `length`, and the candidate where it is largest (see the variants).
+    fn contact_residual(&self, rows: &ContactRows, length: f64) -> (f64, Option<usize>) {
+        let d = rows.components;
+        match self {
+            _ if rows.is_empty() => (0.0, None),
+            Self::Linearised { r, u, rho } => largest(
+                law_residuals(rows, r, rho)
+                    .zip((&rows.u - u).as_slice().chunks(d.max(1)))
+                    .map(|(law, du)| du.iter().fold(law, |a, v| a.max(v.abs())) / length),
+            ),
+            Self::Law { r, rho } => largest(law_residuals(rows, r, rho).map(|law| law / length)),
+        }
+    }
+}
+
+/// The inertia forces `M a` of an iterate with rates `(v, a)`, and in a dynamic increment the
+/// gyroscopic moments of bodies free to turn, weighted as HHT weights the forces:
+/// `(1 + alpha) G(v) - alpha G(v_n)` (`start_gyroscopic` being `G(v_n)`).
+fn inertia_forces<const D: usize>(
+    model: &Model<D>,
+    kind: IncrementKind,
+    (v, a): (&DVector<f64>, &DVector<f64>),
+    start_gyroscopic: Option<&DVector<f64>>,
+) -> DVector<f64> {
+    let mut inertia = model.mass().component_mul(a);
+    if let IncrementKind::Dynamic { hht, .. } = kind
+        && let (Some(end), Some(begin)) = (model.gyroscopic_moments(v), start_gyroscopic)
+    {
+        inertia += end * (1.0 + hht.alpha) - begin * hht.alpha;
+    }
+    inertia
+}
+
+/// The residual without contact of an iterate whose net force is `F = f_int + f_damping -
+/// f_ext` and whose inertia forces are `inertia`: `F` in a static increment; in a dynamic one
+/// HHT's `inertia + (1 + alpha) F - alpha F_n`, its solid's rows scaled by `row_scale`'s
+/// factor, and `F / (2 beta)` on quasi-static equations (see the module documentation).
+fn residual_without_contact<const D: usize>(
+    (model, start, kind): (&Model<D>, &State, IncrementKind),
+    row_scale: Option<(f64, &[bool])>,
+    inertia: &DVector<f64>,
+    net: &DVector<f64>,
+) -> DVector<f64> {
+    match kind {
+        IncrementKind::Static { .. } => net.clone(),
+        IncrementKind::Dynamic { hht, .. } => {
+            let mut r = inertia + net * (1.0 + hht.alpha) - &start.net_force * hht.alpha;
+            if let Some((c, rows)) = row_scale {
+                for (eq, _) in rows.iter().enumerate().filter(|(_, s)| **s) {
+                    r[eq] *= c;
+                }
+            }
+            for (eq, _) in model.quasi_static().iter().enumerate().filter(|(_, q)| **q) {
+                r[eq] = net[eq] * hht.quasi_static_factor();
+            }
+            r
+        }
+    }
+}
+
+/// The residual's values on the `held` equations, `(equation, R)`: what the constraints must
+/// balance; `residual` is zero there afterwards, as the constrained rows become identities.
+fn take_held(residual: &mut DVector<f64>, held: &[bool]) -> Vec<(usize, f64)> {
+    let taken = held
+        .iter()
+        .enumerate()
+        .filter(|(_, h)| **h)
+        .map(|(eq, _)| (eq, residual[eq]))
+        .collect();
+    for (eq, &h) in held.iter().enumerate() {
+        if h {
+            residual[eq] = 0.0;
+        }
+    }
+    taken
+}
+
+/// `step` on the assembled tangent: if `may_switch`, on that tangent itself, `None` if it is
+/// indefinite (it has no Cholesky factor); otherwise with the mass term raised from `shift`
+/// until it has one (see [`Assembler::with_mass_shift`]).
+fn on_factorized_tangent<T>(
+    assembler: &mut Assembler,
+    may_switch: bool,
+    (mass, shift): (&DVector<f64>, (f64, f64)),
+    held: &[bool],
+    mut step: impl FnMut(&mut Assembler) -> Result<T, IncrementFailure>,
+) -> Result<Option<T>, IncrementFailure> {
+    if may_switch {
+        match step(assembler) {
+            Err(e) if is_not_factorized(&e) => Ok(None),
+            stepped => stepped.map(Some),
+        }
+    } else {
+        Ok(Some(assembler.with_mass_shift(mass, shift, held, step)?.0))
+    }
+}
+
+/// The Newton step `dx = -A^-1 R` of an iterate without contacts, `A` the assembled tangent: on
+/// a static increment's `consistent` tangent it is factored as `L D L^T` where it is indefinite
+/// (see [`Assembler::is_held`]); otherwise, or where that fails, by Cholesky with the mass term
+/// raised from `shift` where the tangent is singular (see [`Assembler::with_mass_shift`]).
+fn step_without_contact(
+    assembler: &mut Assembler,
+    consistent: bool,
+    (mass, shift): (&DVector<f64>, (f64, f64)),
+    held: &[bool],
+    residual: &DVector<f64>,
+) -> Result<DVector<f64>, IncrementFailure> {
+    let symmetric = if consistent {
+        match assembler.factorize_symmetric() {
+            Ok(factor) => Some(factor),
+            Err(e) if is_not_factorized(&e) => None,
+            Err(e) => return Err(e),
+        }
+    } else {
+        None
+    };
+    let factor = match symmetric {
+        Some(factor) => factor,
+        None => Solver::Definite(
+            assembler
+                .with_mass_shift(mass, shift, held, |a| a.factorize())?
+                .0,
+        ),
+    };
+    Ok(factor.solve(&(-residual)))
+}
+
+/// A global contact step on the full system of the tangent `k` and the contact rows (see
+/// [`crate::global_contact`]), from the forces `warm` with the candidates' weights `rho`: the
+/// solution of its linearisation's contact problem to `exact`'s (tolerance, steps) where given
+/// (see [`GlobalContactSolver::linearised_solution`]), else one semismooth step.
+fn global_step<const D: usize>(
+    global: &mut GlobalContactSolver,
+    model: &Model<D>,
+    k: SparseColMatRef<'_, usize, f64>,
+    (rows, held): (&ContactRows, &[bool]),
+    residual: &DVector<f64>,
+    (warm, rho): (&DVector<f64>, &[f64]),
+    exact: Option<(f64, usize)>,
+) -> Result<GlobalStep, IncrementFailure> {
+    match exact {
+        Some(limits) => {
+            global.linearised_solution(model, k, rows, residual, warm, rho, held, limits)
+        }
+        None => global.step(model, k, rows, residual, warm, rho, held),
+    }
+}
+
+/// What the constrained equations of a converged iterate `x` must balance: `held_residual`'s
+/// `(equation, R)` as the force of the constraint, and the reaction `R - H^T r` without the
+/// contact forces `r` on those equations, which their rows leave out (taken again here from
+/// contact rows of every equation, `rows_from` as the increment's).
+fn reactions<const D: usize>(
+    model: &Model<D>,
+    start: &State,
+    x: &DVector<f64>,
+    rows_from: (Option<&RowStart>, &[SurfacePoint]),
+    held_residual: &[(usize, f64)],
+    r: &DVector<f64>,
+) -> Result<(DVector<f64>, DVector<f64>), IncrementFailure> {
+    let n = x.len();
+    let held_contact = if held_residual.is_empty() {
+        None
+    } else {
+        let (row_start, previous) = rows_from;
+        let all = contact_rows(
+            model,
+            x,
+            &start.orientations,
+            row_start,
+            Some(previous),
+            &vec![false; n],
+        )?;
+        Some(all.transpose_times(r, n))
+    };
+    let (mut constrained, mut reaction) = (DVector::zeros(n), DVector::zeros(n));
+    for &(eq, value) in held_residual {
+        constrained[eq] = value;
+        reaction[eq] = value - held_contact.as_ref().map_or(0.0, |c| c[eq]);
+    }
+    Ok((constrained, reaction))
+}
+
+/// The round-off of each equation's residual at the iterate `x` of an increment from `x_n`:
+/// that of its stiffness, `stiffness_roundoff`, and in a dynamic increment that of its inertia
+/// `M (x - x_pred) / (beta h^2)` plus terms of the start, where the round-off of `x` reaches
+/// the residual amplified by `1 / (beta h^2)`: on a very short increment that exceeds the
+/// force tolerance (2e-5 of the forces on the spinning drum at h = 5e-8 s), so that Newton
+/// could never converge without it.
+fn force_roundoff(
+    kind: IncrementKind,
+    mass: &DVector<f64>,
+    (x_n, x): (&DVector<f64>, &DVector<f64>),
+    stiffness_roundoff: &DVector<f64>,
+) -> DVector<f64> {
+    match kind {
+        IncrementKind::Static { .. } => stiffness_roundoff.clone(),
+        IncrementKind::Dynamic { hht, h, .. } => {
+            let factor = ROUNDOFF_ULPS * f64::EPSILON * hht.mass_factor(h);
+            DVector::from_fn(x.len(), |i, _| {
+                (factor * mass[i] * x[i].abs().max(x_n[i].abs())).max(stiffness_roundoff[i])
+            })
+        }
+    }
+}
+
+/// The first iterate of an increment of `kind` from `start` (the start itself, or HHT's
+/// predictor), with the `held` equations at their start values and the `prescribed` ones
+/// (`(equation, value)`) at theirs; and which equations are prescribed (`moving`).
+fn predictor(
+    start: &State,
+    kind: IncrementKind,
+    (held, prescribed): (&[bool], &[(usize, f64)]),
+) -> (DVector<f64>, Vec<bool>) {
+    let mut x = match kind {
+        IncrementKind::Static { .. } => start.x.clone(),
+        IncrementKind::Dynamic { hht, h, .. } => hht.predict(h, &start.x, &start.v),
+    };
+    for (eq, &h) in held.iter().enumerate() {
+        if h {
+            x[eq] = start.x[eq];
+        }
+    }
+    let mut moving = vec![false; x.len()];
+    for &(eq, value) in prescribed {
+        x[eq] = value;
+        moving[eq] = true;
+    }
+    (x, moving)
+}
+
+/// The velocity and acceleration of the iterate `x` of an increment of `kind` from `start`:
+/// the start's velocity and no acceleration in a static increment; Newmark's relations in a
+/// dynamic one, the mean rates on `quasi_static` equations (see [`mean_rates`]), and a `held`
+/// equation standing still unless it is `moving` (prescribed), which moves as Newmark's
+/// relations give for its prescribed path.
+fn rates(
+    quasi_static: &[bool],
+    start: &State,
+    kind: IncrementKind,
+    x: &DVector<f64>,
+    (held, moving): (&[bool], &[bool]),
+) -> (DVector<f64>, DVector<f64>) {
+    match kind {
+        IncrementKind::Static { .. } => (start.v.clone(), DVector::zeros(x.len())),
+        IncrementKind::Dynamic { hht, h, .. } => {
+            let (mut v, mut a) = hht.velocity_and_acceleration(h, &start.x, &start.v, &start.a, x);
+            mean_rates(quasi_static, h, &start.x, x, &mut v, &mut a);
+            for (eq, &h) in held.iter().enumerate() {
+                if h && !moving[eq] {
+                    v[eq] = 0.0;
+                    a[eq] = 0.0;
+                }
+            }
+            (v, a)
         }
     }
 }
@@ -872,6 +1046,43 @@ const ROUNDOFF_ULPS: f64 = 16.0;
 /// How often one Newton step may be halved because its end folds an element, before the
 /// increment fails (and is cut back).
 const MAX_STEP_HALVINGS: usize = 4;
+
+/// A residual of the tangent's rows in force units: the scaled rows of the solid (see
+/// [`Factors::row_scale`]) divided by their factor again, except on `quasi_static` equations,
+/// whose rows are measured as they are.
+fn in_force_units(
+    mut residual: DVector<f64>,
+    row_scale: Option<(f64, &[bool])>,
+    quasi_static: &[bool],
+) -> DVector<f64> {
+    if let Some((c, rows)) = row_scale {
+        for (eq, _) in rows
+            .iter()
+            .enumerate()
+            .filter(|(eq, s)| **s && !quasi_static[*eq])
+        {
+            residual[eq] /= c;
+        }
+    }
+    residual
+}
+
+/// Where an iterate's larger residual, each against its tolerance, is worst: the owner of the
+/// force residual's equation, or the contact residual's candidate.
+fn worst_residual<const D: usize>(
+    model: &Model<D>,
+    newton: &NewtonSettings,
+    (force_residual, force_worst): (f64, Option<usize>),
+    (contact_residual, contact_worst): (f64, Option<usize>),
+) -> Option<WorstResidual> {
+    if force_residual / newton.force_tolerance >= contact_residual / newton.contact_tolerance {
+        force_worst
+            .and_then(|eq| model.dofs().owner(eq))
+            .map(WorstResidual::Equation)
+    } else {
+        contact_worst.and_then(|c| candidate(model, c))
+    }
+}
 
 /// `max_i |R_i| / s` with `s` the largest magnitude among the given force vectors, and the
 /// equation `i` where it is reached (`None` without equations); moments are divided by the
