@@ -78,6 +78,7 @@ use crate::hht::{Hht, IncrementEnds};
 use crate::loads::LoadInstant;
 use crate::model::Model;
 use crate::settings::{ContactSolve, NewtonSettings, Settings};
+use crate::sparse::Factorization;
 use crate::state::{ContactPointState, EnergyLedger, State};
 
 /// What kind of increment to take.
@@ -275,356 +276,670 @@ fn solve_increment_with<const D: usize>(
     workspace: &mut Workspace,
     start: &State,
     kind: IncrementKind,
-    (held, prescribed): (&[bool], &[(usize, f64)]),
+    constraints: (&[bool], &[(usize, f64)]),
     settings: &Settings,
-    (mut method, may_switch, counters): (ContactSolve, bool, &mut IncrementCounters),
+    (method, may_switch, counters): (ContactSolve, bool, &mut IncrementCounters),
     timings: &mut Timings,
 ) -> Result<State, IncrementFailure> {
     let Workspace { assembler, global } = workspace;
-    let newton = &settings.newton;
     let max_iterations = match method {
-        ContactSolve::Global => newton.max_iterations.min(GLOBAL_MAX_ITERATIONS),
-        ContactSolve::Reduced => newton.max_iterations,
+        ContactSolve::Global => settings.newton.max_iterations.min(GLOBAL_MAX_ITERATIONS),
+        ContactSolve::Reduced => settings.newton.max_iterations,
     };
-    let n = model.dofs().len();
-    let mass = model.mass();
-    let shift_mass = model.regularization_mass();
-    let quasi_static = model.quasi_static();
-    let length = model.length_scale();
-    let previous: Vec<SurfacePoint> = start.contacts.iter().map(|c| c.closest).collect();
-    // the gyroscopic moments at the start, HHT's history term for bodies free to turn
-    let start_gyroscopic = model.gyroscopic_moments(&start.v);
-    // Dynamic increments take the normal rows between the start and the end positions, so
-    // that the contact impulse does the work `p_N dg` (see `contact_rows`); a static
-    // equilibrium takes the normal at the solution itself.
-    let row_start = match kind {
-        IncrementKind::Static { .. } => None,
-        IncrementKind::Dynamic { .. } => Some(RowStart::new(model, &start.x)),
-    };
-    let Factors {
-        row_scale,
-        k_factor,
-        mut m_factor,
-        m_term,
-        mut shift,
-        damping_rate,
-    } = Factors::new(model, kind);
-    // The internal forces are as exact as the stresses they sum: an equation's force is known
-    // to `eps` of its elements' stiffness times their size (the round-off of `K (J - 1)` of a
-    // nearly incompressible solid: Cook's membrane at nu = 0.4999 under a load of 1e-3
-    // stalled at 1e-5 of it), see `Assembler::stiffness_scale`.
-    let stiffness_roundoff = assembler.stiffness_scale() * (ROUNDOFF_ULPS * f64::EPSILON);
-    let (mut x, moving) = predictor(start, kind, (held, prescribed));
-    assembler.start_mixed_pressures(model, &start.x)?;
-    let mut warm = start.warm_forces.clone();
-    // The contact forces of the last step and what the next iterate's contact state is
-    // checked against.
-    let mut last: Option<LastForces> = None;
-    // The last step (at first the predictor's) and how often it has been halved (see below).
-    let mut last_step: Option<DVector<f64>> = match kind {
-        IncrementKind::Static { .. } => None,
-        IncrementKind::Dynamic { .. } => Some(&x - &start.x),
-    };
-    let mut halvings = 0;
-    // whether global steps solve their linearisation's contact problem (see `is_stagnating`)
-    let mut exact_contact = false;
-    let mut worst = None;
-    // The forces before the last global step, to go back half way with the step.
-    let mut forces_before: Option<DVector<f64>> = None;
-    // The factorization of the last contact step (see the contact step below).
-    let mut reusable = None;
-    // The candidates' weights of the contact law residual, fixed for the increment so that the
-    // law residual measures every iterate alike (see `crate::global_contact`).
-    let mut weights: Option<Vec<f64>> = None;
-
+    let increment = Increment::new(model, assembler, start, kind, constraints, settings)?;
+    let mut newton = Newton::new(&increment, (method, may_switch));
     for iteration in 0..=max_iterations {
-        if x.iter().any(|v| !v.is_finite()) {
+        if newton.x.iter().any(|v| !v.is_finite()) {
             return Err(IncrementFailure::NonFinite { iteration });
         }
-        let clock = Instant::now();
-        let (v, a) = rates(quasi_static, start, kind, &x, (held, &moving));
-        // A convergence check needs the forces alone; the tangent is assembled only if the
-        // iterate is not accepted (about half of the checks in a spin-down accept it). The
-        // global contact solve's first check rarely accepts (one in twenty on `3d-refined`):
-        // there the tangent comes with the forces, so that its elements are evaluated once.
-        let check = last.is_some();
-        let tangent_now =
-            !check || (method == ContactSolve::Global && counters.newton_iterations == 1);
-        let mean_velocity = damping_rate.map(|rate| (&x - &start.x) * rate);
-        let damping = damping_rate
-            .zip(mean_velocity.as_ref())
-            .map(|(rate, velocity)| Damping { velocity, rate });
-        let internal =
-            match assembler.internal_damped(model, &x, tangent_now.then_some(k_factor), damping) {
-                Ok(internal) => internal,
-                // A full Newton step that folds an element overshoots; half of it may not. The
-                // iterate stays a Newton iterate (the next step starts from it, and convergence
-                // is still judged by the residuals), so only the path changes.
-                Err(IncrementFailure::InvertedElement { .. })
-                    if halvings < MAX_STEP_HALVINGS && last_step.is_some() =>
-                {
-                    if let Some(step) = last_step.as_mut() {
-                        *step *= 0.5;
-                        x -= &*step;
-                        assembler.advance_mixed_pressures(model, step);
-                    }
-                    halvings += 1;
-                    continue;
+        let Some(evaluation) = newton.evaluate(&increment, assembler, counters, timings)? else {
+            continue;
+        };
+        if let Some(forces) = newton.last.take() {
+            let check = (&evaluation, &forces);
+            match newton.check(&increment, assembler, check, counters, iteration)? {
+                Check::Converged => return newton.into_state(&increment, evaluation, &forces),
+                Check::NotConverged if iteration == max_iterations => {
+                    return Err(newton.not_converged(counters, iteration));
                 }
-                Err(failure) => return Err(failure),
-            };
-        let f_ext = external_forces(model, &x, &start.orientations, kind.loads())?;
-        let net = &internal.force + &internal.damping_force - &f_ext;
-        let inertia = inertia_forces(model, kind, (&v, &a), start_gyroscopic.as_ref());
-        let mut residual =
-            residual_without_contact((model, start, kind), row_scale, &inertia, &net);
-        let rows = contact_rows(
-            model,
-            &x,
-            &start.orientations,
-            row_start.as_ref(),
-            Some(&previous),
-            held,
-        )?;
-        let held_residual = take_held(&mut residual, held);
-        timings.assembly += clock.elapsed();
-
-        if let Some(forces) = &last {
-            let r = forces.r();
-            let contact_force = rows.transpose_times(r, n);
-            let full = in_force_units(&residual - &contact_force, row_scale, quasi_static);
-            let roundoff = force_roundoff(kind, mass, (&start.x, &x), &stiffness_roundoff);
-            let (force_residual, force_worst) = scaled_force_residual(
-                model,
-                &full,
-                &[
-                    &internal.force,
-                    &internal.damping_force,
-                    &f_ext,
-                    &start.external_force,
-                    &inertia,
-                    &contact_force,
-                ],
-                &roundoff,
-                length,
-            );
-            let (contact_residual, contact_worst) = forces.contact_residual(&rows, length);
-            counters.residuals.push((force_residual, contact_residual));
-            worst = worst_residual(
-                model,
-                newton,
-                (force_residual, force_worst),
-                (contact_residual, contact_worst),
-            );
-            if !force_residual.is_finite() || !contact_residual.is_finite() {
-                return Err(IncrementFailure::NonFinite { iteration });
-            }
-            if force_residual <= newton.force_tolerance
-                && contact_residual <= newton.contact_tolerance
-            {
-                let (constrained, reaction) = reactions(
-                    model,
-                    start,
-                    &x,
-                    (row_start.as_ref(), &previous),
-                    &held_residual,
-                    r,
-                )?;
-                let iterate = Iterate {
-                    x,
-                    v,
-                    a,
-                    net,
-                    f_ext,
-                    internal,
-                    constrained,
-                    reaction,
-                    moving,
-                };
-                let state = finish(model, start, kind, iterate, &rows, r, warm);
-                return Ok(state);
-            }
-            if iteration == max_iterations {
-                return Err(IncrementFailure::NewtonNotConverged {
-                    iterations: iteration,
-                    force_residual,
-                    contact_residual,
-                    worst,
-                });
-            }
-            // Once global steps stop converging (branches that keep changing, or the inexact
-            // solve's error on a few candidates), each later step solves its linearisation's
-            // contact problem, as the reduced path does but on the sparse system (measured in
-            // the static preload of `3d-refined`: without this, four of five increments
-            // stagnate with the law residual near 3e-4 for 12 iterations).
-            exact_contact |=
-                method == ContactSolve::Global && is_stagnating(&counters.residuals, newton);
-            // Semismooth Newton can cycle between two sets of contact branches, each step
-            // undoing the last: then the iterate goes back half way (forces too), which
-            // leaves the cycle.
-            if method == ContactSolve::Global
-                && halvings < MAX_STEP_HALVINGS
-                && is_cycling(&counters.residuals)
-                && let (Some(step), Some(before)) = (last_step.as_mut(), forces_before.as_ref())
-            {
-                *step *= 0.5;
-                x -= &*step;
-                assembler.advance_mixed_pressures(model, &(-&*step));
-                warm = (&warm + before) * 0.5;
-                last = Some(LastForces::Law {
-                    r: warm.clone(),
-                    rho: weights.clone().unwrap_or_default(),
-                });
-                halvings += 1;
-                continue;
+                Check::NotConverged => newton.last = Some(forces),
+                Check::Halved => continue,
             }
         }
-
-        // Once the forces nearly balance (see `CHORD_WITHIN`) or only the contact kinematics
-        // is left to converge (the secant rows' gap converges linearly, see `contact_rows`),
-        // the reduced path's last factorization serves again: the matrix has changed by the
-        // order of the last, small step, so the chord step reaches the tolerance as the Newton
-        // step would, at a fraction of the cost. Its tangent is then not assembled: the
-        // assembler keeps the matrix of that factorization, which also serves if the step
-        // must factorize after all (a candidate joining the near set, see `contact_step`).
-        let chord = method == ContactSolve::Reduced
-            && !rows.is_empty()
-            && reusable.is_some()
-            && counters
-                .residuals
-                .last()
-                .is_some_and(|&(force, _)| force <= CHORD_WITHIN * newton.force_tolerance);
+        let chord = newton.is_chord(&increment, &evaluation, counters);
         let clock = Instant::now();
         if !chord {
-            if !tangent_now {
-                assembler.internal_damped(model, &x, Some(k_factor), damping)?;
-            }
-            if matches!(kind, IncrementKind::Static { .. }) && counters.newton_iterations == 0 {
-                assembler.hold(held);
-                if assembler.is_held(shift_mass, held)? {
-                    m_factor = 0.0;
-                    shift.0 = 0.0;
-                }
-            }
-            assembler.add_diagonal(&(m_term.as_ref() * m_factor));
-            assembler.add_contact_curvature(&rows, &warm);
-            assembler.hold(held);
+            newton.complete_tangent(&increment, assembler, &evaluation, counters)?;
         }
         timings.assembly += clock.elapsed();
-
-        // The step: without contacts on `K + c M` itself (its mass term raised only where it
-        // is singular, see `Assembler::with_mass_shift`); with contacts reduced onto their
-        // forces while `K + c M` factorizes, else (or by request) global on the full system.
-        // The residual keeps the true inertia, so a raised mass term changes only the path.
-        let reduced = if rows.is_empty() {
-            let clock = Instant::now();
-            let consistent = matches!(kind, IncrementKind::Static { .. }) && m_factor == 0.0;
-            let dx =
-                step_without_contact(assembler, consistent, (shift_mass, shift), held, &residual)?;
-            timings.linear_solve += clock.elapsed();
-            last = Some(LastForces::Linearised {
-                r: DVector::zeros(0),
-                u: DVector::zeros(0),
-                rho: Vec::new(),
-            });
-            Some(dx)
-        } else if method == ContactSolve::Reduced {
-            let mut reuse = reusable.take().filter(|_| chord);
-            if weights.is_none() {
-                let k = assembler.lower_triangle()?;
-                weights = Some(contact_weights(k, &rows));
-            }
-            let step = |a: &mut Assembler| {
-                contact_step(
-                    a,
-                    &rows,
-                    &residual,
-                    &warm,
-                    length,
-                    newton.contact_tolerance * length,
-                    &settings.coulomb,
-                    reuse.take(),
-                    timings,
-                )
-            };
-            match on_factorized_tangent(assembler, may_switch, (shift_mass, shift), held, step)? {
-                Some((dx, solution, factor)) => {
-                    reusable = Some(factor);
-                    counters.contact_solves += solution.conic_solves;
-                    counters.fixed_point_iterations += solution.fixed_point_iterations;
-                    counters.contact_newton_steps += solution.newton_steps;
-                    warm.clone_from(&solution.r);
-                    last = Some(LastForces::Linearised {
-                        r: solution.r,
-                        u: solution.u,
-                        rho: weights.clone().unwrap_or_default(),
-                    });
-                    Some(dx)
-                }
-                // the tangent without the contacts is indefinite: global steps from here on
-                // (see `solve_increment`)
-                None => {
-                    method = ContactSolve::Global;
-                    counters.global_switches += 1;
-                    None
-                }
-            }
-        } else {
-            None
-        };
-        let dx = match reduced {
-            Some(dx) => dx,
-            None => {
-                let clock = Instant::now();
-                let k = assembler.lower_triangle()?;
-                let rho = weights.get_or_insert_with(|| contact_weights(k, &rows));
-                if warm.len() != rows.rows.len() {
-                    warm = DVector::zeros(rows.rows.len());
-                }
-                let exact = exact_contact
-                    .then_some((newton.contact_tolerance * length, LINEARISED_MAX_STEPS));
-                let step = global_step(
-                    global,
-                    model,
-                    k,
-                    (&rows, held),
-                    &residual,
-                    (&warm, rho),
-                    exact,
-                );
-                timings.linear_solve += clock.elapsed();
-                let step = step?;
-                forces_before = Some(std::mem::replace(&mut warm, step.r.clone()));
-                last = Some(LastForces::Law {
-                    r: step.r,
-                    rho: rho.clone(),
-                });
-                step.dx
-            }
-        };
+        let dx = newton.step(
+            &increment,
+            (assembler, global),
+            &evaluation,
+            chord,
+            counters,
+            timings,
+        )?;
         counters.newton_iterations += 1;
         if dx.iter().any(|v| !v.is_finite()) {
             return Err(IncrementFailure::NonFinite { iteration });
         }
         assembler.advance_mixed_pressures(model, &dx);
-        x += &dx;
-        last_step = Some(dx);
-        halvings = 0;
+        newton.x += &dx;
+        newton.last_step = Some(dx);
+        newton.halvings = 0;
     }
     // The loop returns from inside, converged or at the last convergence check, unless its
     // last iterations went to halving steps that fold an element: report the last residuals
     // that were measured.
-    let (force_residual, contact_residual) = counters
-        .residuals
-        .last()
-        .copied()
-        .unwrap_or((f64::NAN, f64::NAN));
-    Err(IncrementFailure::NewtonNotConverged {
-        iterations: max_iterations,
-        force_residual,
-        contact_residual,
-        worst,
-    })
+    Err(newton.not_converged(counters, max_iterations))
+}
+
+/// What an increment's Newton iterations share and do not change.
+struct Increment<'a, const D: usize> {
+    model: &'a Model<D>,
+    start: &'a State,
+    kind: IncrementKind,
+    /// The constrained equations.
+    held: &'a [bool],
+    /// The equations that move as prescribed.
+    moving: Vec<bool>,
+    settings: &'a Settings,
+    factors: Factors<'a>,
+    /// The increment's first iterate.
+    predictor: DVector<f64>,
+    /// Where the contact rows start: dynamic increments take the normal rows between the
+    /// start and the end positions, so that the contact impulse does the work `p_N dg` (see
+    /// `contact_rows`); a static equilibrium takes the normal at the solution itself.
+    row_start: Option<RowStart<'a>>,
+    /// The closest points of the start's contacts.
+    previous: Vec<SurfacePoint>,
+    /// The gyroscopic moments at the start, HHT's history term for bodies free to turn.
+    start_gyroscopic: Option<DVector<f64>>,
+    /// The internal forces are as exact as the stresses they sum: an equation's force is
+    /// known to `eps` of its elements' stiffness times their size (the round-off of
+    /// `K (J - 1)` of a nearly incompressible solid: Cook's membrane at nu = 0.4999 under a
+    /// load of 1e-3 stalled at 1e-5 of it), see [`Assembler::stiffness_scale`].
+    stiffness_roundoff: DVector<f64>,
+}
+
+impl<'a, const D: usize> Increment<'a, D> {
+    /// The increment of `kind` from `start` with the `constraints` (held equations, and the
+    /// `(equation, value)` of the prescribed ones); starts the assembler's mixed pressures.
+    fn new(
+        model: &'a Model<D>,
+        assembler: &mut Assembler,
+        start: &'a State,
+        kind: IncrementKind,
+        (held, prescribed): (&'a [bool], &[(usize, f64)]),
+        settings: &'a Settings,
+    ) -> Result<Self, IncrementFailure> {
+        let row_start = match kind {
+            IncrementKind::Static { .. } => None,
+            IncrementKind::Dynamic { .. } => Some(RowStart::new(model, &start.x)),
+        };
+        let stiffness_roundoff = assembler.stiffness_scale() * (ROUNDOFF_ULPS * f64::EPSILON);
+        let (predictor, moving) = predictor(start, kind, (held, prescribed));
+        assembler.start_mixed_pressures(model, &start.x)?;
+        Ok(Self {
+            model,
+            start,
+            kind,
+            held,
+            moving,
+            settings,
+            factors: Factors::new(model, kind),
+            predictor,
+            row_start,
+            previous: start.contacts.iter().map(|c| c.closest).collect(),
+            start_gyroscopic: model.gyroscopic_moments(&start.v),
+            stiffness_roundoff,
+        })
+    }
+
+    /// The contact rows at `x`, of the equations not `held` (every equation's with none).
+    fn contact_rows(
+        &self,
+        x: &DVector<f64>,
+        held: &[bool],
+    ) -> Result<ContactRows, IncrementFailure> {
+        contact_rows(
+            self.model,
+            x,
+            &self.start.orientations,
+            self.row_start.as_ref(),
+            Some(&self.previous),
+            held,
+        )
+    }
+
+    /// What the constrained equations of a converged iterate `x` must balance: `held_residual`'s
+    /// `(equation, R)` as the force of the constraint, and the reaction `R - H^T r` without the
+    /// contact forces `r` on those equations, which their rows leave out (taken again here
+    /// from contact rows of every equation).
+    fn reactions(
+        &self,
+        x: &DVector<f64>,
+        held_residual: &[(usize, f64)],
+        r: &DVector<f64>,
+    ) -> Result<(DVector<f64>, DVector<f64>), IncrementFailure> {
+        let n = x.len();
+        let held_contact = if held_residual.is_empty() {
+            None
+        } else {
+            Some(self.contact_rows(x, &vec![false; n])?.transpose_times(r, n))
+        };
+        let (mut constrained, mut reaction) = (DVector::zeros(n), DVector::zeros(n));
+        for &(eq, value) in held_residual {
+            constrained[eq] = value;
+            reaction[eq] = value - held_contact.as_ref().map_or(0.0, |c| c[eq]);
+        }
+        Ok((constrained, reaction))
+    }
+
+    /// The sections' stiffness damping of a dynamic increment acts on the iterate's mean
+    /// velocity over it, `(x - x_n) rate` (see [`Damping`]).
+    fn mean_velocity(&self, x: &DVector<f64>) -> Option<DVector<f64>> {
+        self.factors
+            .damping_rate
+            .map(|rate| (x - &self.start.x) * rate)
+    }
+}
+
+/// One iterate's forces, residual and contact rows.
+struct Evaluation {
+    v: DVector<f64>,
+    a: DVector<f64>,
+    internal: InternalState,
+    f_ext: DVector<f64>,
+    /// `f_int + f_damping - f_ext`.
+    net: DVector<f64>,
+    inertia: DVector<f64>,
+    /// The residual without contact, zero on the held equations.
+    residual: DVector<f64>,
+    rows: ContactRows,
+    /// What the constraints must balance (see [`take_held`]).
+    held_residual: Vec<(usize, f64)>,
+    /// Whether the tangent was assembled with the forces.
+    tangent_now: bool,
+}
+
+/// What a convergence check found.
+enum Check {
+    Converged,
+    NotConverged,
+    /// The iterate went back half way (see [`Newton::check`]).
+    Halved,
+}
+
+/// The state of an increment's Newton iterations.
+struct Newton {
+    /// How the contact forces of a step are found.
+    method: ContactSolve,
+    /// Whether a reduced step may switch to global steps (see [`solve_increment`]).
+    may_switch: bool,
+    /// `c_M` and the first mass shift (see [`Factors`]); a static increment's first tangent
+    /// may drop the regularisation.
+    m_factor: f64,
+    shift: (f64, f64),
+    /// The iterate.
+    x: DVector<f64>,
+    /// The contact forces a step starts from.
+    warm: DVector<f64>,
+    /// The contact forces of the last step and what the next iterate's contact state is
+    /// checked against.
+    last: Option<LastForces>,
+    /// The last step (at first the predictor's) and how often it has been halved.
+    last_step: Option<DVector<f64>>,
+    halvings: usize,
+    /// Whether global steps solve their linearisation's contact problem (see
+    /// [`is_stagnating`]).
+    exact_contact: bool,
+    worst: Option<WorstResidual>,
+    /// The forces before the last global step, to go back half way with the step.
+    forces_before: Option<DVector<f64>>,
+    /// The factorization of the last contact step (see [`Newton::step`]).
+    reusable: Option<Factorization>,
+    /// The candidates' weights of the contact law residual, fixed for the increment so that
+    /// the law residual measures every iterate alike (see [`crate::global_contact`]).
+    weights: Option<Vec<f64>>,
+}
+
+impl Newton {
+    /// The iterations of `increment` with the contact solve `method`, from its predictor.
+    fn new<const D: usize>(
+        increment: &Increment<'_, D>,
+        (method, may_switch): (ContactSolve, bool),
+    ) -> Self {
+        let x = increment.predictor.clone();
+        let last_step = match increment.kind {
+            IncrementKind::Static { .. } => None,
+            IncrementKind::Dynamic { .. } => Some(&x - &increment.start.x),
+        };
+        Self {
+            method,
+            may_switch,
+            m_factor: increment.factors.m_factor,
+            shift: increment.factors.shift,
+            x,
+            warm: increment.start.warm_forces.clone(),
+            last: None,
+            last_step,
+            halvings: 0,
+            exact_contact: false,
+            worst: None,
+            forces_before: None,
+            reusable: None,
+            weights: None,
+        }
+    }
+
+    /// The iterate's forces, residual and contact rows; `None` if the last step folded an
+    /// element and was halved instead.
+    fn evaluate<const D: usize>(
+        &mut self,
+        increment: &Increment<'_, D>,
+        assembler: &mut Assembler,
+        counters: &IncrementCounters,
+        timings: &mut Timings,
+    ) -> Result<Option<Evaluation>, IncrementFailure> {
+        let Increment {
+            model,
+            start,
+            kind,
+            held,
+            ..
+        } = *increment;
+        let clock = Instant::now();
+        let x = &self.x;
+        let (v, a) = rates(
+            model.quasi_static(),
+            start,
+            kind,
+            x,
+            (held, &increment.moving),
+        );
+        // A convergence check needs the forces alone; the tangent is assembled only if the
+        // iterate is not accepted (about half of the checks in a spin-down accept it). The
+        // global contact solve's first check rarely accepts (one in twenty on `3d-refined`):
+        // there the tangent comes with the forces, so that its elements are evaluated once.
+        let tangent_now = self.last.is_none()
+            || (self.method == ContactSolve::Global && counters.newton_iterations == 1);
+        let mean_velocity = increment.mean_velocity(x);
+        let damping = increment
+            .factors
+            .damping_rate
+            .zip(mean_velocity.as_ref())
+            .map(|(rate, velocity)| Damping { velocity, rate });
+        let k_factor = tangent_now.then_some(increment.factors.k_factor);
+        let internal = match assembler.internal_damped(model, x, k_factor, damping) {
+            Ok(internal) => internal,
+            // A full Newton step that folds an element overshoots; half of it may not. The
+            // iterate stays a Newton iterate (the next step starts from it, and convergence
+            // is still judged by the residuals), so only the path changes.
+            Err(IncrementFailure::InvertedElement { .. })
+                if self.halvings < MAX_STEP_HALVINGS && self.last_step.is_some() =>
+            {
+                if let Some(step) = self.last_step.as_mut() {
+                    *step *= 0.5;
+                    self.x -= &*step;
+                    assembler.advance_mixed_pressures(model, step);
+                }
+                self.halvings += 1;
+                return Ok(None);
+            }
+            Err(failure) => return Err(failure),
+        };
+        let f_ext = external_forces(model, x, &start.orientations, kind.loads())?;
+        let net = &internal.force + &internal.damping_force - &f_ext;
+        let inertia = inertia_forces(model, kind, (&v, &a), increment.start_gyroscopic.as_ref());
+        let mut residual = residual_without_contact(
+            (model, start, kind),
+            increment.factors.row_scale,
+            &inertia,
+            &net,
+        );
+        let rows = increment.contact_rows(x, held)?;
+        let held_residual = take_held(&mut residual, held);
+        timings.assembly += clock.elapsed();
+        Ok(Some(Evaluation {
+            v,
+            a,
+            internal,
+            f_ext,
+            net,
+            inertia,
+            residual,
+            rows,
+            held_residual,
+            tangent_now,
+        }))
+    }
+
+    /// The convergence check of an evaluated iterate against the contact `forces` of the last
+    /// step: its scaled force and contact residuals (kept in `counters`). An iterate that does
+    /// not converge may switch global steps to exact contact solves, or go back half way out
+    /// of a cycle (then with the forces half way back as the last step's).
+    fn check<const D: usize>(
+        &mut self,
+        increment: &Increment<'_, D>,
+        assembler: &mut Assembler,
+        (evaluation, forces): (&Evaluation, &LastForces),
+        counters: &mut IncrementCounters,
+        iteration: usize,
+    ) -> Result<Check, IncrementFailure> {
+        let Increment {
+            model, start, kind, ..
+        } = *increment;
+        let newton = &increment.settings.newton;
+        let length = model.length_scale();
+        let rows = &evaluation.rows;
+        let contact_force = rows.transpose_times(forces.r(), self.x.len());
+        let full = in_force_units(
+            &evaluation.residual - &contact_force,
+            increment.factors.row_scale,
+            model.quasi_static(),
+        );
+        let roundoff = force_roundoff(
+            kind,
+            model.mass(),
+            (&start.x, &self.x),
+            &increment.stiffness_roundoff,
+        );
+        let (force_residual, force_worst) = scaled_force_residual(
+            model,
+            &full,
+            &[
+                &evaluation.internal.force,
+                &evaluation.internal.damping_force,
+                &evaluation.f_ext,
+                &start.external_force,
+                &evaluation.inertia,
+                &contact_force,
+            ],
+            &roundoff,
+            length,
+        );
+        let (contact_residual, contact_worst) = forces.contact_residual(rows, length);
+        counters.residuals.push((force_residual, contact_residual));
+        self.worst = worst_residual(
+            model,
+            newton,
+            (force_residual, force_worst),
+            (contact_residual, contact_worst),
+        );
+        if !force_residual.is_finite() || !contact_residual.is_finite() {
+            return Err(IncrementFailure::NonFinite { iteration });
+        }
+        if force_residual <= newton.force_tolerance && contact_residual <= newton.contact_tolerance
+        {
+            return Ok(Check::Converged);
+        }
+        // Once global steps stop converging (branches that keep changing, or the inexact
+        // solve's error on a few candidates), each later step solves its linearisation's
+        // contact problem, as the reduced path does but on the sparse system (measured in
+        // the static preload of `3d-refined`: without this, four of five increments
+        // stagnate with the law residual near 3e-4 for 12 iterations).
+        let global = self.method == ContactSolve::Global;
+        self.exact_contact |= global && is_stagnating(&counters.residuals, newton);
+        // Semismooth Newton can cycle between two sets of contact branches, each step
+        // undoing the last: then the iterate goes back half way (forces too), which
+        // leaves the cycle.
+        if global
+            && self.halvings < MAX_STEP_HALVINGS
+            && is_cycling(&counters.residuals)
+            && let (Some(step), Some(before)) =
+                (self.last_step.as_mut(), self.forces_before.as_ref())
+        {
+            *step *= 0.5;
+            self.x -= &*step;
+            assembler.advance_mixed_pressures(model, &(-&*step));
+            self.warm = (&self.warm + before) * 0.5;
+            self.last = Some(LastForces::Law {
+                r: self.warm.clone(),
+                rho: self.weights.clone().unwrap_or_default(),
+            });
+            self.halvings += 1;
+            return Ok(Check::Halved);
+        }
+        Ok(Check::NotConverged)
+    }
+
+    /// The end state of the increment converged at the evaluated iterate with the contact
+    /// `forces` of the last step.
+    fn into_state<const D: usize>(
+        self,
+        increment: &Increment<'_, D>,
+        evaluation: Evaluation,
+        forces: &LastForces,
+    ) -> Result<State, IncrementFailure> {
+        let r = forces.r();
+        let (constrained, reaction) = increment.reactions(&self.x, &evaluation.held_residual, r)?;
+        let Evaluation {
+            v,
+            a,
+            internal,
+            f_ext,
+            net,
+            rows,
+            ..
+        } = evaluation;
+        let iterate = Iterate {
+            x: self.x,
+            v,
+            a,
+            net,
+            f_ext,
+            internal,
+            constrained,
+            reaction,
+            moving: increment.moving.clone(),
+        };
+        Ok(finish(
+            increment.model,
+            increment.start,
+            increment.kind,
+            iterate,
+            &rows,
+            r,
+            self.warm,
+        ))
+    }
+
+    /// The failure of iterations that did not converge in `iterations`, with the last
+    /// residuals measured.
+    fn not_converged(&self, counters: &IncrementCounters, iterations: usize) -> IncrementFailure {
+        let (force_residual, contact_residual) = counters
+            .residuals
+            .last()
+            .copied()
+            .unwrap_or((f64::NAN, f64::NAN));
+        IncrementFailure::NewtonNotConverged {
+            iterations,
+            force_residual,
+            contact_residual,
+            worst: self.worst,
+        }
+    }
+
+    /// Whether the step reuses the reduced path's last factorization (a chord step): once the
+    /// forces nearly balance (see [`CHORD_WITHIN`]) or only the contact kinematics is left to
+    /// converge (the secant rows' gap converges linearly, see `contact_rows`), it serves
+    /// again: the matrix has changed by the order of the last, small step, so the chord step
+    /// reaches the tolerance as the Newton step would, at a fraction of the cost. Its tangent
+    /// is then not assembled: the assembler keeps the matrix of that factorization, which also
+    /// serves if the step must factorize after all (a candidate joining the near set, see
+    /// `contact_step`).
+    fn is_chord<const D: usize>(
+        &self,
+        increment: &Increment<'_, D>,
+        evaluation: &Evaluation,
+        counters: &IncrementCounters,
+    ) -> bool {
+        self.method == ContactSolve::Reduced
+            && !evaluation.rows.is_empty()
+            && self.reusable.is_some()
+            && counters.residuals.last().is_some_and(|&(force, _)| {
+                force <= CHORD_WITHIN * increment.settings.newton.force_tolerance
+            })
+    }
+
+    /// The iterate's tangent `c_K K_T + c_M M` with the contact rows' curvature, the held
+    /// equations' rows made identities. A static increment's first tangent drops the
+    /// regularisation where `K_T` holds every motion without the contacts (see
+    /// [`Assembler::is_held`]).
+    fn complete_tangent<const D: usize>(
+        &mut self,
+        increment: &Increment<'_, D>,
+        assembler: &mut Assembler,
+        evaluation: &Evaluation,
+        counters: &IncrementCounters,
+    ) -> Result<(), IncrementFailure> {
+        let Increment {
+            model, kind, held, ..
+        } = *increment;
+        if !evaluation.tangent_now {
+            let mean_velocity = increment.mean_velocity(&self.x);
+            let damping = increment
+                .factors
+                .damping_rate
+                .zip(mean_velocity.as_ref())
+                .map(|(rate, velocity)| Damping { velocity, rate });
+            let k_factor = Some(increment.factors.k_factor);
+            assembler.internal_damped(model, &self.x, k_factor, damping)?;
+        }
+        if matches!(kind, IncrementKind::Static { .. }) && counters.newton_iterations == 0 {
+            assembler.hold(held);
+            if assembler.is_held(model.regularization_mass(), held)? {
+                self.m_factor = 0.0;
+                self.shift.0 = 0.0;
+            }
+        }
+        assembler.add_diagonal(&(increment.factors.m_term.as_ref() * self.m_factor));
+        assembler.add_contact_curvature(&evaluation.rows, &self.warm);
+        assembler.hold(held);
+        Ok(())
+    }
+
+    /// The Newton step `dx` and the contact forces of the next iterate: without contacts on
+    /// `K + c M` itself (its mass term raised only where it is singular, see
+    /// [`Assembler::with_mass_shift`]); with contacts reduced onto their forces while
+    /// `K + c M` factorizes, else (or by request) global on the full system. The residual
+    /// keeps the true inertia, so a raised mass term changes only the path.
+    fn step<const D: usize>(
+        &mut self,
+        increment: &Increment<'_, D>,
+        (assembler, global): (&mut Assembler, &mut GlobalContactSolver),
+        evaluation: &Evaluation,
+        chord: bool,
+        counters: &mut IncrementCounters,
+        timings: &mut Timings,
+    ) -> Result<DVector<f64>, IncrementFailure> {
+        let Increment {
+            model,
+            kind,
+            held,
+            settings,
+            ..
+        } = *increment;
+        let (rows, residual) = (&evaluation.rows, &evaluation.residual);
+        let length = model.length_scale();
+        let shift_mass = model.regularization_mass();
+        let contact_tolerance = settings.newton.contact_tolerance * length;
+        if rows.is_empty() {
+            let clock = Instant::now();
+            let consistent = matches!(kind, IncrementKind::Static { .. }) && self.m_factor == 0.0;
+            let dx = step_without_contact(
+                assembler,
+                consistent,
+                (shift_mass, self.shift),
+                held,
+                residual,
+            )?;
+            timings.linear_solve += clock.elapsed();
+            self.last = Some(LastForces::Linearised {
+                r: DVector::zeros(0),
+                u: DVector::zeros(0),
+                rho: Vec::new(),
+            });
+            return Ok(dx);
+        }
+        if self.method == ContactSolve::Reduced {
+            let mut reuse = self.reusable.take().filter(|_| chord);
+            if self.weights.is_none() {
+                let k = assembler.lower_triangle()?;
+                self.weights = Some(contact_weights(k, rows));
+            }
+            let warm = &self.warm;
+            let step = |a: &mut Assembler| {
+                contact_step(
+                    a,
+                    rows,
+                    residual,
+                    warm,
+                    length,
+                    contact_tolerance,
+                    &settings.coulomb,
+                    reuse.take(),
+                    timings,
+                )
+            };
+            let stepped = on_factorized_tangent(
+                assembler,
+                self.may_switch,
+                (shift_mass, self.shift),
+                held,
+                step,
+            )?;
+            match stepped {
+                Some((dx, solution, factor)) => {
+                    self.reusable = Some(factor);
+                    counters.contact_solves += solution.conic_solves;
+                    counters.fixed_point_iterations += solution.fixed_point_iterations;
+                    counters.contact_newton_steps += solution.newton_steps;
+                    self.warm.clone_from(&solution.r);
+                    self.last = Some(LastForces::Linearised {
+                        r: solution.r,
+                        u: solution.u,
+                        rho: self.weights.clone().unwrap_or_default(),
+                    });
+                    return Ok(dx);
+                }
+                // the tangent without the contacts is indefinite: global steps from here on
+                // (see `solve_increment`)
+                None => {
+                    self.method = ContactSolve::Global;
+                    counters.global_switches += 1;
+                }
+            }
+        }
+        let clock = Instant::now();
+        let k = assembler.lower_triangle()?;
+        let rho = self.weights.get_or_insert_with(|| contact_weights(k, rows));
+        if self.warm.len() != rows.rows.len() {
+            self.warm = DVector::zeros(rows.rows.len());
+        }
+        let exact = self
+            .exact_contact
+            .then_some((contact_tolerance, LINEARISED_MAX_STEPS));
+        let step = global_step(
+            global,
+            model,
+            k,
+            (rows, held),
+            residual,
+            (&self.warm, rho),
+            exact,
+        );
+        timings.linear_solve += clock.elapsed();
+        let step = step?;
+        self.forces_before = Some(std::mem::replace(&mut self.warm, step.r.clone()));
+        self.last = Some(LastForces::Law {
+            r: step.r,
+            rho: rho.clone(),
+        });
+        Ok(step.dx)
+    }
 }
 
 /// The constant factors of an increment's residual and tangent: the solid's rows of the tangent
@@ -882,41 +1197,6 @@ fn global_step<const D: usize>(
         }
         None => global.step(model, k, rows, residual, warm, rho, held),
     }
-}
-
-/// What the constrained equations of a converged iterate `x` must balance: `held_residual`'s
-/// `(equation, R)` as the force of the constraint, and the reaction `R - H^T r` without the
-/// contact forces `r` on those equations, which their rows leave out (taken again here from
-/// contact rows of every equation, `rows_from` as the increment's).
-fn reactions<const D: usize>(
-    model: &Model<D>,
-    start: &State,
-    x: &DVector<f64>,
-    rows_from: (Option<&RowStart>, &[SurfacePoint]),
-    held_residual: &[(usize, f64)],
-    r: &DVector<f64>,
-) -> Result<(DVector<f64>, DVector<f64>), IncrementFailure> {
-    let n = x.len();
-    let held_contact = if held_residual.is_empty() {
-        None
-    } else {
-        let (row_start, previous) = rows_from;
-        let all = contact_rows(
-            model,
-            x,
-            &start.orientations,
-            row_start,
-            Some(previous),
-            &vec![false; n],
-        )?;
-        Some(all.transpose_times(r, n))
-    };
-    let (mut constrained, mut reaction) = (DVector::zeros(n), DVector::zeros(n));
-    for &(eq, value) in held_residual {
-        constrained[eq] = value;
-        reaction[eq] = value - held_contact.as_ref().map_or(0.0, |c| c[eq]);
-    }
-    Ok((constrained, reaction))
 }
 
 /// The round-off of each equation's residual at the iterate `x` of an increment from `x_n`:
