@@ -8,6 +8,7 @@
 //! momentum balanced by the contact impulses ([`MOMENTUM_TOLERANCE`]) and the energy balance
 //! within [`ENERGY_TOLERANCE`].
 
+use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -168,11 +169,28 @@ pub fn section(path: &Path, ladder: &Ladder) -> (String, Counts) {
         out.push('\n');
     }
     let mut checks = Checks::default();
-    let expected = 2 * 4 * ladder.factors.len();
+    // whole: each formulation the record names, in both dimensions at every factor, once
+    let formulations: BTreeSet<&str> = ladder.runs.iter().map(|r| r.formulation.as_str()).collect();
+    let expected = 2 * formulations.len() * ladder.factors.len();
+    let once = |dim: &str, formulation: &str, factor: f64| {
+        let is = |r: &&LadderRun| {
+            r.dimension == dim && r.formulation == formulation && r.factor == factor
+        };
+        ladder.runs.iter().filter(is).count() == 1
+    };
+    let whole = ["2d", "3d"].into_iter().all(|dim| {
+        formulations
+            .iter()
+            .all(|f| ladder.factors.iter().all(|&factor| once(dim, f, factor)))
+    });
     checks.record(
         "every dimension, formulation and factor recorded",
-        ladder.runs.len() == expected,
-        format!("{} runs of {expected}", ladder.runs.len()),
+        whole && ladder.runs.len() == expected,
+        format!(
+            "{} runs of {expected} ({} formulations)",
+            ladder.runs.len(),
+            formulations.len()
+        ),
     );
     let crashed = ladder.runs.iter().filter(|r| r.status == "crashed").count();
     checks.record("no run crashed", crashed == 0, format!("{crashed} crashed"));
@@ -238,7 +256,7 @@ mod tests {
     fn ladder() -> Ladder {
         let mut runs = Vec::new();
         for dim in ["2d", "3d"] {
-            for formulation in ["reduced", "full", "hybrid", "incompatible"] {
+            for formulation in ["reduced", "enhanced", "full", "hybrid", "incompatible"] {
                 for factor in [1.0, 10.0] {
                     let folds = formulation != "full" && factor == 10.0;
                     runs.push(run(dim, formulation, factor, folds));
@@ -272,6 +290,22 @@ mod tests {
         l.runs.pop();
         let (text, counts) = section(Path::new("pressure-limit.json"), &l);
         assert_eq!(counts.failed, 3, "{text}");
-        assert!(text.contains("15 runs of 16"), "{text}");
+        assert!(text.contains("19 runs of 20 (5 formulations)"), "{text}");
+    }
+
+    /// A run recorded twice in place of another leaves the count right but the record not
+    /// whole.
+    #[test]
+    fn a_run_recorded_twice_in_place_of_another_fails() {
+        let mut l = ladder();
+        l.runs[1].factor = l.runs[0].factor;
+        let (text, counts) = section(Path::new("pressure-limit.json"), &l);
+        assert!(
+            text.contains(
+                "**FAIL** every dimension, formulation and factor recorded: 20 runs of 20"
+            ),
+            "{text}"
+        );
+        assert!(counts.failed >= 1, "{text}");
     }
 }
