@@ -138,6 +138,14 @@ impl<'a, const D: usize> Increment<'a, D> {
             .damping_rate
             .map(|rate| (x - &self.start.x) * rate)
     }
+
+    /// The stiffness damping at the mean velocity `velocity` (see [`Increment::mean_velocity`]).
+    pub(super) fn damping<'v>(&self, velocity: Option<&'v DVector<f64>>) -> Option<Damping<'v>> {
+        self.factors
+            .damping_rate
+            .zip(velocity)
+            .map(|(rate, velocity)| Damping { velocity, rate })
+    }
 }
 
 /// One iterate's forces, residual and contact rows.
@@ -260,11 +268,7 @@ impl Newton {
         let tangent_now = self.last.is_none()
             || (self.method == ContactSolve::Global && counters.newton_iterations == 1);
         let mean_velocity = increment.mean_velocity(x);
-        let damping = increment
-            .factors
-            .damping_rate
-            .zip(mean_velocity.as_ref())
-            .map(|(rate, velocity)| Damping { velocity, rate });
+        let damping = increment.damping(mean_velocity.as_ref());
         let k_factor = tangent_now.then_some(increment.factors.k_factor);
         let internal = match assembler.internal_damped(model, x, k_factor, damping) {
             Ok(internal) => internal,
@@ -498,11 +502,7 @@ impl Newton {
         } = *increment;
         if !evaluation.tangent_now {
             let mean_velocity = increment.mean_velocity(&self.x);
-            let damping = increment
-                .factors
-                .damping_rate
-                .zip(mean_velocity.as_ref())
-                .map(|(rate, velocity)| Damping { velocity, rate });
+            let damping = increment.damping(mean_velocity.as_ref());
             let k_factor = Some(increment.factors.k_factor);
             assembler.internal_damped(model, &self.x, k_factor, damping)?;
         }
