@@ -71,6 +71,66 @@ pub(super) fn finish<const D: usize>(
         }
     };
     let r = &r;
+    let (contacts, friction, normal_work) = contact_states(start, kind, rows, r);
+    let (time, load_factor) = match kind {
+        IncrementKind::Static { load_factor, .. } => (start.time, load_factor),
+        IncrementKind::Dynamic { h, .. } => (start.time + h, 1.0),
+    };
+    let dx = &x - &start.x;
+    let contact_reaction = rows.transpose_times(r, x.len());
+    let moved: Vec<usize> = (0..x.len()).filter(|&eq| moving[eq]).collect();
+    let reaction_work = reaction_work(start, kind, (&reaction, &moved), &dx);
+    let algorithmic = algorithmic_dissipation(
+        (model, start, kind),
+        (&dx, &net, &a, &v),
+        (&contact_reaction, &constrained, &moved),
+    );
+    // the viscous forces' work by the trapezoidal rule, as the algorithmic dissipation takes
+    // them among the smooth forces
+    let damping = match start.damping_force.len() {
+        0 => 0.5 * internal.damping_force.dot(&dx),
+        _ => 0.5 * (&start.damping_force + &internal.damping_force).dot(&dx),
+    };
+    let energy = EnergyLedger {
+        kinetic: 0.5 * v.component_mul(&v).dot(model.mass()),
+        strain: internal.strain_energy,
+        hourglass: internal.hourglass_energy,
+        external_work: start.energy.external_work + 0.5 * (&start.external_force + &f_ext).dot(&dx),
+        reaction_work: start.energy.reaction_work + reaction_work,
+        friction_dissipation: start.energy.friction_dissipation + friction,
+        normal_work: start.energy.normal_work + normal_work,
+        algorithmic_dissipation: start.energy.algorithmic_dissipation + algorithmic,
+        damping_dissipation: start.energy.damping_dissipation + damping,
+    };
+    let orientations = model.record_orientations(&start.orientations, &x);
+    State {
+        time,
+        load_factor,
+        orientations,
+        contact_reaction,
+        reaction,
+        x,
+        v,
+        a,
+        net_force: net,
+        damping_force: internal.damping_force,
+        external_force: f_ext,
+        contacts,
+        warm_forces,
+        energy,
+    }
+}
+
+/// The contact points' states at the end of the increment, from the contact rows at the
+/// converged iterate and their forces `r` (the mean force of a dynamic increment's impulse),
+/// with the friction's dissipation `-t . slip` and the normal forces' work `p_N dg` over the
+/// increment.
+fn contact_states(
+    start: &State,
+    kind: IncrementKind,
+    rows: &ContactRows,
+    r: &DVector<f64>,
+) -> (Vec<ContactPointState>, f64, f64) {
     let d = rows.components;
     let mut contacts = Vec::with_capacity(rows.len());
     let mut friction = 0.0;
@@ -109,14 +169,18 @@ pub(super) fn finish<const D: usize>(
             tangential_force: tangential,
         });
     }
-    let (time, load_factor) = match kind {
-        IncrementKind::Static { load_factor, .. } => (start.time, load_factor),
-        IncrementKind::Dynamic { h, .. } => (start.time + h, 1.0),
-    };
-    let dx = &x - &start.x;
-    let contact_reaction = rows.transpose_times(r, x.len());
-    let moved: Vec<usize> = (0..x.len()).filter(|&eq| moving[eq]).collect();
-    let reaction_work: f64 = moved
+    (contacts, friction, normal_work)
+}
+
+/// The work of the prescribed (`moved`) equations' reactions over the step `dx`: by the
+/// trapezoidal rule in a static increment, as the mean force of the impulse in a dynamic one.
+fn reaction_work(
+    start: &State,
+    kind: IncrementKind,
+    (reaction, moved): (&DVector<f64>, &[usize]),
+    dx: &DVector<f64>,
+) -> f64 {
+    moved
         .iter()
         .map(|&eq| {
             let mean = match kind {
@@ -127,23 +191,33 @@ pub(super) fn finish<const D: usize>(
             };
             mean * dx[eq]
         })
-        .sum();
-    let algorithmic = match kind {
+        .sum()
+}
+
+/// The energy HHT's integration removed over a dynamic increment (none in a static one; see
+/// [`crate::hht::Hht::algorithmic_dissipation`]), the contact forces and all that the
+/// constraint of a prescribed equation balances acting as impulses.
+fn algorithmic_dissipation<const D: usize>(
+    (model, start, kind): (&Model<D>, &State, IncrementKind),
+    (dx, net, a, v): (&DVector<f64>, &DVector<f64>, &DVector<f64>, &DVector<f64>),
+    (contact_reaction, constrained, moved): (&DVector<f64>, &DVector<f64>, &[usize]),
+) -> f64 {
+    match kind {
         IncrementKind::Static { .. } => 0.0,
         IncrementKind::Dynamic { hht, h, .. } => {
             // the forces that act as impulses: the contacts', and all that the constraint of
             // a prescribed equation balances (its reaction and the contact forces on it)
             let mut impulse_forces = contact_reaction.clone();
-            for &eq in &moved {
+            for &eq in moved {
                 impulse_forces[eq] += constrained[eq];
             }
-            // the gyroscopic moments enter HHT's equations as the forces do (see the module
-            // documentation), so they are part of the smooth forces here
+            // the gyroscopic moments enter HHT's equations as the forces do (see the
+            // `increment` module's documentation), so they are part of the smooth forces here
             let (f0, f1) = match (
                 model.gyroscopic_moments(&start.v),
-                model.gyroscopic_moments(&v),
+                model.gyroscopic_moments(v),
             ) {
-                (Some(g0), Some(g1)) => (&start.net_force + g0, &net + g1),
+                (Some(g0), Some(g1)) => (&start.net_force + g0, net + g1),
                 _ => (start.net_force.clone(), net.clone()),
             };
             hht.algorithmic_dissipation(
@@ -151,48 +225,14 @@ pub(super) fn finish<const D: usize>(
                 &IncrementEnds {
                     mass: model.mass(),
                     quasi_static: model.quasi_static(),
-                    dx: &dx,
+                    dx,
                     f0: &f0,
                     f1: &f1,
                     a0: &start.a,
-                    a1: &a,
+                    a1: a,
                     contact: &impulse_forces,
                 },
             )
         }
-    };
-    // the viscous forces' work by the trapezoidal rule, as the algorithmic dissipation takes
-    // them among the smooth forces
-    let damping = match start.damping_force.len() {
-        0 => 0.5 * internal.damping_force.dot(&dx),
-        _ => 0.5 * (&start.damping_force + &internal.damping_force).dot(&dx),
-    };
-    let energy = EnergyLedger {
-        kinetic: 0.5 * v.component_mul(&v).dot(model.mass()),
-        strain: internal.strain_energy,
-        hourglass: internal.hourglass_energy,
-        external_work: start.energy.external_work + 0.5 * (&start.external_force + &f_ext).dot(&dx),
-        reaction_work: start.energy.reaction_work + reaction_work,
-        friction_dissipation: start.energy.friction_dissipation + friction,
-        normal_work: start.energy.normal_work + normal_work,
-        algorithmic_dissipation: start.energy.algorithmic_dissipation + algorithmic,
-        damping_dissipation: start.energy.damping_dissipation + damping,
-    };
-    let orientations = model.record_orientations(&start.orientations, &x);
-    State {
-        time,
-        load_factor,
-        orientations,
-        contact_reaction,
-        reaction,
-        x,
-        v,
-        a,
-        net_force: net,
-        damping_force: internal.damping_force,
-        external_force: f_ext,
-        contacts,
-        warm_forces,
-        energy,
     }
 }
