@@ -281,8 +281,9 @@ fn solve_increment_with<const D: usize>(
         ContactSolve::Global => settings.newton.max_iterations.min(GLOBAL_MAX_ITERATIONS),
         ContactSolve::Reduced => settings.newton.max_iterations,
     };
-    let increment = Increment::new(model, assembler, start, kind, constraints, settings)?;
-    let mut newton = Newton::new(&increment, (method, may_switch));
+    let (increment, predictor) =
+        Increment::new(model, assembler, start, kind, constraints, settings)?;
+    let mut newton = Newton::new(&increment, predictor, (method, may_switch));
     for iteration in 0..=max_iterations {
         if newton.x.iter().any(|v| !v.is_finite()) {
             return Err(IncrementFailure::NonFinite { iteration });
@@ -319,10 +320,7 @@ fn solve_increment_with<const D: usize>(
         if dx.iter().any(|v| !v.is_finite()) {
             return Err(IncrementFailure::NonFinite { iteration });
         }
-        assembler.advance_mixed_pressures(model, &dx);
-        newton.x += &dx;
-        newton.last_step = Some(dx);
-        newton.halvings = 0;
+        newton.advance(model, assembler, dx);
     }
     // The loop returns from inside, converged or at the last convergence check, unless its
     // last iterations went to halving steps that fold an element: report the last residuals

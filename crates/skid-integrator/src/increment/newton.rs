@@ -31,35 +31,34 @@ use super::{IncrementCounters, IncrementKind};
 
 /// What an increment's Newton iterations share and do not change.
 pub(super) struct Increment<'a, const D: usize> {
-    pub(super) model: &'a Model<D>,
-    pub(super) start: &'a State,
-    pub(super) kind: IncrementKind,
+    model: &'a Model<D>,
+    start: &'a State,
+    kind: IncrementKind,
     /// The constrained equations.
-    pub(super) held: &'a [bool],
+    held: &'a [bool],
     /// The equations that move as prescribed.
-    pub(super) moving: Vec<bool>,
-    pub(super) settings: &'a Settings,
-    pub(super) factors: Factors<'a>,
-    /// The increment's first iterate.
-    pub(super) predictor: DVector<f64>,
+    moving: Vec<bool>,
+    settings: &'a Settings,
+    factors: Factors<'a>,
     /// Where the contact rows start: dynamic increments take the normal rows between the
     /// start and the end positions, so that the contact impulse does the work `p_N dg` (see
     /// `contact_rows`); a static equilibrium takes the normal at the solution itself.
-    pub(super) row_start: Option<RowStart<'a>>,
+    row_start: Option<RowStart<'a>>,
     /// The closest points of the start's contacts.
-    pub(super) previous: Vec<SurfacePoint>,
+    previous: Vec<SurfacePoint>,
     /// The gyroscopic moments at the start, HHT's history term for bodies free to turn.
-    pub(super) start_gyroscopic: Option<DVector<f64>>,
+    start_gyroscopic: Option<DVector<f64>>,
     /// The internal forces are as exact as the stresses they sum: an equation's force is
     /// known to `eps` of its elements' stiffness times their size (the round-off of
     /// `K (J - 1)` of a nearly incompressible solid: Cook's membrane at nu = 0.4999 under a
     /// load of 1e-3 stalled at 1e-5 of it), see [`Assembler::stiffness_scale`].
-    pub(super) stiffness_roundoff: DVector<f64>,
+    stiffness_roundoff: DVector<f64>,
 }
 
 impl<'a, const D: usize> Increment<'a, D> {
     /// The increment of `kind` from `start` with the `constraints` (held equations, and the
-    /// `(equation, value)` of the prescribed ones); starts the assembler's mixed pressures.
+    /// `(equation, value)` of the prescribed ones), and its first iterate (see [`predictor`]);
+    /// starts the assembler's mixed pressures.
     pub(super) fn new(
         model: &'a Model<D>,
         assembler: &mut Assembler,
@@ -67,7 +66,7 @@ impl<'a, const D: usize> Increment<'a, D> {
         kind: IncrementKind,
         (held, prescribed): (&'a [bool], &[(usize, f64)]),
         settings: &'a Settings,
-    ) -> Result<Self, IncrementFailure> {
+    ) -> Result<(Self, DVector<f64>), IncrementFailure> {
         let row_start = match kind {
             IncrementKind::Static { .. } => None,
             IncrementKind::Dynamic { .. } => Some(RowStart::new(model, &start.x)),
@@ -75,7 +74,7 @@ impl<'a, const D: usize> Increment<'a, D> {
         let stiffness_roundoff = assembler.stiffness_scale() * (ROUNDOFF_ULPS * f64::EPSILON);
         let (predictor, moving) = predictor(start, kind, (held, prescribed));
         assembler.start_mixed_pressures(model, &start.x)?;
-        Ok(Self {
+        let increment = Self {
             model,
             start,
             kind,
@@ -83,12 +82,12 @@ impl<'a, const D: usize> Increment<'a, D> {
             moving,
             settings,
             factors: Factors::new(model, kind),
-            predictor,
             row_start,
             previous: start.contacts.iter().map(|c| c.closest).collect(),
             start_gyroscopic: model.gyroscopic_moments(&start.v),
             stiffness_roundoff,
-        })
+        };
+        Ok((increment, predictor))
     }
 
     /// The contact rows at `x`, of the equations not `held` (every equation's with none).
@@ -150,20 +149,20 @@ impl<'a, const D: usize> Increment<'a, D> {
 
 /// One iterate's forces, residual and contact rows.
 pub(super) struct Evaluation {
-    pub(super) v: DVector<f64>,
-    pub(super) a: DVector<f64>,
-    pub(super) internal: InternalState,
-    pub(super) f_ext: DVector<f64>,
+    v: DVector<f64>,
+    a: DVector<f64>,
+    internal: InternalState,
+    f_ext: DVector<f64>,
     /// `f_int + f_damping - f_ext`.
-    pub(super) net: DVector<f64>,
-    pub(super) inertia: DVector<f64>,
+    net: DVector<f64>,
+    inertia: DVector<f64>,
     /// The residual without contact, zero on the held equations.
-    pub(super) residual: DVector<f64>,
-    pub(super) rows: ContactRows,
+    residual: DVector<f64>,
+    rows: ContactRows,
     /// What the constraints must balance (see [`take_held`]).
-    pub(super) held_residual: Vec<(usize, f64)>,
+    held_residual: Vec<(usize, f64)>,
     /// Whether the tangent was assembled with the forces.
-    pub(super) tangent_now: bool,
+    tangent_now: bool,
 }
 
 /// What a convergence check found.
@@ -177,43 +176,43 @@ pub(super) enum Check {
 /// The state of an increment's Newton iterations.
 pub(super) struct Newton {
     /// How the contact forces of a step are found.
-    pub(super) method: ContactSolve,
+    method: ContactSolve,
     /// Whether a reduced step may switch to global steps (see [`super::solve_increment`]).
-    pub(super) may_switch: bool,
+    may_switch: bool,
     /// `c_M` and the first mass shift (see [`Factors`]); a static increment's first tangent
     /// may drop the regularisation.
-    pub(super) m_factor: f64,
-    pub(super) shift: (f64, f64),
+    m_factor: f64,
+    shift: (f64, f64),
     /// The iterate.
     pub(super) x: DVector<f64>,
     /// The contact forces a step starts from.
-    pub(super) warm: DVector<f64>,
+    warm: DVector<f64>,
     /// The contact forces of the last step and what the next iterate's contact state is
     /// checked against.
     pub(super) last: Option<LastForces>,
     /// The last step (at first the predictor's) and how often it has been halved.
-    pub(super) last_step: Option<DVector<f64>>,
-    pub(super) halvings: usize,
+    last_step: Option<DVector<f64>>,
+    halvings: usize,
     /// Whether global steps solve their linearisation's contact problem (see
     /// [`is_stagnating`]).
-    pub(super) exact_contact: bool,
-    pub(super) worst: Option<WorstResidual>,
+    exact_contact: bool,
+    worst: Option<WorstResidual>,
     /// The forces before the last global step, to go back half way with the step.
-    pub(super) forces_before: Option<DVector<f64>>,
+    forces_before: Option<DVector<f64>>,
     /// The factorization of the last contact step (see [`Newton::step`]).
-    pub(super) reusable: Option<Factorization>,
+    reusable: Option<Factorization>,
     /// The candidates' weights of the contact law residual, fixed for the increment so that
     /// the law residual measures every iterate alike (see [`crate::global_contact`]).
-    pub(super) weights: Option<Vec<f64>>,
+    weights: Option<Vec<f64>>,
 }
 
 impl Newton {
-    /// The iterations of `increment` with the contact solve `method`, from its predictor.
+    /// The iterations of `increment` with the contact solve `method`, from its predictor `x`.
     pub(super) fn new<const D: usize>(
         increment: &Increment<'_, D>,
+        x: DVector<f64>,
         (method, may_switch): (ContactSolve, bool),
     ) -> Self {
-        let x = increment.predictor.clone();
         let last_step = match increment.kind {
             IncrementKind::Static { .. } => None,
             IncrementKind::Dynamic { .. } => Some(&x - &increment.start.x),
@@ -234,6 +233,19 @@ impl Newton {
             reusable: None,
             weights: None,
         }
+    }
+
+    /// Takes the Newton step `dx` (the mixed pressures with it).
+    pub(super) fn advance<const D: usize>(
+        &mut self,
+        model: &Model<D>,
+        assembler: &mut Assembler,
+        dx: DVector<f64>,
+    ) {
+        assembler.advance_mixed_pressures(model, &dx);
+        self.x += &dx;
+        self.last_step = Some(dx);
+        self.halvings = 0;
     }
 
     /// The iterate's forces, residual and contact rows; `None` if the last step folded an
@@ -684,7 +696,7 @@ impl LastForces {
 /// `step` on the assembled tangent: if `may_switch`, on that tangent itself, `None` if it is
 /// indefinite (it has no Cholesky factor); otherwise with the mass term raised from `shift`
 /// until it has one (see [`Assembler::with_mass_shift`]).
-pub(super) fn on_factorized_tangent<T>(
+fn on_factorized_tangent<T>(
     assembler: &mut Assembler,
     may_switch: bool,
     (mass, shift): (&DVector<f64>, (f64, f64)),
@@ -705,7 +717,7 @@ pub(super) fn on_factorized_tangent<T>(
 /// a static increment's `consistent` tangent it is factored as `L D L^T` where it is indefinite
 /// (see [`Assembler::is_held`]); otherwise, or where that fails, by Cholesky with the mass term
 /// raised from `shift` where the tangent is singular (see [`Assembler::with_mass_shift`]).
-pub(super) fn step_without_contact(
+fn step_without_contact(
     assembler: &mut Assembler,
     consistent: bool,
     (mass, shift): (&DVector<f64>, (f64, f64)),
@@ -736,7 +748,7 @@ pub(super) fn step_without_contact(
 /// [`crate::global_contact`]), from the forces `warm` with the candidates' weights `rho`: the
 /// solution of its linearisation's contact problem to `exact`'s (tolerance, steps) where given
 /// (see [`GlobalContactSolver::linearised_solution`]), else one semismooth step.
-pub(super) fn global_step<const D: usize>(
+fn global_step<const D: usize>(
     global: &mut GlobalContactSolver,
     model: &Model<D>,
     k: SparseColMatRef<'_, usize, f64>,
@@ -755,7 +767,7 @@ pub(super) fn global_step<const D: usize>(
 
 /// True if the last convergence check repeats the one two before it (both residuals within
 /// 5 %): Newton alternating between two iterates.
-pub(super) fn is_cycling(residuals: &[(f64, f64)]) -> bool {
+fn is_cycling(residuals: &[(f64, f64)]) -> bool {
     let [.., (f0, c0), _, (f2, c2)] = residuals else {
         return false;
     };
@@ -765,7 +777,7 @@ pub(super) fn is_cycling(residuals: &[(f64, f64)]) -> bool {
 
 /// True if the last convergence check is not below half the one before it, each measured
 /// against its tolerance (the larger of the two ratios): Newton is not converging.
-pub(super) fn is_stagnating(residuals: &[(f64, f64)], newton: &NewtonSettings) -> bool {
+fn is_stagnating(residuals: &[(f64, f64)], newton: &NewtonSettings) -> bool {
     let [.., before, last] = residuals else {
         return false;
     };
@@ -775,14 +787,14 @@ pub(super) fn is_stagnating(residuals: &[(f64, f64)], newton: &NewtonSettings) -
 }
 
 /// Semismooth steps on one linearisation before its contact problem is taken as solved.
-pub(super) const LINEARISED_MAX_STEPS: usize = 30;
+const LINEARISED_MAX_STEPS: usize = 30;
 
 /// A reduced step reuses the last factorization (a chord step) once the force residual is
 /// within this factor of its tolerance. Measured on the drum's spin-downs, where the first
 /// Newton step leaves a relative force residual of 1e-5 to 1e-4: the chord step takes it below
 /// 1e-6 as often as the Newton step does (Newton iterations 3020 and 3024 on `3d-r3d4`, 2304
 /// and 2312 on `3d-analytic`) with half the factorizations.
-pub(super) const CHORD_WITHIN: f64 = 1e3;
+const CHORD_WITHIN: f64 = 1e3;
 
 /// How often one Newton step may be halved because its end folds an element, before the
 /// increment fails (and is cut back).

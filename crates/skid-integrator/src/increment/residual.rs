@@ -241,7 +241,7 @@ pub(super) fn rates(
 /// (indefinite without its contacts) at 0.1 to 5 ms steps: 1e-6 converges every increment in
 /// about two iterations, 1e-3 takes 50 % more iterations, 1e-2 and above fail at 0.1 ms (the
 /// shifted Newton step crawls).
-pub(super) const QUASI_STATIC_SHIFT: f64 = 1e-6;
+const QUASI_STATIC_SHIFT: f64 = 1e-6;
 
 /// The round-off of an equation's inertia term, in units of `eps M |x| / (beta h^2)`: the
 /// rounding of `x`, of the predictor and of the differences that form the acceleration.
